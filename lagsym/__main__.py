@@ -1,0 +1,5 @@
+"""``python -m lagsym`` runs the command line."""
+
+from .cli import run_console
+
+run_console()

@@ -1,0 +1,53 @@
+"""The lagsym error family.
+
+Every error lagsym raises on purpose derives from :class:`LagsymError` and from
+the matching built-in exception, so callers may catch either.  Each class
+carries the exit status the command line uses for it: 2 for bad input or a bad
+request, 3 for hardware and line faults.
+"""
+
+from __future__ import annotations
+
+import enum
+
+
+class ExitStatus(enum.IntEnum):
+    """Exit statuses of the ``lagsym`` command."""
+
+    OK = 0
+    WARNING = 1  # a check found something worth a look (``--strict``)
+    BAD_INPUT = 2  # bad file, bad value, bad option
+    LINE_FAULT = 3  # hardware or serial line fault; the message says what to do next
+    INTERRUPTED = 130
+
+
+class LagsymError(Exception):
+    """Base class of every error lagsym raises on purpose."""
+
+    exit_status: ExitStatus = ExitStatus.BAD_INPUT
+
+
+class InputError(LagsymError, ValueError):
+    """A file or value given to lagsym is unusable; the message names it."""
+
+
+class GridError(InputError):
+    """Control points that do not form the rectangular grid the method needs."""
+
+
+class FormulaError(InputError):
+    """A reference formula that does not parse under the strict grammar."""
+
+
+class ToolpathError(LagsymError, ValueError):
+    """Toolpath settings that cannot give a safe path."""
+
+
+class ProgramError(LagsymError, ValueError):
+    """A part program that a control would refuse (an alarm), or that cannot be written."""
+
+
+class TransferError(LagsymError, OSError):
+    """A fault on the serial line or in the machine at the other end."""
+
+    exit_status = ExitStatus.LINE_FAULT

@@ -1,0 +1,43 @@
+"""Shared fixtures."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+
+settings.register_profile("ci", max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("dev", max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+
+@pytest.fixture(scope="session")
+def rs274():
+    """LinuxCNC's standalone interpreter (fetched from Debian into .cache if need be)."""
+    from debtools import rs274 as find
+
+    return find()
+
+
+@pytest.fixture
+def run_cli(capsys):
+    """Run the ``lagsym`` command in-process; returns (status, stdout, stderr)."""
+    import io
+
+    from lagsym.cli import main
+
+    def run(*argv):
+        out, err = io.StringIO(), io.StringIO()
+        status = main([str(a) for a in argv], out, err)
+        return status, out.getvalue(), err.getvalue()
+
+    return run
