@@ -43,7 +43,9 @@ __all__ = [
     "toolpath_figure",
     "deviation_figure",
     "deviation_map",
+    "curve_basis_figure",
     "save_figure",
+    "image_format",
     "rendering_backend",
     "IMAGE_FORMATS",
     "DEFAULT_WINDOW_SIZE",
@@ -59,6 +61,8 @@ POINT_COLOR = "crimson"
 NET_COLOR = "black"
 FEED_COLOR = "orangered"
 RAPID_COLOR = "royalblue"
+_CYCLE = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+          "tab:olive", "tab:cyan")
 
 # A tiny scene rendered in a child process: a render window that cannot get an
 # OpenGL context may crash the process that asks, so never ask in this one.
@@ -403,6 +407,49 @@ def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | N
     return p
 
 
+def curve_basis_figure(curve, *, samples: int = 401, units: str = "mm", window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
+                       off_screen: bool | None = None):
+    """The basis polynomials ``L_i(x)`` of a curve's nodes, each 1 at its own node and 0 at the others.
+
+    Parameters
+    ----------
+    curve : LagrangeCurve
+        Supplies the nodes.
+    samples : int
+        Samples along x.
+    units : str
+        Length unit of x.
+    window_size : (int, int)
+        Image size in pixels.
+    off_screen : bool, optional
+        Render without a window; forced where there is no display.
+
+    Returns
+    -------
+    pyvista.Plotter
+    """
+    import pyvista as pv
+
+    from .evaluate import basis_matrix
+
+    n = _samples(samples)
+    nodes = curve.points.x_array
+    xs = np.linspace(nodes[0], nodes[-1], n)
+    lx = basis_matrix(nodes, xs)
+    p = _plotter(window_size=window_size, off_screen=off_screen)
+    chart = pv.Chart2D(x_label=f"x ({units})", y_label="L_i(x)")
+    chart.title = f"Lagrange basis polynomials of degree {curve.degree} on {len(nodes)} nodes"
+    for i in range(len(nodes)):
+        color = _CYCLE[i % len(_CYCLE)]
+        chart.line(xs, lx[:, i], color=color, width=2.5, label=f"L{i + 1}(x)")
+        chart.scatter(nodes[i:i + 1], [1.0], color=color, size=10, style="o")
+    chart.scatter(nodes, np.zeros_like(nodes), color="black", size=6, style="o")
+    chart.x_range = _padded(xs.min(), xs.max())
+    chart.y_range = _padded(float(lx.min()), float(lx.max()))
+    p.add_chart(chart)
+    return p
+
+
 def _padded(lo: float, hi: float, share: float = 0.06) -> list[float]:
     pad = (hi - lo) * share or 1.0
     return [float(lo - pad), float(hi + pad)]
@@ -687,6 +734,20 @@ def deviation_figure(x, y, deviations: Mapping[str, np.ndarray], *, units: str =
 # ----------------------------------------------------------------------------- writing images
 
 
+def image_format(path: str | os.PathLike) -> str:
+    """The image format for ``path``, from its suffix (one of :data:`IMAGE_FORMATS`).
+
+    >>> image_format("surface.PNG"), image_format("a/b.jpg")
+    ('png', 'jpeg')
+    """
+    path = Path(path)
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix not in IMAGE_FORMATS:
+        raise InputError(f"{path}: cannot tell the image format from {path.suffix or 'no suffix'!r}; "
+                         f"use one of: {', '.join('.' + f for f in IMAGE_FORMATS)}")
+    return {"jpg": "jpeg", "tif": "tiff"}.get(suffix, suffix)
+
+
 def save_figure(plotter, path: str | os.PathLike, *, close: bool = True) -> Path:
     """Render ``plotter`` and write the image to ``path`` atomically.
 
@@ -713,15 +774,12 @@ def save_figure(plotter, path: str | os.PathLike, *, close: bool = True) -> Path
     from .io import atomic_write
 
     path = Path(path)
-    suffix = path.suffix.lower().lstrip(".")
-    if suffix not in IMAGE_FORMATS:
-        raise InputError(f"{path}: cannot tell the image format from {path.suffix or 'no suffix'!r}; "
-                         f"use one of: {', '.join('.' + f for f in IMAGE_FORMATS)}")
+    fmt = image_format(path)
     img = plotter.screenshot(return_img=True)
     if close:
         plotter.close()
     buf = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(img)).save(buf, format={"jpg": "jpeg", "tif": "tiff"}.get(suffix, suffix))
+    Image.fromarray(np.ascontiguousarray(img)).save(buf, format=fmt)
     with atomic_write(path, "wb") as f:
         f.write(buf.getvalue())
     return path
