@@ -22,7 +22,6 @@ Array conventions follow :func:`lagsym.evaluate.evaluate_grid`: a height array
 
 from __future__ import annotations
 
-import atexit
 import functools
 import os
 import shutil
@@ -100,15 +99,29 @@ def _probe(window_class: str) -> bool:
     return done.returncode == 0 and done.stdout.strip() == "ok"
 
 
+def _die_with_parent() -> None:
+    """In the child before exec: ask Linux to end it with SIGTERM when its parent exits."""
+    import ctypes
+    import signal
+
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+
+
 def _start_xvfb() -> str:
-    """Start a private Xvfb server, stopped when this process exits; return its display name."""
+    """Start a private Xvfb server that ends with this process; return its display name.
+
+    The kernel ends the server when this process exits (not an ``atexit``
+    handler, which would run while VTK still holds its X connection).
+    """
     read_fd, write_fd = os.pipe()
     try:
         server = subprocess.Popen(
             ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
             pass_fds=(write_fd,),
+            stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
+            preexec_fn=_die_with_parent,
         )
     finally:
         os.close(write_fd)
@@ -117,16 +130,7 @@ def _start_xvfb() -> str:
     if not number.isdigit():
         server.terminate()
         raise RenderError("Xvfb started but did not report a display number")
-    atexit.register(_stop, server)
     return f":{number}"
-
-
-def _stop(server: subprocess.Popen) -> None:
-    server.terminate()
-    try:
-        server.wait(timeout=5)
-    except subprocess.TimeoutExpired:
-        server.kill()
 
 
 @functools.cache
@@ -274,10 +278,13 @@ def _plan_view(plotter, zoom: float = 0.8) -> None:
     plotter.camera.zoom(zoom)
 
 
-def _fit(text: str, width_px: float, largest: int = 14, smallest: int = 6) -> int:
-    """A font size at which the longest line of ``text`` fits in ``width_px`` pixels."""
+def _fit(text: str, width_px: float, largest: int = 14, smallest: int = 5) -> int:
+    """A font size at which the longest line of ``text`` fits in ``width_px`` pixels.
+
+    A character of VTK's Arial is at most about 1.2 font sizes wide; the rest is margin.
+    """
     longest = max((len(line) for line in text.splitlines()), default=1) or 1
-    return int(max(smallest, min(largest, width_px / (1.3 * longest))))
+    return int(max(smallest, min(largest, width_px / (1.5 * longest))))
 
 
 def _z_scale(x_span: float, y_span: float, z_span: float) -> float:
@@ -293,7 +300,7 @@ def _title(surface_or_curve) -> str:
     if isinstance(deg, tuple):
         n, m = deg
         d = f"degree {n}" if n == m else f"degree {n} in x, {m} in y"
-        return f"Lagrange surface z = F(x, y), {d} ({n + 1}x{m + 1} control points)"
+        return f"Lagrange surface z = F(x, y), {d} ({n + 1}x{m + 1} points)"
     return f"Lagrange curve y = F(x), degree {deg} ({deg + 1} points)"
 
 
@@ -563,7 +570,9 @@ def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str =
     w, h = _window_size(window_size)
     p = _plotter(shape=(2, n + 1), window_size=(w, h), off_screen=off_screen, col_weights=[1.0] * n + [_BAR_COLUMN])
     panel = w / (n + _BAR_COLUMN)
-    zname, dname = f"z ({units})", f"deviation ({units})"
+    zname, dname = f"z ({units})", f"dev. ({units})"
+    top = _fit("\n".join(names), panel, largest=14)
+    bottom = _fit("\n".join(f"{name} - {reference}" for name in names), panel, largest=12)
     z_actor = d_actor = None
     for col, name in enumerate(names):
         p.subplot(0, col)
@@ -571,19 +580,19 @@ def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str =
                              clim=(zlo, zhi), smooth_shading=True, show_scalar_bar=False)
         if pts is not None:
             p.add_mesh(_pointcloud(pts), color=POINT_COLOR, point_size=8, render_points_as_spheres=True)
-        p.add_text(name, position="upper_edge", font_size=_fit(name, panel, largest=14), color="black")
+        p.add_text(name, position="upper_edge", font_size=top, color="black")
         p.set_scale(zscale=scale)
         _view(p, zoom=1.0)
         p.subplot(1, col)
         if name == reference:
-            _add_plan(p, x, y, pts, f"{name} (reference)\ncontrol points, plan", panel)
+            _add_plan(p, x, y, pts, f"{name}\n(reference)", bottom)
             continue
         d = zs[name] - ref
         d_actor = p.add_mesh(_scalar_mesh(x, y, np.zeros_like(d), dname, d), scalars=dname, cmap=DEVIATION_CMAP,
                              clim=(-dmax, dmax), lighting=False, show_scalar_bar=False)
         p.add_mesh(_outline(x, y), color="black", line_width=1, lighting=False)
-        text = f"{name} - {reference}\nlargest {np.abs(d).max():.4g} {units}"
-        p.add_text(text, position="upper_edge", font_size=_fit(text, panel, largest=12), color="black")
+        text = f"{name} - {reference}\nlargest {np.abs(d).max():.3g} {units}"
+        p.add_text(text, position="upper_edge", font_size=bottom, color="black")
         _plan_view(p)
     _bar_column(p, 0, n, z_actor.mapper, zname, h // 2)
     if d_actor is not None:
@@ -591,14 +600,14 @@ def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str =
     return p
 
 
-def _add_plan(p, x, y, pts, text: str, panel_px: float) -> None:
+def _add_plan(p, x, y, pts, text: str, font: int) -> None:
     import pyvista as pv
 
     p.add_mesh(_outline(x, y), color="gray", line_width=1, lighting=False)
     if pts is not None:
         p.add_mesh(pv.PolyData(np.c_[pts[:, :2], np.zeros(len(pts))]), color=POINT_COLOR, point_size=8,
                    render_points_as_spheres=True)
-    p.add_text(text, position="upper_edge", font_size=_fit(text, panel_px, largest=12), color="black")
+    p.add_text(text, position="upper_edge", font_size=font, color="black")
     _plan_view(p)
 
 
@@ -680,8 +689,8 @@ def toolpath_figure(surface, moves, *, rapid=None, samples: int = 61, units: str
     _labels(p, units, font_size=max(8, h // 60))
     deg = surface.degree
     text = title if title is not None else (
-        f"Toolpath over the Lagrange surface of degree {deg[0]} x {deg[1]}\n"
-        f"{feed.size} feed moves (orange-red), {quick.size} rapids (blue)")
+        f"Toolpath over the Lagrange surface, degree {deg[0]} x {deg[1]}\n"
+        f"{feed.size} feed moves (red), {quick.size} rapids (blue)")
     p.add_text(text, position="upper_edge", font_size=_fit(text, w, largest=12), color="black")
     _view(p, zoom=0.9)
     return p
@@ -717,15 +726,16 @@ def deviation_figure(x, y, deviations: Mapping[str, np.ndarray], *, units: str =
     w, h = _window_size(window_size)
     p = _plotter(shape=(1, n + 1), window_size=(w, h), off_screen=off_screen, col_weights=[1.0] * n + [_BAR_COLUMN])
     panel = w / (n + _BAR_COLUMN)
-    dname = f"deviation ({units})"
+    dname = f"dev. ({units})"
+    font = _fit("\n".join([*ds, f"largest 0.000 {units}"]), panel, largest=12)
     actor = None
     for col, (name, d) in enumerate(ds.items()):
         p.subplot(0, col)
         actor = p.add_mesh(_scalar_mesh(x, y, np.zeros_like(d), dname, d), scalars=dname, cmap=DEVIATION_CMAP,
                            clim=(-dmax, dmax), lighting=False, show_scalar_bar=False)
         p.add_mesh(_outline(x, y), color="black", line_width=1, lighting=False)
-        text = f"{name}\nlargest {np.abs(d).max():.4g} {units}"
-        p.add_text(text, position="upper_edge", font_size=_fit(text, panel, largest=12), color="black")
+        p.add_text(f"{name}\nlargest {np.abs(d).max():.3g} {units}", position="upper_edge", font_size=font,
+                   color="black")
         _plan_view(p)
     _bar_column(p, 0, n, actor.mapper, dname, h)
     return p
