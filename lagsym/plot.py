@@ -217,13 +217,13 @@ def _plotter(shape=(1, 1), window_size=DEFAULT_WINDOW_SIZE, off_screen: bool | N
     import pyvista as pv
 
     size = _window_size(window_size)
-    if rendering_backend() != "display" or off_screen is None and os.environ.get("PYVISTA_OFF_SCREEN") == "true":
-        off_screen = True
+    if rendering_backend() != "display":
+        off_screen = True  # a window on no screen, or on a private Xvfb, would show nobody anything
     theme = pv.themes.DocumentTheme()
     theme.jupyter_backend = "static"
     theme.font.color = "black"
     theme.font.family = "arial"
-    return pv.Plotter(shape=shape, window_size=list(size), off_screen=bool(off_screen), theme=theme,
+    return pv.Plotter(shape=shape, window_size=list(size), off_screen=off_screen, theme=theme,
                       lighting="three lights", border=False, col_weights=col_weights)
 
 

@@ -251,6 +251,27 @@ def test_figures_leave_the_global_theme_alone(surface2):
     assert pv.global_theme.to_dict() == before
 
 
+def test_jupyter_shows_a_static_image_headless(tmp_path):
+    """A notebook run headless, as CI runs one, gets the figure inline as a PNG."""
+    import nbclient
+    import nbformat
+
+    code = (
+        f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
+        "from lagsym import plot\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        f"s = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-2.json')!r}))\n"
+        "plot.surface_figure(s, samples=9, window_size=(200, 150)).show()"
+    )
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+    nbclient.NotebookClient(nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+                            ).execute()
+    outputs = nb.cells[0].outputs
+    assert [o.output_type for o in outputs] == ["display_data"], outputs
+    assert "image/png" in outputs[0].data
+
+
 def test_importing_lagsym_does_not_load_vtk():
     code = "import sys, lagsym, lagsym.plot, lagsym.cli.plot, lagsym.cli; assert 'pyvista' not in sys.modules " \
            "and 'vtkmodules' not in sys.modules, sorted(m for m in sys.modules if 'vtk' in m)[:5]"
