@@ -47,6 +47,10 @@ class ProgramError(LagsymError, ValueError):
     """A part program that a control would refuse (an alarm), or that cannot be written."""
 
 
+class RenderError(LagsymError, RuntimeError):
+    """Pictures cannot be drawn here (no display and no offscreen renderer); the message says what to install."""
+
+
 class TransferError(LagsymError, OSError):
     """A fault on the serial line or in the machine at the other end."""
 

@@ -1,0 +1,98 @@
+"""``lagsym plot FILE``: pictures of the surface, its basis functions, or the curve through a set of points."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import InputError
+from ..grid import CurvePoints
+from ..io import read_any_points
+from ..lagrange import lagrange_curve, lagrange_surface
+
+NAME = "plot"
+ORDER = 50
+HELP = "draw the surface, its basis functions or a curve (an image with -o, else a window)"
+DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
+coloured by z, with the control points and the net joining them; or, with
+--show basis, every basis function L_i(x) L_k(y) as a grid of small pictures.
+A file of [x, y] points draws the curve through them (and, with --show basis,
+its basis polynomials L_i(x)).
+
+With -o FILE the picture is written as an image (.png, .jpg, .tif, .bmp), and
+no display is needed.  Without -o a window opens, which needs a display.
+
+examples:
+  lagsym plot examples/paper-example-4.json -o surface.png
+  lagsym plot examples/paper-example-4.json --show basis -o basis.png
+  lagsym plot examples/paper-curve-3rd.json -o curve.png
+  lagsym plot examples/paper-example-1.json --size 800x600 --units in"""
+
+SHOW = ("surface", "basis", "compare", "toolpath")
+
+
+def _size(text: str) -> tuple[int, int]:
+    w, sep, h = text.lower().partition("x")
+    if not sep or not w.strip().isdigit() or not h.strip().isdigit():
+        raise argparse.ArgumentTypeError(f"{text!r} should be WIDTHxHEIGHT in pixels, like 1024x768")
+    return int(w), int(h)
+
+
+def add_arguments(p) -> None:
+    # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
+    p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
+    p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
+                   help="surface (default), basis, compare, or 'toolpath PROGRAM'")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
+    p.add_argument("--units", default="mm", help="length unit for the axis labels (default: mm)")
+    p.add_argument("--size", type=_size, default=(1024, 768), metavar="WxH",
+                   help="picture size in pixels (default: 1024x768)")
+    p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
+
+
+def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None, str]:
+    """What to draw, the program file for a toolpath, and the points file.
+
+    ``--show`` takes one or more words, so it may have swallowed FILE when the
+    user wrote ``--show basis FILE``; take it back from the end.
+    """
+    words = list(show or ["surface"])
+    what = words.pop(0)
+    if what not in SHOW:
+        raise InputError(f"--show {what!r} is not one of: {', '.join(SHOW)}")
+    wanted = 1 if what == "toolpath" else 0
+    if file is None and len(words) > wanted:
+        file = words.pop()
+    if file is None:
+        raise InputError("no points FILE given: lagsym plot FILE [--show WHAT] [-o IMAGE]")
+    if len(words) != wanted:
+        if what == "toolpath":
+            raise InputError("--show toolpath needs exactly one PROGRAM file: --show toolpath PROGRAM")
+        raise InputError(f"--show {what} takes no file, but got {' '.join(words)!r}")
+    return what, (words[0] if words else None), file
+
+
+def run(args, out, err) -> int:
+    from .. import plot
+
+    what, program, file = _request(args.show, args.file)
+    if what in ("compare", "toolpath"):
+        raise InputError(f"--show {' '.join(filter(None, (what, program)))} is not available yet")
+    if args.output:
+        plot.image_format(args.output)
+    elif plot.rendering_backend() != "display":
+        raise InputError("no display to open a window on: give -o FILE to write the picture to a file")
+    points = read_any_points(file)
+    opts = dict(units=args.units, window_size=args.size, off_screen=True if args.output else None)
+    if args.samples is not None:
+        opts["samples"] = args.samples
+    if isinstance(points, CurvePoints):
+        curve = lagrange_curve(points)
+        figure = plot.curve_basis_figure(curve, **opts) if what == "basis" else plot.curve_figure(curve, **opts)
+    else:
+        surface = lagrange_surface(points)
+        figure = plot.basis_figure(surface, **opts) if what == "basis" else plot.surface_figure(surface, **opts)
+    if args.output:
+        plot.save_figure(figure, args.output)
+    else:
+        figure.show(title=f"lagsym plot {file}")
+    return 0

@@ -1,0 +1,419 @@
+"""Pictures, rendered offscreen for real and checked as pixels.
+
+Every figure is rendered at a fixed size and checked three ways: the image has
+the size asked for, it is not blank (a fair share of pixels differ from the
+white background), and it matches a stored reference image within a
+tolerance.  The reference check is shown to fail for a blank image and for a
+picture taken with the camera turned.  To store new reference images after a
+deliberate change to a figure, run
+
+    LAGSYM_UPDATE_REFERENCE_IMAGES=1 python3 -m pytest -q tests/test_plot.py
+
+and look at every image in tests/reference_images/ before committing it.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from conftest import EXAMPLES, ROOT
+from lagsym import plot
+from lagsym.errors import InputError
+from lagsym.evaluate import evaluate_grid
+from lagsym.io import read_curve_points, read_points
+from lagsym.lagrange import lagrange_curve, lagrange_surface
+
+REFERENCE = Path(__file__).resolve().parent / "reference_images"
+UPDATE = os.environ.get("LAGSYM_UPDATE_REFERENCE_IMAGES") == "1"
+SIZE = (320, 240)
+WIDE = (480, 300)
+
+# Two images are compared block by block (8x8 pixel averages, which forgive
+# anti-aliasing and text a pixel off, as differ between OpenGL drivers): the
+# score is the share of the drawn blocks whose colour changed by more than
+# CHANGED (0-255).  A blank image scores about 0.85, a camera turned by 5
+# degrees about 0.3, leaving out the control net about 0.15.
+BLOCK = 8
+CHANGED = 16.0
+TOLERANCE = 0.08
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _blocks(img: np.ndarray) -> np.ndarray:
+    h, w = (img.shape[0] // BLOCK) * BLOCK, (img.shape[1] // BLOCK) * BLOCK
+    img = img[:h, :w, :3].astype(float)
+    return img.reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK, 3).mean(axis=(1, 3))
+
+
+def image_difference(a: np.ndarray, b: np.ndarray) -> float:
+    """Share of the blocks drawn in either image (not white) whose mean colour differs by more than CHANGED."""
+    if a.shape != b.shape:
+        return 1.0
+    ba, bb = _blocks(a), _blocks(b)
+    changed = np.abs(ba - bb).mean(axis=-1) > CHANGED
+    drawn = (np.abs(ba - 255).max(axis=-1) > 8) | (np.abs(bb - 255).max(axis=-1) > 8)
+    return float(changed.sum() / max(int(drawn.sum()), 1))
+
+
+def render(plotter) -> np.ndarray:
+    img = plotter.screenshot(return_img=True)
+    plotter.close()
+    return np.asarray(img)
+
+
+def ink(img: np.ndarray) -> float:
+    """Share of pixels that are not the white background."""
+    return float((np.abs(img[..., :3].astype(int) - 255).max(axis=-1) > 30).mean())
+
+
+def check_reference(img: np.ndarray, name: str) -> None:
+    path = REFERENCE / f"{name}.png"
+    if UPDATE or not path.exists():
+        if not UPDATE:
+            pytest.fail(f"no reference image {path}; run with LAGSYM_UPDATE_REFERENCE_IMAGES=1 to store one")
+        REFERENCE.mkdir(exist_ok=True)
+        Image.fromarray(img).save(path, optimize=True)
+    ref = np.asarray(Image.open(path).convert("RGB"))
+    diff = image_difference(img, ref)
+    assert diff <= TOLERANCE, f"{name}: {diff:.1%} of the picture differs from {path.name} (tolerance {TOLERANCE:.0%})"
+
+
+def check_picture(img: np.ndarray, size, least_ink: float) -> None:
+    w, h = size
+    assert img.shape == (h, w, 3)
+    assert ink(img) >= least_ink, f"only {ink(img):.1%} of the pixels are drawn"
+
+
+# ----------------------------------------------------------------------------- data
+
+
+@pytest.fixture(scope="module")
+def surface4():
+    return lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+
+
+@pytest.fixture(scope="module")
+def surface2():
+    return lagrange_surface(read_points(EXAMPLES / "paper-example-2.json"))
+
+
+@pytest.fixture(scope="module")
+def curve3():
+    return lagrange_curve(read_curve_points(EXAMPLES / "paper-curve-3rd.json"))
+
+
+def comparison(surface):
+    """Stand-ins for the other methods' surfaces: plain, fixed arrays."""
+    x = np.linspace(1.0, 5.0, 33)
+    y = np.linspace(1.0, 5.0, 33)
+    z = evaluate_grid(surface, x, y)
+    bump = np.outer(np.sin(np.pi * (x - 1) / 4), np.sin(np.pi * (y - 1) / 4))
+    return x, y, {"Lagrange": z, "Bezier": z - 0.6 * bump, "B-spline": z - 0.4 * bump, "Hermite": z + 0.3 * bump}
+
+
+def raster(surface, rows: int = 7, per_row: int = 25, safe_z: float = 5.0):
+    """A zigzag path along x over the surface, with rapids in and out at ``safe_z``."""
+    pts, rapid = [(1.0, 1.0, safe_z)], [False]
+    for j, y in enumerate(np.linspace(1.0, 5.0, rows)):
+        xs = np.linspace(1.0, 5.0, per_row)[:: 1 if j % 2 == 0 else -1]
+        zs = surface.evaluate(xs, np.full_like(xs, y))
+        for k, (x, z) in enumerate(zip(xs, zs)):
+            pts.append((x, y, z))
+            rapid.append(j == 0 and k == 0)
+    pts.append((pts[-1][0], pts[-1][1], safe_z))
+    rapid.append(True)
+    return np.array(pts), np.array(rapid)
+
+
+# ----------------------------------------------------------------------------- the figures
+
+
+def test_surface_figure(surface4):
+    img = render(plot.surface_figure(surface4, samples=41, window_size=SIZE))
+    check_picture(img, SIZE, 0.12)
+    check_reference(img, "surface")
+
+
+def test_surface_colours_span_the_colour_map(surface4):
+    """The shaded surface alone (no colour bar, no net) shows both ends of the colour map."""
+    import matplotlib
+
+    img = render(plot.surface_figure(surface4, samples=41, window_size=SIZE, scalar_bar=False, control_net=False,
+                                     title=""))
+    lut = matplotlib.colormaps[plot.SURFACE_CMAP](np.linspace(0.0, 1.0, 64))[:, :3] * 255
+    px = img.reshape(-1, 3).astype(float)
+    px = px[np.abs(px - 255).max(axis=1) > 30]
+    # Shading scales a colour's brightness, so match directions in RGB space, not values.
+    unit = px / np.linalg.norm(px, axis=1, keepdims=True).clip(1e-9)
+    lut_unit = lut / np.linalg.norm(lut, axis=1, keepdims=True)
+    nearest = np.argmax(unit @ lut_unit.T, axis=1)
+    close = np.max(unit @ lut_unit.T, axis=1) > 0.998
+    hit = np.bincount(nearest[close], minlength=len(lut)) > 20
+    positions = np.flatnonzero(hit) / (len(lut) - 1)
+    assert positions.min() <= 0.15 and positions.max() >= 0.85, positions
+    assert hit.mean() >= 0.5, f"only {hit.mean():.0%} of the colour map shows"
+
+
+def test_curve_figure(curve3):
+    img = render(plot.curve_figure(curve3, window_size=SIZE))
+    check_picture(img, SIZE, 0.03)
+    # The curve is drawn in its own colour, and the points in theirs.
+    blue = (np.abs(img.astype(int) - (31, 119, 180)).max(axis=-1) < 40).mean()
+    red = (np.abs(img.astype(int) - (220, 20, 60)).max(axis=-1) < 40).mean()
+    assert blue > 0.005 and red > 0.001
+    check_reference(img, "curve")
+
+
+def test_curve_basis_figure(curve3):
+    img = render(plot.curve_basis_figure(curve3, window_size=SIZE))
+    check_picture(img, SIZE, 0.05)
+    check_reference(img, "curve_basis")
+
+
+def test_basis_figure(surface2):
+    img = render(plot.basis_figure(surface2, samples=15, window_size=WIDE))
+    check_picture(img, WIDE, 0.08)
+    check_reference(img, "basis")
+
+
+def test_compare_figure(surface4):
+    x, y, surfaces = comparison(surface4)
+    pts = np.array(surface4.grid.points(), dtype=float)
+    img = render(plot.compare_figure(x, y, surfaces, control_points=pts, window_size=WIDE))
+    check_picture(img, WIDE, 0.12)
+    check_reference(img, "compare")
+
+
+def test_toolpath_figure(surface4):
+    moves, rapid = raster(surface4)
+    img = render(plot.toolpath_figure(surface4, moves, rapid=rapid, samples=31, window_size=SIZE))
+    check_picture(img, SIZE, 0.11)
+    # Feed moves are drawn in their own colour.
+    red = (np.abs(img.astype(int) - (255, 69, 0)).max(axis=-1) < 40).mean()
+    assert red > 0.003
+    check_reference(img, "toolpath")
+
+
+def test_deviation_map_writes_a_png(surface4, tmp_path):
+    x, y, surfaces = comparison(surface4)
+    devs = {name: z - surfaces["Lagrange"] for name, z in surfaces.items() if name != "Lagrange"}
+    out = plot.deviation_map(x, y, devs, tmp_path / "dev.png", window_size=WIDE)
+    assert out == tmp_path / "dev.png"
+    img = np.asarray(Image.open(out).convert("RGB"))
+    check_picture(img, WIDE, 0.07)
+    check_reference(img, "deviation")
+
+
+# ----------------------------------------------------------------------------- the checks themselves
+
+
+def test_reference_check_fails_on_a_blank_image():
+    ref = np.asarray(Image.open(REFERENCE / "surface.png").convert("RGB"))
+    blank = np.full_like(ref, 255)
+    assert image_difference(blank, ref) > 0.5
+    assert ink(blank) == 0.0
+
+
+def test_reference_check_fails_when_the_camera_moves(surface4):
+    p = plot.surface_figure(surface4, samples=41, window_size=SIZE)
+    p.camera.azimuth += 10.0
+    turned = render(p)
+    ref = np.asarray(Image.open(REFERENCE / "surface.png").convert("RGB"))
+    assert ink(turned) > 0.12  # a real picture ...
+    assert image_difference(turned, ref) > TOLERANCE  # ... but not the one expected
+
+
+def test_reference_check_fails_for_another_surface(surface2):
+    img = render(plot.surface_figure(surface2, samples=41, window_size=SIZE))
+    ref = np.asarray(Image.open(REFERENCE / "surface.png").convert("RGB"))
+    assert image_difference(img, ref) > TOLERANCE
+
+
+# ----------------------------------------------------------------------------- values in, no global state
+
+
+def test_figures_leave_the_global_theme_alone(surface2):
+    import pyvista as pv
+
+    before = pv.global_theme.to_dict()
+    p = plot.surface_figure(surface2, samples=5, window_size=SIZE)
+    assert p.theme.jupyter_backend == "static"  # inline in Jupyter, also when run headless
+    p.close()
+    assert pv.global_theme.to_dict() == before
+
+
+def test_jupyter_shows_a_static_image_headless(tmp_path):
+    """A notebook run headless, as CI runs one, gets the figure inline as a PNG."""
+    import nbclient
+    import nbformat
+
+    code = (
+        f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
+        "from lagsym import plot\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        f"s = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-2.json')!r}))\n"
+        "plot.surface_figure(s, samples=9, window_size=(200, 150)).show()"
+    )
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+    nbclient.NotebookClient(nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+                            ).execute()
+    outputs = nb.cells[0].outputs
+    assert [o.output_type for o in outputs] == ["display_data"], outputs
+    assert "image/png" in outputs[0].data
+
+
+def test_importing_lagsym_does_not_load_vtk():
+    code = "import sys, lagsym, lagsym.plot, lagsym.cli.plot, lagsym.cli; assert 'pyvista' not in sys.modules " \
+           "and 'vtkmodules' not in sys.modules, sorted(m for m in sys.modules if 'vtk' in m)[:5]"
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+def test_rendering_backend_is_known():
+    assert plot.rendering_backend() in ("display", "egl", "osmesa", "xvfb") or \
+        plot.rendering_backend() == os.environ.get("VTK_DEFAULT_OPENGL_WINDOW")
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="Xvfb is the Linux fallback")
+def test_xvfb_fallback_renders():
+    """The last resort where neither EGL nor OSMesa works: a private Xvfb server, gone with its process."""
+    code = (
+        "import os; from lagsym.plot import _start_xvfb\n"
+        "os.environ['DISPLAY'] = _start_xvfb()\n"
+        "os.environ['VTK_DEFAULT_OPENGL_WINDOW'] = 'vtkXOpenGLRenderWindow'\n"
+        "import pyvista as pv\n"
+        "p = pv.Plotter(off_screen=True, window_size=(64, 48)); p.add_mesh(pv.Sphere(), color='red')\n"
+        "img = p.screenshot(return_img=True); p.close()\n"
+        "print(int((img[..., 1] < 60).mean() * 100))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")}
+    done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert int(done.stdout.split()[-1]) >= 5  # a red sphere fills part of the picture
+
+
+# ----------------------------------------------------------------------------- errors name the value
+
+
+def test_compare_needs_its_reference(surface4):
+    x, y, surfaces = comparison(surface4)
+    with pytest.raises(InputError, match=r"'Lagrangian' is not among the surfaces: 'Lagrange', 'Bezier'"):
+        plot.compare_figure(x, y, surfaces, reference="Lagrangian")
+
+
+def test_compare_checks_shapes(surface4):
+    x, y, surfaces = comparison(surface4)
+    surfaces["Bezier"] = surfaces["Bezier"][:, :-1]
+    with pytest.raises(InputError, match=r"surface 'Bezier' has shape \(33, 32\), but the axes x and y give \(33, 33\)"):
+        plot.compare_figure(x, y, surfaces)
+
+
+def test_axes_must_increase(surface4):
+    x, y, surfaces = comparison(surface4)
+    with pytest.raises(InputError, match=r"x must increase strictly, but x\[0\] = 5.0"):
+        plot.deviation_figure(x[::-1], y, {"a": surfaces["Bezier"]})
+
+
+def test_moves_shape_and_rapid_mask(surface4):
+    with pytest.raises(InputError, match=r"moves should be an \(N, 3\) array"):
+        plot.toolpath_figure(surface4, np.zeros((4, 2)))
+    with pytest.raises(InputError, match=r"moves\[1\] = \[1.0, nan, 0.0\] is not finite"):
+        plot.toolpath_figure(surface4, [[0, 0, 0], [1, np.nan, 0]])
+    with pytest.raises(InputError, match=r"rapid should be a boolean array of shape \(2,\)"):
+        plot.toolpath_figure(surface4, np.zeros((2, 3)), rapid=np.array([0, 1]))
+
+
+def test_bad_options(surface2, tmp_path):
+    with pytest.raises(InputError, match="samples = 1 should be an integer of at least 2"):
+        plot.surface_figure(surface2, samples=1)
+    with pytest.raises(InputError, match="window size 10x10 is out of range"):
+        plot.surface_figure(surface2, window_size=(10, 10))
+    with pytest.raises(InputError, match=r"'\.svg'; use one of: \.png, \.jpg"):
+        plot.image_format(tmp_path / "a.svg")
+
+
+# ----------------------------------------------------------------------------- the command
+
+
+def png_size(path: Path) -> tuple[int, int]:
+    with Image.open(path) as im:
+        assert im.format == "PNG"
+        return im.size
+
+
+@pytest.mark.parametrize("file, show", [
+    ("paper-example-4.json", []),
+    ("paper-example-1.json", ["--show", "basis"]),
+    ("paper-curve-3rd.json", []),
+    ("paper-curve-2nd.json", ["--show", "basis"]),
+])
+def test_cli_writes_pictures(run_cli, tmp_path, file, show):
+    out = tmp_path / "fig.png"
+    status, stdout, stderr = run_cli("plot", EXAMPLES / file, *show, "-o", out, "--size", "200x150",
+                                     "--samples", "9")
+    assert (status, stderr) == (0, "")
+    assert png_size(out) == (200, 150)
+    assert ink(np.asarray(Image.open(out).convert("RGB"))) > 0.01
+
+
+def test_cli_show_before_file(run_cli, tmp_path):
+    out = tmp_path / "b.png"
+    status, _, stderr = run_cli("plot", "--show", "basis", EXAMPLES / "paper-example-1.json", "-o", out,
+                                "--size", "200x150", "--samples", "5")
+    assert (status, stderr) == (0, "")
+    assert out.exists()
+
+
+def test_cli_units_reach_the_axes(run_cli, tmp_path, monkeypatch):
+    seen = {}
+    real = plot.surface_figure
+
+    def spy(surface, **opts):
+        seen.update(opts)
+        return real(surface, **opts)
+
+    monkeypatch.setattr(plot, "surface_figure", spy)
+    status, _, _ = run_cli("plot", EXAMPLES / "paper-example-1.json", "--units", "in", "-o", tmp_path / "s.png",
+                           "--size", "100x80", "--samples", "5")
+    assert status == 0 and seen["units"] == "in"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--show", "compare"], "--show compare is not available yet"),
+    (["--show", "toolpath", "part.ngc"], "--show toolpath part.ngc is not available yet"),
+    (["--show", "toolpath"], "--show toolpath needs exactly one PROGRAM file"),
+    (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath"),
+    (["--show", "basis", "extra"], "--show basis takes no file, but got 'extra'"),
+    (["-o", "out.svg"], "cannot tell the image format from '.svg'"),
+    (["--size", "10x10", "-o", "x.png"], "window size 10x10 is out of range"),
+])
+def test_cli_refuses(run_cli, argv, message):
+    status, stdout, stderr = run_cli("plot", EXAMPLES / "paper-example-1.json", *argv)
+    assert status == 2 and stdout == ""
+    assert message in stderr and stderr.count("\n") == 1
+
+
+def test_cli_without_output_needs_a_display(run_cli, monkeypatch):
+    monkeypatch.setattr(plot, "rendering_backend", lambda: "egl")
+    status, _, stderr = run_cli("plot", EXAMPLES / "paper-example-1.json")
+    assert status == 2 and "no display to open a window on: give -o FILE" in stderr
+
+
+def test_cli_bad_size_is_a_usage_error(run_cli):
+    status, _, stderr = run_cli("plot", EXAMPLES / "paper-example-1.json", "--size", "big")
+    assert status == 2 and "'big' should be WIDTHxHEIGHT" in stderr
+
+
+def test_cli_missing_file(run_cli, tmp_path):
+    status, _, stderr = run_cli("plot", tmp_path / "none.json", "-o", tmp_path / "x.png")
+    assert status == 2 and "no such file" in stderr
+    assert not (tmp_path / "x.png").exists()
