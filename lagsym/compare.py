@@ -331,12 +331,15 @@ def compare_surfaces(
     bad = np.argwhere(~np.isfinite(z_f))
     if len(bad):
         i, j = bad[0]
-        raise InputError(f"reference {label!r} is not finite at (x, y) = ({xs[i]:g}, {ys[j]:g}), sample ({i + 1},{j + 1})")
+        raise InputError(
+            f"reference {label!r} is not finite at (x, y) = ({xs[i]:g}, {ys[j]:g}), sample ({i + 1},{j + 1})"
+        )
     columns = []
     for m in dict.fromkeys(methods):
         surface = make_surface(m, grid, degree=degree, hermite=hermite)
         z_a = _readonly(surface.evaluate_grid(xs, ys))
-        columns.append(MethodComparison(surface.name, z_a, _readonly(z_f - z_a), deviation_measures(z_f, z_a, tolerance)))
+        measures = deviation_measures(z_f, z_a, tolerance)
+        columns.append(MethodComparison(surface.name, z_a, _readonly(z_f - z_a), measures))
     n, mm = grid.shape
     return Comparison(
         reference=label,
@@ -428,7 +431,9 @@ def render_table(c: Comparison, fmt: str = "text") -> str:
         lines += ["| " + " | ".join(r) + " |" for r in rows]
         return "\n".join(lines) + "\n\n" + "\n".join(f"- {n}" for n in _notes(c)) + "\n"
     widths = [max(len(r[k]) for r in [header] + rows) for k in range(len(header))]
-    fmt_row = lambda r: "  ".join([r[0].ljust(widths[0])] + [v.rjust(w) for v, w in zip(r[1:], widths[1:])])  # noqa: E731
+    def line(r):
+        return "  ".join([r[0].ljust(widths[0])] + [v.rjust(w) for v, w in zip(r[1:], widths[1:])])
+
     title = f"Comparison with {c.reference}"
-    lines = [title, fmt_row(header), "  ".join("-" * w for w in widths)] + [fmt_row(r) for r in rows]
+    lines = [title, line(header), "  ".join("-" * w for w in widths)] + [line(r) for r in rows]
     return "\n".join(lines) + "\n\n" + "\n".join(_notes(c)) + "\n"

@@ -45,7 +45,7 @@ def _column(c, name):
     return next(m for m in c.methods if m.name == name)
 
 
-# --- measures ----------------------------------------------------------------------------------------------------------
+# --- measures ---------------------------------------------------------------------------------------------------------
 
 
 def test_measures_by_hand():
@@ -97,7 +97,7 @@ def test_samples_fall_on_the_nodes_exactly():
         sample_axes(g, (1, 5))
 
 
-# --- Table 1's setting -------------------------------------------------------------------------------------------------
+# --- Table 1's setting ------------------------------------------------------------------------------------------------
 
 
 def test_lagrange_reproduces_the_parabola_exactly(table1):
@@ -160,7 +160,7 @@ def test_comparison_is_frozen_with_read_only_arrays(table1):
     assert set(c.deviations) == {"Lagrange", "Hermite", "Bezier", "B-spline"}
 
 
-# --- references --------------------------------------------------------------------------------------------------------
+# --- references -------------------------------------------------------------------------------------------------------
 
 
 def test_measured_points_are_compared_where_they_were_measured(tmp_path):
@@ -199,7 +199,7 @@ def test_bad_choices_name_the_valid_ones():
         render_table(c, "html")
 
 
-# --- rendering ---------------------------------------------------------------------------------------------------------
+# --- rendering --------------------------------------------------------------------------------------------------------
 
 
 def test_text_table_is_shaped_like_table_1(table1):
@@ -236,7 +236,7 @@ def test_json_writes_null_for_an_undefined_rate():
     assert doc["methods"]["Bezier"]["deviation_rate"] is None
 
 
-# --- the command -------------------------------------------------------------------------------------------------------
+# --- the command ------------------------------------------------------------------------------------------------------
 
 
 def test_cli_default_compares_with_lagrange(run_cli):

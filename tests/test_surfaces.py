@@ -55,7 +55,7 @@ def _corners(g):
     return [(i, k) for i in (0, len(g.x) - 1) for k in (0, len(g.y) - 1)]
 
 
-# --- the shared protocol ---------------------------------------------------------------------------------------------
+# --- the shared protocol --------------------------------------------------------------------------------------------
 
 
 def test_follows_the_protocol_and_is_frozen(method):
@@ -108,7 +108,7 @@ def test_unknown_choices_name_the_valid_ones():
     assert [make_surface(m, UNEVEN).name for m in METHODS] == ["Lagrange", "Hermite", "Bezier", "B-spline"]
 
 
-# --- Bernstein and B-spline bases ------------------------------------------------------------------------------------
+# --- Bernstein and B-spline bases -----------------------------------------------------------------------------------
 
 fractions01 = st.fractions(min_value=0, max_value=1, max_denominator=10**6)
 
@@ -172,7 +172,7 @@ def test_parametric_surfaces_agree_with_geomdl(degree):
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
 
 
-# --- parametric inversion: compared at the same (x, y), not the same (u, v) -----------------------------------------
+# --- parametric inversion: compared at the same (x, y), not the same (u, v) ----------------------------------------
 
 uneven_nodes = st.lists(st.integers(-50, 50), min_size=2, max_size=7, unique=True).map(sorted)
 
@@ -208,7 +208,7 @@ def test_bezier_and_bspline_stay_in_the_convex_hull(z):
         assert (zz >= lo - 1e-9).all() and (zz <= hi + 1e-9).all()
 
 
-# --- Hermite -----------------------------------------------------------------------------------------------------------
+# --- Hermite ----------------------------------------------------------------------------------------------------------
 
 
 def test_tangent_rule_is_central_inside_one_sided_at_the_ends():
@@ -237,7 +237,7 @@ def test_piecewise_hermite_is_c1_across_cell_edges():
         assert abs(left - right) < 1e-4
 
 
-# --- Lagrange reproduces polynomials exactly ---------------------------------------------------------------------------
+# --- Lagrange reproduces polynomials exactly --------------------------------------------------------------------------
 
 
 @given(st.lists(st.integers(-9, 9), min_size=9, max_size=9), st.fractions(-5, 5, max_denominator=50),

@@ -74,7 +74,8 @@ def add_arguments(p) -> None:
     p.add_argument("--degree", type=int, default=3, metavar="P",
                    help="B-spline degree in each direction (default 3, capped at n-1)")
     p.add_argument("--hermite", choices=HERMITE_KINDS, default="corner",
-                   help="corner: one patch on the 4 corners (default, as in the paper); piecewise: C1 through every point")
+                   help="corner: one patch on the 4 corners (default, as in the paper); "
+                        "piecewise: C1 patches through every point")
     p.add_argument("--tolerance", type=_tolerance, default=DEFAULT_TOLERANCE_MM, metavar="MM",
                    help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")
     p.add_argument("--format", choices=TABLE_FORMATS, default="text", help="table format (default text)")

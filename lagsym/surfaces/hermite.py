@@ -161,5 +161,6 @@ def hermite_surface(grid: ControlGrid, kind: str = "corner") -> HermiteSurface:
         return HermiteSurface("Hermite", HermiteBasis(tuple(map(float, x))), HermiteBasis(tuple(map(float, y))),
                               _readonly(z), _readonly(zx), _readonly(zy), _readonly(zxy))
     ends = np.ix_([0, -1], [0, -1])
-    return HermiteSurface("Hermite", HermiteBasis((float(x[0]), float(x[-1]))), HermiteBasis((float(y[0]), float(y[-1]))),
+    corners_x, corners_y = HermiteBasis((float(x[0]), float(x[-1]))), HermiteBasis((float(y[0]), float(y[-1])))
+    return HermiteSurface("Hermite", corners_x, corners_y,
                           _readonly(z[ends]), _readonly(zx[ends]), _readonly(zy[ends]), _readonly(zxy[ends]))
