@@ -428,7 +428,7 @@ def render_table(c: Comparison, fmt: str = "text") -> str:
     rows = _rows(c)
     if fmt == "markdown":
         lines = ["| " + " | ".join(header) + " |", "|" + "---|" + "---:|" * len(names)]
-        lines += ["| " + " | ".join(r) + " |" for r in rows]
+        lines += ["| " + " | ".join(v.replace("|", "\\|") for v in r) + " |" for r in rows]
         return "\n".join(lines) + "\n\n" + "\n".join(f"- {n}" for n in _notes(c)) + "\n"
     widths = [max(len(r[k]) for r in [header] + rows) for k in range(len(header))]
     def line(r):

@@ -220,6 +220,8 @@ def test_markdown_csv_and_json(table1):
     assert md[0] == "| Parameters | Lagrange | Hermite | Bezier | B-spline |"
     assert md[1] == "|---|---:|---:|---:|---:|"
     assert len([line for line in md if line.startswith("| ")]) == 1 + len(MEASURES)
+    # Pipes inside a label are escaped, so every row has exactly the header's cells.
+    assert all(line.replace("\\|", "").count("|") == 6 for line in md if line.startswith("| "))
     rows = list(csv.reader(io.StringIO(render_table(c, "csv"))))
     assert rows[0] == ["measure", "Lagrange", "Hermite", "Bezier", "B-spline"]
     assert [r[0] for r in rows[1:]] == [key for key, _ in MEASURES]
