@@ -145,6 +145,7 @@ def test_hermite_differs(table1):
     # On an uneven net the corner patch and the Bezier surface part.
     nodes = [0, 4, 15, 30, 40]
     uneven = grid_from_table(nodes, nodes, [[f.exact_value(x, y) for y in nodes] for x in nodes])
+    assert read_points(EXAMPLES / "parabola-uneven.json") == uneven
     u = compare_surfaces(uneven, f, methods=["hermite", "bezier"], samples=(41, 41))
     assert np.abs(u.methods[0].deviation - u.methods[1].deviation).max() > 0.1
     assert [m.measures.coincided for m in u.methods] == [4, 4]
