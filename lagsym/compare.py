@@ -288,10 +288,11 @@ def compare_surfaces(
     ----------
     grid : ControlGrid
         The control net every method is built from.
-    reference : "lagrange", Formula or ControlGrid, optional
+    reference : "lagrange", Formula, Surface or ControlGrid, optional
         ``z_f``: the Lagrange surface (default), a parsed formula
-        (:func:`lagsym.formula.parse_formula`), or measured points, compared at
-        the measured positions themselves (no interpolation of the measurements).
+        (:func:`lagsym.formula.parse_formula`) or any value with ``name`` and
+        ``evaluate_grid``, or measured points, compared at the measured
+        positions themselves (no interpolation of the measurements).
     samples : (int, int), optional
         Samples in x and in y over the control box (default
         :data:`DEFAULT_SAMPLES`); not allowed with measured points.

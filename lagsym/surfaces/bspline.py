@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from ..errors import InputError
 from ..grid import ControlGrid
@@ -58,6 +57,10 @@ class BSplineBasis:
 
     def evaluate(self, t) -> np.ndarray:
         """``B[p, i] = N_{i,degree}(t[p])`` for a 1-D array of parameters in ``[0, 1]``."""
+        # Imported here: scipy.interpolate takes most of a second to load, and every
+        # lagsym command would pay for it through the CLI's module discovery.
+        from scipy.interpolate import BSpline
+
         t = np.clip(np.asarray(t, dtype=float).ravel(), 0.0, 1.0)
         knots = np.array([float(k) for k in self.knots])
         return BSpline.design_matrix(t, knots, self.degree).toarray()

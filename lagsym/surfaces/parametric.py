@@ -56,7 +56,8 @@ def invert_parameter(basis: ParameterBasis, nodes, values) -> np.ndarray:
     -------
     numpy.ndarray
         One parameter per value, found by bisection (the map is monotone, so
-        bisection cannot miss).  The end nodes map to exactly 0 and 1.
+        bisection cannot miss).  The end nodes map to exactly 0 and 1; values
+        outside the nodes' span are clamped to the nearer end.
 
     Examples
     --------
