@@ -250,3 +250,33 @@ def test_lagrange_reproduces_polynomials_of_its_degree(c, x, y):
     nodes_x, nodes_y = [-2, 0, 3], [1, 2, 4]
     g = grid_from_table(nodes_x, nodes_y, [[p(a, b) for b in nodes_y] for a in nodes_x])
     assert lagrange_surface(g).exact_value(x, y) == p(x, y)
+
+
+# --- random nets ---------------------------------------------------------------------------------------------------
+
+
+@st.composite
+def nets(draw):
+    """Random control nets: 2-6 unevenly spaced nodes per direction, integer heights."""
+    xs = draw(st.lists(st.integers(-30, 30), min_size=2, max_size=6, unique=True))
+    ys = draw(st.lists(st.integers(-30, 30), min_size=2, max_size=6, unique=True))
+    z = draw(st.lists(st.lists(st.integers(-99, 99), min_size=len(ys), max_size=len(ys)),
+                      min_size=len(xs), max_size=len(xs)))
+    return grid_from_table(xs, ys, z)
+
+
+@given(nets())
+def test_every_method_meets_the_corners_of_any_net(g):
+    for kind, build in KINDS.items():
+        s = build(g)
+        xs, ys = [float(g.x[0]), float(g.x[-1])], [float(g.y[0]), float(g.y[-1])]
+        expected = [[float(g.z[i][k]) for k in (0, -1)] for i in (0, -1)]
+        np.testing.assert_allclose(s.evaluate_grid(xs, ys), expected, rtol=0, atol=1e-9, err_msg=kind)
+
+
+@given(nets())
+def test_full_degree_bspline_is_bezier_on_any_net(g):
+    xs = np.linspace(float(g.x[0]), float(g.x[-1]), 7)
+    ys = np.linspace(float(g.y[0]), float(g.y[-1]), 5)
+    np.testing.assert_allclose(bspline_surface(g, 10).evaluate_grid(xs, ys), bezier_surface(g).evaluate_grid(xs, ys),
+                               rtol=0, atol=1e-9)
