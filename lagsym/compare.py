@@ -53,6 +53,7 @@ from .surfaces import HERMITE_KINDS, METHODS, make_surface
 __all__ = [
     "DEFAULT_SAMPLES",
     "DEFAULT_TOLERANCE_MM",
+    "MAX_SAMPLES",
     "MEASURES",
     "TABLE_FORMATS",
     "Comparison",
@@ -66,6 +67,7 @@ __all__ = [
 
 DEFAULT_SAMPLES = (61, 61)  # 60 steps: every node of an evenly spaced 3- to 7-node net is a sample
 DEFAULT_TOLERANCE_MM = 1e-6
+MAX_SAMPLES = 4_000_000  # a 2000 x 2000 grid; each method holds a few arrays of this size
 TABLE_FORMATS = ("text", "markdown", "csv", "json")
 
 #: Rows of the table, in the paper's order first: (attribute, label).
@@ -238,10 +240,15 @@ def sample_axes(grid: ControlGrid, samples: tuple[int, int] = DEFAULT_SAMPLES) -
     >>> xs.tolist(), ys.tolist()
     ([0.0, 1.0, 2.0, 3.0], [1.0, 1.5, 2.0])
     """
-    axes = []
-    for name, count, nodes in (("x", samples[0], grid.x), ("y", samples[1], grid.y)):
+    if len(samples) != 2:
+        raise InputError(f"samples {samples!r} should be two counts, in x and in y")
+    for name, count in (("x", samples[0]), ("y", samples[1])):
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 2:
             raise InputError(f"{count!r} samples in {name}: need an integer >= 2")
+    if samples[0] * samples[1] > MAX_SAMPLES:
+        raise InputError(f"{samples[0]} x {samples[1]} samples is more than the limit of {MAX_SAMPLES}")
+    axes = []
+    for count, nodes in ((samples[0], grid.x), (samples[1], grid.y)):
         lo, hi = nodes[0], nodes[-1]
         axes.append(_readonly([float(lo + (hi - lo) * Fraction(k, count - 1)) for k in range(count)]))
     return axes[0], axes[1]

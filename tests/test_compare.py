@@ -95,6 +95,8 @@ def test_samples_fall_on_the_nodes_exactly():
     assert set(g.x_array) <= set(xs) and set(g.y_array) <= set(ys)
     with pytest.raises(InputError, match="1 samples in x"):
         sample_axes(g, (1, 5))
+    with pytest.raises(InputError, match="more than the limit"):
+        sample_axes(g, (5000, 5000))
 
 
 # --- Table 1's setting ------------------------------------------------------------------------------------------------
