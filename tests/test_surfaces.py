@@ -217,13 +217,13 @@ def test_tangent_rule_is_central_inside_one_sided_at_the_ends():
     np.testing.assert_allclose(d @ f, [1.0, 3.0, 5.0, 7.0])
 
 
-@given(st.lists(st.lists(st.integers(-50, 50), min_size=4, max_size=4), min_size=4, max_size=4),
-       st.integers(1, 5), st.integers(1, 5))
-def test_corner_hermite_is_the_cubic_bezier_on_an_even_4x4_net(z, hx, hy):
-    # Ferguson form of a cubic Bezier: end tangent 3 (P1 - P0) per unit parameter, i.e. the
-    # one-sided difference per unit x; twist 9 (P11 - P10 - P01 + P00), the cross difference.
-    g = grid_from_table([hx * i for i in range(4)], [hy * k for k in range(4)], z)
-    xs, ys = np.linspace(0, 3 * hx, 13), np.linspace(0, 3 * hy, 10)
+@given(st.integers(2, 4), st.integers(2, 4), st.integers(1, 5), st.integers(1, 5), st.data())
+def test_corner_hermite_is_the_bezier_on_an_even_net_of_up_to_4x4(n, m, hx, hy, data):
+    # Ferguson form of a Bezier of degree <= 3: end tangent n (P1 - P0) per unit parameter, i.e. the
+    # one-sided difference per unit x; twist n m (P11 - P10 - P01 + P00), the cross difference.
+    z = data.draw(st.lists(st.lists(st.integers(-50, 50), min_size=m, max_size=m), min_size=n, max_size=n))
+    g = grid_from_table([hx * i for i in range(n)], [hy * k for k in range(m)], z)
+    xs, ys = np.linspace(0, (n - 1) * hx, 13), np.linspace(0, (m - 1) * hy, 10)
     np.testing.assert_allclose(hermite_surface(g, "corner").evaluate_grid(xs, ys),
                                bezier_surface(g).evaluate_grid(xs, ys), rtol=0, atol=1e-9)
 
