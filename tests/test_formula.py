@@ -151,3 +151,19 @@ def test_generated_formulas_evaluate_exactly_and_numerically(pair):
     f = parse_formula(text)
     assert f.exact_value(Fraction(3, 2), -2) == value
     np.testing.assert_allclose(f(1.5, -2.0), float(value), rtol=1e-9, atol=1e-9)
+
+
+def test_never_reaches_eval_or_sympify(monkeypatch):
+    import builtins
+
+    import sympy
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("eval-like call")
+
+    monkeypatch.setattr(builtins, "eval", refuse)
+    monkeypatch.setattr(builtins, "exec", refuse)
+    monkeypatch.setattr(sympy, "sympify", refuse)
+    f = parse_formula("z = sqrt(x**2 + y**2) / 2 - 0.5")
+    assert float(f(3.0, 4.0)) == 2.0
+    assert parse_formula("x*y - 1").exact_value(2, 3) == 5
