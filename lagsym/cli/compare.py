@@ -1,0 +1,110 @@
+"""``lagsym compare FILE``: the paper's deviation table for Lagrange, Hermite, Bezier and B-spline surfaces."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..compare import DEFAULT_SAMPLES, DEFAULT_TOLERANCE_MM, TABLE_FORMATS, compare_surfaces, render_table
+from ..errors import InputError
+from ..formula import parse_formula
+from ..io import read_points
+from ..surfaces import HERMITE_KINDS, METHODS
+from ._common import emit
+
+NAME = "compare"
+ORDER = 45
+HELP = "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)"
+DESCRIPTION = """Build the Lagrange, Hermite, Bezier and B-spline surfaces from the control
+points in FILE, sample them at the same (x, y) positions and print the paper's
+deviation measures (Table 1), one column per method.
+
+The reference z_f is the Lagrange surface (default), a formula in x and y
+(numbers, x, y, pi, + - * / ** ( ) and sin cos tan exp log sqrt abs), or a
+points file of measurements, compared at the measured positions.
+
+examples:
+  lagsym compare examples/paper-example-4.json
+  lagsym compare examples/parabola.json --reference "50 - ((x-20)**2 + (y-20)**2)/20" --degree 4
+  lagsym compare examples/paper-example-1.json --reference "x**2 + 3*y" --samples 41x41 --format csv"""
+
+
+def _samples(text: str) -> tuple[int, int]:
+    parts = text.lower().split("x")
+    try:
+        counts = [int(p) for p in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} should be NX or NXxNY, for example 41x41") from None
+    if len(counts) == 1:
+        counts *= 2
+    if len(counts) != 2 or min(counts) < 2 or max(counts) > 10_000:
+        raise argparse.ArgumentTypeError(f"{text!r} should be NX or NXxNY with counts from 2 to 10000")
+    return counts[0], counts[1]
+
+
+def _methods(text: str) -> list[str]:
+    names = [t.strip().lower() for t in text.split(",") if t.strip()]
+    for name in names:
+        if name not in METHODS:
+            raise argparse.ArgumentTypeError(f"method {name!r} is not one of {', '.join(METHODS)}")
+    if not names:
+        raise argparse.ArgumentTypeError(f"no methods given; choose from {', '.join(METHODS)}")
+    return names
+
+
+def _tolerance(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"tolerance {text!r} should be a number >= 0 (mm)")
+    return value
+
+
+def add_arguments(p) -> None:
+    p.add_argument("file", help="control points file: JSON or CSV with x,y,z")
+    p.add_argument("--reference", default="lagrange", metavar="REF",
+                   help="z_f: 'lagrange' (default), a formula such as '0.5*x**2 + y', or a .json/.csv file of "
+                        "measured points")
+    p.add_argument("--samples", type=_samples, metavar="NXxNY",
+                   help=f"sample grid over the control box (default {DEFAULT_SAMPLES[0]}x{DEFAULT_SAMPLES[1]})")
+    p.add_argument("--methods", type=_methods, default=list(METHODS), metavar="LIST",
+                   help=f"comma-separated columns, from {','.join(METHODS)} (default all)")
+    p.add_argument("--degree", type=int, default=3, metavar="P",
+                   help="B-spline degree in each direction (default 3, capped at n-1)")
+    p.add_argument("--hermite", choices=HERMITE_KINDS, default="corner",
+                   help="corner: one patch on the 4 corners (default, as in the paper); "
+                        "piecewise: C1 patches through every point")
+    p.add_argument("--tolerance", type=_tolerance, default=DEFAULT_TOLERANCE_MM, metavar="MM",
+                   help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")
+    p.add_argument("--format", choices=TABLE_FORMATS, default="text", help="table format (default text)")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the table to FILE instead of standard output")
+    p.add_argument("--plot", metavar="FILE", help="also write a deviation colour map per method to FILE")
+
+
+def _reference(text: str):
+    if text == "lagrange":
+        return text
+    try:
+        is_file = Path(text).suffix.lower() in (".json", ".csv") or Path(text).is_file()
+    except (OSError, ValueError):
+        is_file = False
+    return read_points(text) if is_file else parse_formula(text)
+
+
+def run(args, out, err) -> int:
+    grid = read_points(args.file)
+    reference = _reference(args.reference)
+    if args.degree < 1:
+        raise InputError(f"--degree {args.degree}: a B-spline degree should be 1 or more")
+    comparison = compare_surfaces(grid, reference, samples=args.samples, methods=args.methods,
+                                  degree=args.degree, hermite=args.hermite, tolerance=args.tolerance)
+    if args.plot:
+        try:
+            from ..plot import deviation_map
+        except ImportError:
+            raise InputError("--plot needs lagsym.plot") from None
+        deviation_map(comparison.xs, comparison.ys, comparison.deviations, args.plot)
+    emit(render_table(comparison, args.format), args.output, out)
+    return 0
