@@ -5,6 +5,7 @@ tensor-product Lagrange polynomial ``z = F(x, y)``, samples it, compares it
 with other surfaces, plans toolpaths and writes programs for CNC controls.
 """
 
+from .compare import Comparison, DeviationMeasures, compare_surfaces, deviation_measures, render_table
 from .errors import (
     ExitStatus,
     FormulaError,
@@ -12,16 +13,30 @@ from .errors import (
     InputError,
     LagsymError,
     ProgramError,
+    RenderError,
     ToolpathError,
     TransferError,
 )
+from .formula import Formula, parse_formula
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
 from .io import read_any_points, read_curve_points, read_points
 from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
+from .surfaces import bezier_surface, bspline_surface, hermite_surface, make_surface
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Comparison",
+    "DeviationMeasures",
+    "Formula",
+    "bezier_surface",
+    "bspline_surface",
+    "compare_surfaces",
+    "deviation_measures",
+    "hermite_surface",
+    "make_surface",
+    "parse_formula",
+    "render_table",
     "ControlGrid",
     "CurvePoints",
     "ExitStatus",
@@ -32,6 +47,7 @@ __all__ = [
     "LagrangeSurface",
     "LagsymError",
     "ProgramError",
+    "RenderError",
     "ToolpathError",
     "TransferError",
     "curve_from_points",

@@ -294,7 +294,19 @@ def test_cli_errors_exit_2_with_one_line(run_cli, args, message):
     assert len(err.strip().splitlines()) == 1
 
 
-@pytest.mark.skipif(importlib.util.find_spec("lagsym.plot") is not None, reason="lagsym.plot is present")
-def test_cli_plot_needs_the_plot_module(run_cli, tmp_path):
-    status, _, err = run_cli("compare", PARABOLA, "--plot", tmp_path / "d.png")
-    assert status == 2 and "--plot needs lagsym.plot" in err
+def test_cli_plot_writes_a_deviation_map(run_cli, tmp_path):
+    from PIL import Image
+
+    target = tmp_path / "d.png"
+    status, out, err = run_cli("compare", PARABOLA, "--samples", "21x21", "--plot", target)
+    assert status == 0, err
+    assert "Deviation rate" in out
+    with Image.open(target) as im:
+        assert im.size == (1024, 768)
+        px = np.asarray(im.convert("RGB"), dtype=float)
+    assert (np.abs(px - px[0, 0]).sum(axis=2) > 30).mean() > 0.05  # something was drawn
+
+
+def test_cli_plot_refuses_an_unknown_image_type_before_comparing(run_cli, tmp_path):
+    status, _, err = run_cli("compare", PARABOLA, "--plot", tmp_path / "d.xyz")
+    assert status == 2 and "d.xyz" in err and not (tmp_path / "d.xyz").exists()

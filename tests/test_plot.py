@@ -355,6 +355,7 @@ def png_size(path: Path) -> tuple[int, int]:
     ("paper-example-1.json", ["--show", "basis"]),
     ("paper-curve-3rd.json", []),
     ("paper-curve-2nd.json", ["--show", "basis"]),
+    ("paper-example-4.json", ["--show", "compare"]),
 ])
 def test_cli_writes_pictures(run_cli, tmp_path, file, show):
     out = tmp_path / "fig.png"
@@ -388,8 +389,6 @@ def test_cli_units_reach_the_axes(run_cli, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--show", "compare"], "--show compare is not available yet"),
-    (["--show", "toolpath", "part.ngc"], "--show toolpath part.ngc is not available yet"),
     (["--show", "toolpath"], "--show toolpath needs exactly one PROGRAM file"),
     (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath"),
     (["--show", "basis", "extra"], "--show basis takes no file, but got 'extra'"),

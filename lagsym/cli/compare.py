@@ -98,13 +98,15 @@ def run(args, out, err) -> int:
     reference = _reference(args.reference)
     if args.degree < 1:
         raise InputError(f"--degree {args.degree}: a B-spline degree should be 1 or more")
+    if args.plot:
+        from ..plot import image_format
+
+        image_format(args.plot)  # refuse a bad image name before the work
     comparison = compare_surfaces(grid, reference, samples=args.samples, methods=args.methods,
                                   degree=args.degree, hermite=args.hermite, tolerance=args.tolerance)
     if args.plot:
-        try:
-            from ..plot import deviation_map
-        except ImportError:
-            raise InputError("--plot needs lagsym.plot") from None
+        from ..plot import deviation_map
+
         deviation_map(comparison.xs, comparison.ys, comparison.deviations, args.plot)
     emit(render_table(comparison, args.format), args.output, out)
     return 0

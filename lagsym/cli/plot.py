@@ -47,6 +47,8 @@ def add_arguments(p) -> None:
     p.add_argument("--size", type=_size, default=(1024, 768), metavar="WxH",
                    help="picture size in pixels (default: 1024x768)")
     p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
+    p.add_argument("--scale", type=float, default=1.0,
+                   help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
 
 
 def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None, str]:
@@ -75,8 +77,6 @@ def run(args, out, err) -> int:
     from .. import plot
 
     what, program, file = _request(args.show, args.file)
-    if what in ("compare", "toolpath"):
-        raise InputError(f"--show {' '.join(filter(None, (what, program)))} is not available yet")
     if args.output:
         plot.image_format(args.output)
     elif plot.rendering_backend() != "display":
@@ -88,6 +88,10 @@ def run(args, out, err) -> int:
     if isinstance(points, CurvePoints):
         curve = lagrange_curve(points)
         figure = plot.curve_basis_figure(curve, **opts) if what == "basis" else plot.curve_figure(curve, **opts)
+    elif what == "compare":
+        figure = _compare_figure(plot, points, args, opts)
+    elif what == "toolpath":
+        figure = _toolpath_figure(plot, points, program, args, opts)
     else:
         surface = lagrange_surface(points)
         figure = plot.basis_figure(surface, **opts) if what == "basis" else plot.surface_figure(surface, **opts)
@@ -96,3 +100,28 @@ def run(args, out, err) -> int:
     else:
         figure.show(title=f"lagsym plot {file}")
     return 0
+
+
+def _compare_figure(plot, grid, args, opts):
+    """The Lagrange, Hermite, Bezier and B-spline surfaces side by side (the paper's Figure 10)."""
+    from ..compare import compare_surfaces
+
+    n = opts.pop("samples", None) or 41
+    c = compare_surfaces(grid, samples=(n, n))
+    surfaces = {"Lagrange": c.z_reference}
+    surfaces.update({m.name: m.z for m in c.methods if m.name != "Lagrange"})
+    return plot.compare_figure(c.xs, c.ys, surfaces, control_points=_control_points(grid), **opts)
+
+
+def _control_points(grid):
+    import numpy as np
+
+    return np.array([[float(v) for v in p] for p in grid.points()])
+
+
+def _toolpath_figure(plot, grid, program, args, opts):
+    """The moves of a G-code program drawn over the surface (the paper's Figures 12 and 14)."""
+    from ..gcode import read_program
+
+    moves = read_program(program)
+    return plot.toolpath_figure(lagrange_surface(grid), moves.tip_points_surface(args.scale), rapid=moves.rapid, **opts)
