@@ -167,6 +167,13 @@ class SurfaceEvaluator:
         for a flat grid): the scale errors are measured against.
     bounds : tuple of float
         ``(x0, x1, y0, y1)``, the control box.
+    x_nodes, y_nodes : numpy.ndarray
+        The nodes as floats.
+    x_exact, y_exact : numpy.ndarray
+        Which nodes are floats exactly (``1/3`` is not).
+    node_values : numpy.ndarray
+        The control heights rounded once: the value wherever a sample point
+        is a node exactly, so a sample passes through the control points.
     """
 
     x_offset: float
@@ -176,6 +183,11 @@ class SurfaceEvaluator:
     coefficients: np.ndarray
     data_range: float
     bounds: tuple[float, float, float, float]
+    x_nodes: np.ndarray
+    y_nodes: np.ndarray
+    x_exact: np.ndarray
+    y_exact: np.ndarray
+    node_values: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -214,7 +226,23 @@ class SurfaceEvaluator:
         """
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
-        return self.x_factor(xs) @ self.y_basis(ys)
+        return self.snap_grid(self.x_factor(xs) @ self.y_basis(ys), xs, ys)
+
+    @staticmethod
+    def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Indices into ``v`` of values that are a node exactly, and which node."""
+        k = np.clip(np.searchsorted(nodes, v), 0, len(nodes) - 1)
+        hit = (nodes[k] == v) & exact[k]
+        return np.flatnonzero(hit), k[hit]
+
+    def snap_grid(self, z: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Set ``z[i, j]`` to the control height where ``(xs[i], ys[j])`` is a control point exactly; in place."""
+        ix, kx = self._hits(self.x_nodes, self.x_exact, xs)
+        if ix.size:
+            iy, ky = self._hits(self.y_nodes, self.y_exact, ys)
+            if iy.size:
+                z[np.ix_(ix, iy)] = self.node_values[np.ix_(kx, ky)]
+        return z
 
     def points(self, x, y, chunk: int = CHUNK_POINTS) -> np.ndarray:
         """``F(x, y)`` at scattered points; ``x`` and ``y`` broadcast together.
@@ -235,6 +263,10 @@ class SurfaceEvaluator:
             tx = chebyshev_matrix(self._s(xf[lo:hi]), n, vx)
             ty = chebyshev_matrix(self._t(yf[lo:hi]), m, vy)
             out[lo:hi] = np.einsum("bp,bp->p", c @ tx, ty)
+        px, kx = self._hits(self.x_nodes, self.x_exact, xf)
+        if px.size:
+            py, ky = self._hits(self.y_nodes, self.y_exact, yf[px])
+            out[px[py]] = self.node_values[kx[py], ky]
         return out.reshape(shape)
 
     def error_bound(self, box: tuple[float, float, float, float] | None = None) -> float:
@@ -291,6 +323,12 @@ def _data_range(values) -> float:
     return spread if spread > 0 else max(max(abs(v) for v in values), 1.0)
 
 
+def _exact_floats(nodes) -> np.ndarray:
+    a = np.array([Fraction(float(v)) == v for v in nodes])
+    a.setflags(write=False)
+    return a
+
+
 _SURFACES: dict[int, SurfaceEvaluator] = {}
 
 
@@ -316,6 +354,11 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
         coefficients=_readonly(coeffs),
         data_range=_data_range(v for row in g.z for v in row),
         bounds=tuple(float(v) for v in g.bounds),
+        x_nodes=g.x_array,
+        y_nodes=g.y_array,
+        x_exact=_exact_floats(g.x),
+        y_exact=_exact_floats(g.y),
+        node_values=_readonly(g.z_array),
     )
     _SURFACES[key] = ev
     weakref.finalize(surface, _SURFACES.pop, key, None)

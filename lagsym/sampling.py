@@ -268,11 +268,13 @@ def sample_grid(
     return SampleGrid(region, _count(nx, "nx"), _count(ny, "ny"))
 
 
-def sample(surface, nx: int | None = None, ny: int | None = None, **kwargs) -> Sample:
+def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: SampleGrid | None = None,
+           **kwargs) -> Sample:
     """Sample ``surface`` on a regular grid and return ``(X, Y, Z)``.
 
-    Takes the arguments of :func:`sample_grid`; see there.  The heights come
-    from the stable evaluator, never from the expanded power basis.
+    Takes the arguments of :func:`sample_grid` (see there), or a ready
+    ``grid``.  The heights come from the stable evaluator, never from the
+    expanded power basis.
 
     >>> from lagsym.grid import grid_from_table
     >>> from lagsym.lagrange import lagrange_surface
@@ -281,7 +283,7 @@ def sample(surface, nx: int | None = None, ny: int | None = None, **kwargs) -> S
     >>> Z.tolist()
     [[0.0, 0.0], [1.0, 1.0], [4.0, 4.0]]
     """
-    g = kwargs.pop("grid", None) or sample_grid(surface, nx, ny, **kwargs)
+    g = grid if grid is not None else sample_grid(surface, nx, ny, **kwargs)
     z = surface_evaluator(surface).grid(g.xs, g.ys)
     z.setflags(write=False)
     shape = (g.nx, g.ny)
@@ -300,4 +302,5 @@ def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS) -> 
     rows = max(1, block_points // grid.ny)
     for start in range(0, grid.nx, rows):
         stop = min(start + rows, grid.nx)
-        yield Block(start, grid.xs[start:stop], grid.ys, w[start:stop] @ ty)
+        xs = grid.xs[start:stop]
+        yield Block(start, xs, grid.ys, ev.snap_grid(w[start:stop] @ ty, xs, grid.ys))
