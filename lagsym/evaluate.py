@@ -54,6 +54,7 @@ __all__ = [
 ]
 
 EPS = float(np.finfo(float).eps)
+EPS_BASIS = float(np.finfo(np.longdouble).eps)  # the basis recurrence runs in longdouble
 CHUNK_POINTS = 1 << 16  # scattered points are evaluated in blocks of this many (bounded memory, warm caches)
 
 
@@ -113,13 +114,18 @@ def chebyshev_transform(nodes) -> tuple[float, float, flint.fmpq_mat]:
 
 
 def chebyshev_matrix(s, n: int, out: np.ndarray | None = None) -> np.ndarray:
-    """``T_k(s)`` for ``k < n`` by the three-term recurrence, as an ``(n, len(s))`` array.
+    """``T_k(s)`` for ``k < n`` by the three-term recurrence, as an ``(n, len(s))`` float array.
+
+    The recurrence runs in ``numpy.longdouble`` (64-bit mantissa on x86)
+    and is rounded once to float64, so the basis values carry half a unit
+    of rounding; where ``longdouble`` is plain float64 the bound of
+    :meth:`SurfaceEvaluator.error_bound` accounts for it.
 
     >>> chebyshev_matrix(np.array([0.5, 1.0]), 3).tolist()
     [[1.0, 1.0], [0.5, 1.0], [-0.5, 1.0]]
     """
-    s = np.asarray(s, dtype=float).ravel()
-    v = np.empty((n, s.size)) if out is None else out[:, : s.size]
+    s = np.asarray(s).ravel().astype(np.longdouble, copy=False)
+    v = np.empty((n, s.size), dtype=np.longdouble)
     v[0] = 1.0
     if n > 1:
         v[1] = s
@@ -128,7 +134,11 @@ def chebyshev_matrix(s, n: int, out: np.ndarray | None = None) -> np.ndarray:
         for k in range(2, n):
             np.multiply(s2, v[k - 1], out=v[k])
             v[k] -= v[k - 2]
-    return v
+    if out is None:
+        return v.astype(float)
+    out = out[:, : s.size]
+    out[...] = v
+    return out
 
 
 def _cheb_growth(n: int, smax: float) -> np.ndarray:
@@ -137,11 +147,11 @@ def _cheb_growth(n: int, smax: float) -> np.ndarray:
 
 
 def _axis_error(n: int, smax: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per-degree size ``|T_k|`` and rounding weight for one axis.
+    """Per-degree size ``|T_k|`` and rounding weight (in units of ``longdouble`` rounding) for one axis.
 
-    The weight counts units of rounding: the recurrence (at most ``k**2``),
-    and the rounding of ``s`` itself (``|ds| <= 2u |s|``) carried through the
-    slope ``|T_k'| <= k**2 |T_k|``.
+    The weight counts the recurrence (at most ``k**2`` units) and the
+    rounding of ``s`` itself (``|ds| <= 2 u |s|``) carried through the slope
+    ``|T_k'| <= k**2 |T_k|``.
     """
     k = np.arange(n, dtype=float)
     smax = max(smax, 1.0)
@@ -195,10 +205,12 @@ class SurfaceEvaluator:
         return self.coefficients.shape
 
     def _s(self, x) -> np.ndarray:
-        return (np.asarray(x, dtype=float) - self.x_offset) / self.x_scale
+        x = np.asarray(x, dtype=float).astype(np.longdouble)
+        return (x - self.x_offset) / np.longdouble(self.x_scale)
 
     def _t(self, y) -> np.ndarray:
-        return (np.asarray(y, dtype=float) - self.y_offset) / self.y_scale
+        y = np.asarray(y, dtype=float).astype(np.longdouble)
+        return (y - self.y_offset) / np.longdouble(self.y_scale)
 
     def x_factor(self, xs) -> np.ndarray:
         """``W = Tx.T @ C`` for the grid lines ``xs``: shape ``(len(xs), m)``.
@@ -283,8 +295,10 @@ class SurfaceEvaluator:
         -------
         float
             Against the exact value of the polynomial at the given float
-            coordinates: a few units of rounding times
-            ``sum |C[a, b]| |T_a| |T_b|``, weighted by degree.
+            coordinates: ``sum |C[a, b]| |T_a| |T_b|`` times ``n + m + 2``
+            units of float64 rounding (the coefficients, the basis values and
+            the two matrix products) plus ``a**2 + b**2`` units of the
+            basis's ``longdouble`` rounding (recurrence and normalization).
         """
         x0, x1, y0, y1 = self.bounds if box is None else box
         sx = max(abs((x0 - self.x_offset) / self.x_scale), abs((x1 - self.x_offset) / self.x_scale))
@@ -293,8 +307,8 @@ class SurfaceEvaluator:
         gx, wx = _axis_error(n, sx)
         gy, wy = _axis_error(m, sy)
         size = np.abs(self.coefficients) * np.outer(gx, gy)
-        weight = (n + m + 2) + wx[:, None] + wy[None, :]
-        return float(EPS * np.sum(size * weight))
+        weight = EPS * (n + m + 2) + EPS_BASIS * (wx[:, None] + wy[None, :])
+        return float(np.sum(size * weight))
 
     def relative_error_bound(self, box: tuple[float, float, float, float] | None = None) -> float:
         """:meth:`error_bound` as a fraction of :attr:`data_range`."""
@@ -313,7 +327,7 @@ class CurveEvaluator:
     def __call__(self, x) -> np.ndarray:
         """``F(x)`` for ``x`` of any shape."""
         x = np.asarray(x, dtype=float)
-        s = (x - self.offset) / self.scale
+        s = (x.astype(np.longdouble) - self.offset) / np.longdouble(self.scale)
         return (self.coefficients @ chebyshev_matrix(s, len(self.coefficients))).reshape(x.shape)
 
 

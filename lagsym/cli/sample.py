@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import contextlib
 
-from ..evaluate import surface_evaluator
+from ..conditioning import FLOAT_ERROR_LIMIT, float_error_bound
 from ..export import FORMATS, MESH_MAX_POINTS, format_of, write_csv, write_sample
 from ..io import read_points
 from ..lagrange import lagrange_surface
@@ -34,7 +34,6 @@ examples:
 
 DEFAULT_COUNT = 101
 PROGRESS_POINTS = 250_000  # smaller jobs finish before a bar is worth drawing
-TRUST = 1e-12  # relative error bound above which the samples are flagged
 
 
 def add_arguments(p) -> None:
@@ -87,10 +86,10 @@ def run(args, out, err) -> int:
                   f"y {float(grid.box.y0):g}..{float(grid.box.y1):g} reaches outside the control points "
                   f"(x {float(b[0]):g}..{float(b[1]):g}, y {float(b[2]):g}..{float(b[3]):g}): "
                   f"the surface there is extrapolated and follows no data\n")
-    rel = surface_evaluator(surface).relative_error_bound(grid.box.floats())
-    if rel > TRUST:
+    rel = float_error_bound(surface, grid.box.floats())
+    if rel > FLOAT_ERROR_LIMIT:
         err.write(f"lagsym: warning: rounding error of the samples may reach {rel:.1e} of the data range "
-                  f"(trusted limit {TRUST:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "
+                  f"(trusted limit {FLOAT_ERROR_LIMIT:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "
                   f"ill-conditioned (see 'lagsym check'); use fewer or Chebyshev-spaced nodes, "
                   f"or exact values from 'lagsym equation'\n")
     with _progress(err, grid.size, args.quiet) as progress:
