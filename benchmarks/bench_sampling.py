@@ -123,10 +123,10 @@ def _data(kind: str, xs, ys, rng) -> list[list[Fraction]]:
     if kind == "rough":  # heights like the paper's Example 4: two decimals, 1.00 to 3.40
         return [[Fraction(int(v), 100) for v in rng.integers(100, 341, len(ys))] for _ in xs]
     x0, x1, y0, y1 = float(xs[0]), float(xs[-1]), float(ys[0]), float(ys[-1])
-    # a smooth part, exact: a low-degree polynomial in the unit box with decimal coefficients
-    return [[Fraction(1) + Fraction(3, 2) * u * (1 - u) * 4 + Fraction(1, 2) * u * v - Fraction(3, 10) * v * v
-             for v in [(y - Fraction(y0)) / Fraction(y1 - y0) for y in ys]]
-            for u in [(x - Fraction(x0)) / Fraction(x1 - x0) for x in xs]]
+    # smooth: an analytic function sampled to full float precision (every digit kept, exactly)
+    return [[Fraction(1.0 + 0.5 * math.sin(2 * u + 1) * math.cos(3 * v) + 0.2 * u * v)
+             for v in [(float(y) - y0) / (y1 - y0) for y in ys]]
+            for u in [(float(x) - x0) / (x1 - x0) for x in xs]]
 
 
 def _errors(surface, x, y, values) -> float:
