@@ -257,3 +257,36 @@ def test_cli_quiet_example_has_no_warning(run_cli, tmp_path):
     status, _, err = run_cli("sample", EXAMPLE4, "--nx", "400", "--ny", "400", "-o", tmp_path / "i.csv")
     assert (status, err) == (0, "")
     assert Fraction(1) == Fraction(str(1.0))
+
+
+class _Terminal:
+    """A text stream that says it is a terminal, to see the progress bar."""
+
+    def __init__(self):
+        import io
+
+        self.buf = io.StringIO()
+
+    def write(self, s):
+        return self.buf.write(s)
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return True
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_cli_progress_bar_only_on_a_terminal_and_not_quiet(tmp_path, quiet):
+    import io
+
+    from lagsym.cli import main
+
+    err = _Terminal()
+    argv = ["sample", str(EXAMPLE4), "--nx", "600", "--ny", "600", "-o", str(tmp_path / "p.npy")]
+    status = main(argv + (["--quiet"] if quiet else []), io.StringIO(), err)
+    assert status == 0
+    shown = err.buf.getvalue()
+    assert ("sampling" in shown) != quiet
+    assert np.load(tmp_path / "p.npy").shape == (360000, 3)

@@ -43,11 +43,9 @@ def write_csv(stream: IO[str], blocks: Iterable[Block], progress: Progress | Non
     for block in blocks:
         if ys_text is None:
             ys_text = [f",{v!r}," for v in block.ys.tolist()]
-        lines = []
-        for x, row in zip(block.xs.tolist(), block.z.tolist()):
+        for x, row in zip(block.xs.tolist(), block.z):
             xt = repr(x)
-            lines.append("".join([f"{xt}{yt}{z!r}\n" for yt, z in zip(ys_text, row)]))
-        stream.write("".join(lines))
+            stream.write("".join([f"{xt}{yt}{z!r}\n" for yt, z in zip(ys_text, row.tolist())]))
         done += block.z.size
         if progress is not None:
             progress(done)
