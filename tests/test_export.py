@@ -290,3 +290,11 @@ def test_cli_progress_bar_only_on_a_terminal_and_not_quiet(tmp_path, quiet):
     shown = err.buf.getvalue()
     assert ("sampling" in shown) != quiet
     assert np.load(tmp_path / "p.npy").shape == (360000, 3)
+
+
+def test_ply_header_names_each_property_once(tmp_path, surface, grid):
+    path = tmp_path / "s.ply"
+    write_sample(path, surface, grid)
+    header = path.read_bytes().split(b"end_header")[0].decode("ascii").splitlines()
+    props = [line.split()[-1] for line in header if line.startswith("property double")]
+    assert props == ["x", "y", "z"]

@@ -8,7 +8,7 @@ extension      contents                                    streamed
 ``.vtk``       legacy VTK triangle mesh, point data ``z``  no
 ``.vts``       VTK XML structured grid, point data ``z``   no
 ``.stl``       binary STL triangles                        no
-``.ply``       binary PLY triangles, vertex property ``z`` no
+``.ply``       binary PLY triangles                        no
 ``.obj``       Wavefront OBJ triangles                     no
 =============  ==========================================  =========
 

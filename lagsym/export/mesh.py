@@ -57,7 +57,7 @@ def write_meshio(path: str | os.PathLike, sample: Sample, file_format: str) -> N
     _check_size(sample, path)
     nx, ny = sample.z.shape
     points = np.column_stack([np.asarray(sample.x).ravel(), np.asarray(sample.y).ravel(), sample.z.ravel()])
-    point_data = {"z": sample.z.ravel()} if file_format in ("vtk", "ply") else {}
+    point_data = {"z": sample.z.ravel()} if file_format == "vtk" else {}  # PLY would repeat the name z
     mesh = meshio.Mesh(points, [("triangle", triangles(nx, ny))], point_data=point_data)
     options = {"binary": True} if file_format in ("vtk", "stl", "ply") else {}
     with atomic_path(path) as tmp:
