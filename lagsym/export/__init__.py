@@ -27,7 +27,7 @@ from ..errors import InputError
 from ..io import atomic_write
 from ..sampling import BLOCK_POINTS, SampleGrid, iter_blocks, sample
 from ._files import usual_mode
-from .mesh import MESH_MAX_POINTS, MESHIO_FORMATS, write_meshio, write_vts
+from .mesh import MESH_MAX_POINTS, MESHIO_FORMATS, write_meshio, write_stl, write_vts
 from .table import write_csv, write_npy
 
 __all__ = ["FORMATS", "STREAMED", "MESH_MAX_POINTS", "format_of", "write_sample", "write_csv", "write_npy"]
@@ -98,6 +98,8 @@ def _write(path, ext: str, surface, grid: SampleGrid, progress, block_points: in
     s = sample(surface, grid=grid)
     if ext == ".vts":
         write_vts(path, s)
+    elif ext == ".stl":
+        write_stl(path, s)
     else:
         write_meshio(path, s, MESHIO_FORMATS[ext])
     if progress is not None:

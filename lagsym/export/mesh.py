@@ -1,11 +1,12 @@
 """Triangle meshes for CAD and viewers: VTK (``.vtk``, ``.vts``), STL, PLY and OBJ.
 
 The sample grid is triangulated, each grid cell into two triangles whose
-normals point up (+z).  Files are written by meshio (``.vtk``, ``.stl``,
-``.ply``, ``.obj``) and by VTK's XML writer (``.vts``, a structured grid that
-keeps the rows and columns); both libraries are imported inside the functions
-that use them.  A mesh is built whole in memory, about 100 bytes a point, so
-its size is limited by :data:`MESH_MAX_POINTS`; the point tables stream.
+normals point up (+z).  Files are written by meshio (``.vtk``, ``.ply``,
+``.obj``) and by VTK (``.stl``, whose writer streams the facets from the
+shared points instead of copying each triangle; ``.vts``, a structured grid
+that keeps the rows and columns); both libraries are imported inside the
+functions that use them.  A mesh is built whole in memory, so its size is
+limited by :data:`MESH_MAX_POINTS`; the point tables stream.
 """
 
 from __future__ import annotations
@@ -18,10 +19,10 @@ from ..errors import InputError
 from ..sampling import Sample
 from ._files import atomic_path
 
-__all__ = ["MESH_MAX_POINTS", "MESHIO_FORMATS", "triangles", "write_meshio", "write_vts"]
+__all__ = ["MESH_MAX_POINTS", "MESHIO_FORMATS", "triangles", "write_meshio", "write_stl", "write_vts"]
 
-MESH_MAX_POINTS = 4_200_000  # 2049 x 2049 grid lines
-MESHIO_FORMATS = {".vtk": "vtk", ".stl": "stl", ".ply": "ply", ".obj": "obj"}
+MESH_MAX_POINTS = 2049 * 2049  # meshes are built whole: about 600 MB at the peak
+MESHIO_FORMATS = {".vtk": "vtk", ".ply": "ply", ".obj": "obj"}
 
 
 def triangles(nx: int, ny: int) -> np.ndarray:
@@ -51,7 +52,7 @@ def _check_size(sample: Sample, path) -> None:
 
 
 def write_meshio(path: str | os.PathLike, sample: Sample, file_format: str) -> None:
-    """Write ``sample`` as a triangle mesh with meshio (``vtk``, ``stl``, ``ply`` or ``obj``), atomically."""
+    """Write ``sample`` as a triangle mesh with meshio (``vtk``, ``ply`` or ``obj``), atomically."""
     import meshio
 
     _check_size(sample, path)
@@ -59,7 +60,7 @@ def write_meshio(path: str | os.PathLike, sample: Sample, file_format: str) -> N
     points = np.column_stack([np.asarray(sample.x).ravel(), np.asarray(sample.y).ravel(), sample.z.ravel()])
     point_data = {"z": sample.z.ravel()} if file_format == "vtk" else {}  # PLY would repeat the name z
     mesh = meshio.Mesh(points, [("triangle", triangles(nx, ny))], point_data=point_data)
-    options = {"binary": True} if file_format in ("vtk", "stl", "ply") else {}
+    options = {"binary": True} if file_format in ("vtk", "ply") else {}
     with atomic_path(path) as tmp:
         meshio.write(tmp, mesh, file_format=file_format, **options)
 
@@ -90,5 +91,36 @@ def write_vts(path: str | os.PathLike, sample: Sample) -> None:
         writer.SetInputData(grid)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
+        if not writer.Write():
+            raise OSError(f"{path}: VTK could not write the file")
+
+
+def write_stl(path: str | os.PathLike, sample: Sample) -> None:
+    """Write ``sample`` as a binary STL file (float32 facets, as STL stores them) with VTK's writer."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+    from vtkmodules.vtkIOGeometry import vtkSTLWriter
+
+    _check_size(sample, path)
+    nx, ny = sample.z.shape
+    xyz = np.empty((nx * ny, 3), dtype=np.float32)
+    xyz[:, 0].reshape(nx, ny)[...] = sample.x
+    xyz[:, 1].reshape(nx, ny)[...] = sample.y
+    xyz[:, 2] = sample.z.ravel()
+    conn = triangles(nx, ny).astype(np.int64).ravel()
+    offsets = np.arange(0, conn.size + 1, 3, dtype=np.int64)
+    pts = vtkPoints()
+    pts.SetData(numpy_to_vtk(xyz, deep=False))
+    cells = vtkCellArray()
+    cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=False), numpy_to_vtkIdTypeArray(conn, deep=False))
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    poly.SetPolys(cells)
+    with atomic_path(path) as tmp:
+        writer = vtkSTLWriter()
+        writer.SetFileName(tmp)
+        writer.SetInputData(poly)
+        writer.SetFileTypeToBinary()
         if not writer.Write():
             raise OSError(f"{path}: VTK could not write the file")
