@@ -78,6 +78,8 @@ def speed(n: int = 2000) -> None:
     t_scipy = best(scipy_both_axes, repeat=7)
     t_rows = best(scipy_row_by_row, repeat=3)
     t_lamb = best(lambda: f(xs[:, None], ys[None, :]), repeat=3)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    t_lamb_mesh = best(lambda: f(X, Y), repeat=3)
     rng = np.random.default_rng(0)
     px, py = rng.uniform(1, 5, 10**6), rng.uniform(1, 5, 10**6)
     t_scatter = best(lambda: surface.evaluate(px, py), repeat=5)
@@ -95,8 +97,10 @@ def speed(n: int = 2000) -> None:
           f"{t_scipy / t_grid:.1f}x slower |")
     print(f"| SciPy `BarycentricInterpolator`, one interpolator per x row | {t_rows * 1e3:.1f} | "
           f"{t_rows / t_grid:.0f}x slower |")
-    print(f"| `lambdify` of the expanded expression (broadcast) | {t_lamb * 1e3:.1f} | "
+    print(f"| `lambdify` of the expanded expression, broadcast `x[:, None]`, `y[None, :]` | {t_lamb * 1e3:.1f} | "
           f"{t_lamb / t_grid:.0f}x slower |")
+    print(f"| `lambdify` of the expanded expression, on `meshgrid` arrays | {t_lamb_mesh * 1e3:.1f} | "
+          f"{t_lamb_mesh / t_grid:.0f}x slower |")
     print()
     print("| scattered points | time (ms) | ratio |")
     print("|---|---:|---:|")
