@@ -5,7 +5,9 @@
 * the Lebesgue constant of each node set: how much the interpolant can amplify
   an error in the data (and floating-point rounding);
 * the overshoot of the surface between the nodes compared with the data range
-  (Runge's phenomenon).
+  (Runge's phenomenon);
+* a bound on the rounding error of numeric samples, so that ill-conditioned
+  grids are flagged instead of silently giving noise.
 """
 
 from __future__ import annotations
@@ -14,15 +16,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .evaluate import evaluate_grid, lebesgue_constant
+from .evaluate import evaluate_grid, lebesgue_constant, surface_evaluator
 from .lagrange import LagrangeSurface
 
-__all__ = ["Finding", "CheckReport", "check_surface", "check_curve", "DEGREE_LIMIT", "SPACING_LIMIT", "LEBESGUE_LIMIT", "OVERSHOOT_LIMIT"]
+__all__ = [
+    "Finding", "CheckReport", "check_surface", "check_curve", "float_error_bound",
+    "DEGREE_LIMIT", "SPACING_LIMIT", "LEBESGUE_LIMIT", "OVERSHOOT_LIMIT", "FLOAT_ERROR_LIMIT",
+]
 
 DEGREE_LIMIT = 6  # the paper's danger line (section 4, item 4)
 SPACING_LIMIT = 5.0  # mean dx / mean dy beyond 5 (or below 1/5) is "too large" (item 2)
 LEBESGUE_LIMIT = 10.0  # data errors amplified more than tenfold
 OVERSHOOT_LIMIT = 0.10  # the surface leaves the data range by more than 10 % of it
+FLOAT_ERROR_LIMIT = 1e-12  # numeric samples trusted to this fraction of the data range
 EPS = float(np.finfo(float).eps)
 
 
@@ -62,18 +68,20 @@ def _spacing(nodes: np.ndarray) -> float:
     return float(np.mean(np.diff(nodes)))
 
 
-def float_error_bound(surface: LagrangeSurface) -> float:
-    """A bound on the floating-point error of the stable evaluator, relative to the data range.
+def float_error_bound(surface: LagrangeSurface, box: tuple[float, float, float, float] | None = None) -> float:
+    """A bound on the floating-point error of the numeric evaluator, as a fraction of the data range.
 
-    Barycentric evaluation is forward stable: its error is a few units of
-    rounding times the Lebesgue constants of the two node sets.
+    The evaluator (:class:`~lagsym.evaluate.SurfaceEvaluator`) works in the
+    Chebyshev basis of normalized coordinates, with coefficients found
+    exactly; its rounding error is a few units of rounding times
+    ``sum |C[a, b]|`` weighted by degree.  That sum is of the size of the
+    surface itself, so the bound grows only where the surface does: with many
+    equally spaced nodes and rough data the interpolant swings far beyond the
+    data (Runge), and the bound says the samples cannot be trusted to the
+    last digits.  ``box`` (``(x0, x1, y0, y1)``) defaults to the control box;
+    beyond it (extrapolation) the bound grows.
     """
-    g = surface.grid
-    lam = lebesgue_constant(g.x_array) * lebesgue_constant(g.y_array)
-    zmax = float(np.abs(g.z_array).max())
-    zr = float(np.ptp(g.z_array)) or max(zmax, 1.0)
-    n, m = g.shape
-    return EPS * lam * (n + m) * zmax / zr
+    return surface_evaluator(surface).relative_error_bound(box)
 
 
 def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> CheckReport:
@@ -115,10 +123,12 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
                 f"worst near (x, y) = ({xs[i]:.4g}, {ys[j]:.4g})")
     )
     err = float_error_bound(surface)
+    bad = err > FLOAT_ERROR_LIMIT
     findings.append(
-        Finding("float_error", err, 1e-12, err > 1e-12,
+        Finding("float_error", err, FLOAT_ERROR_LIMIT, bad,
                 f"floating-point evaluation error bound: {err:.2g} of the data range"
-                + (" (numeric samples cannot be trusted to 1e-12; use exact evaluation or fewer nodes)" if err > 1e-12 else ""))
+                + (f" (numeric samples cannot be trusted to {FLOAT_ERROR_LIMIT:g}; use fewer or Chebyshev-spaced "
+                   f"nodes, or exact values from 'lagsym equation')" if bad else f" (limit {FLOAT_ERROR_LIMIT:g})"))
     )
     return CheckReport(source=g.source, findings=tuple(findings))
 

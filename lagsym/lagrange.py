@@ -210,6 +210,18 @@ class LagrangeSurface:
 
         return evaluate_points(self, x, y)
 
+    def sample(self, nx: int | None = None, ny: int | None = None, **kwargs):
+        """Sample on a regular grid: ``X, Y, Z = surface.sample(nx, ny)``; see :func:`lagsym.sampling.sample`."""
+        from .sampling import sample
+
+        return sample(self, nx, ny, **kwargs)
+
+    def lambdify(self):
+        """The NumPy function ``f(x, y)`` of the exact expression; see :func:`lagsym.evaluate.lambdify_surface`."""
+        from .evaluate import lambdify_surface
+
+        return lambdify_surface(self)
+
 
 def lagrange_curve(points: CurvePoints) -> LagrangeCurve:
     """The exact Lagrange curve through ``points`` (paper eq. 1-3).

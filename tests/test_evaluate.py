@@ -1,0 +1,217 @@
+"""The numeric evaluator agrees with exact evaluation, within its stated bound."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from conftest import EXAMPLES
+from lagsym.conditioning import check_surface, float_error_bound
+from lagsym.evaluate import (
+    chebyshev_matrix,
+    chebyshev_transform,
+    evaluate_grid,
+    evaluate_points,
+    surface_evaluator,
+)
+from lagsym.grid import curve_from_points, grid_from_table
+from lagsym.io import read_points
+from lagsym.lagrange import lagrange_curve, lagrange_surface
+
+EXAMPLE_FILES = sorted(EXAMPLES.glob("paper-example-*.json"))
+
+
+def _error(surface, x, y, z) -> float:
+    """Largest ``|z - F(x, y)|`` with ``F`` evaluated exactly at the float coordinates."""
+    return max(
+        abs(float(surface.exact_value(Fraction(a), Fraction(b)) - Fraction(c)))
+        for a, b, c in zip(np.ravel(x).tolist(), np.ravel(y).tolist(), np.ravel(z).tolist())
+    )
+
+
+def _chebyshev_like(n: int, a: int, b: int) -> list[Fraction]:
+    """Chebyshev points of the first kind on [a, b], rounded to 3 decimals (as a user would type them)."""
+    return [Fraction(round((a + b) / 2 - (b - a) / 2 * math.cos(math.pi * (2 * k + 1) / (2 * n)), 3)).limit_denominator(1000)
+            for k in range(n)]
+
+
+def _rough(n: int, m: int, seed: int) -> list[list[Fraction]]:
+    rng = np.random.default_rng(seed)
+    return [[Fraction(int(v), 100) for v in rng.integers(100, 340, m)] for _ in range(n)]
+
+
+exact_decimal = st.integers(-10_000, 10_000).map(lambda k: Fraction(k, 100))
+
+
+@st.composite
+def surfaces(draw, max_nodes: int = 7):
+    n = draw(st.integers(2, max_nodes))
+    m = draw(st.integers(2, max_nodes))
+    xs = sorted(draw(st.sets(st.integers(-500, 500), min_size=n, max_size=n)))
+    ys = sorted(draw(st.sets(st.integers(-500, 500), min_size=m, max_size=m)))
+    scale = draw(st.sampled_from([Fraction(1), Fraction(1, 10), Fraction(1, 3)]))
+    z = [[draw(exact_decimal) for _ in range(m)] for _ in range(n)]
+    return lagrange_surface(grid_from_table([v * scale for v in xs], [v * scale for v in ys], z))
+
+
+@given(surfaces(), st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1)), min_size=1, max_size=8))
+def test_points_agree_with_exact_evaluation_within_the_bound(surface, unit_points):
+    x0, x1, y0, y1 = (float(v) for v in surface.grid.bounds)
+    x = np.array([x0 + u * (x1 - x0) for u, _ in unit_points])
+    y = np.array([y0 + v * (y1 - y0) for _, v in unit_points])
+    ev = surface_evaluator(surface)
+    assert _error(surface, x, y, surface.evaluate(x, y)) <= ev.error_bound()
+
+
+@given(surfaces(max_nodes=5), st.integers(2, 9), st.integers(2, 9))
+def test_grid_agrees_with_exact_evaluation_within_the_bound(surface, nx, ny):
+    x0, x1, y0, y1 = (float(v) for v in surface.grid.bounds)
+    xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+    z = evaluate_grid(surface, xs, ys)
+    xx, yy = np.meshgrid(xs, ys, indexing="ij")
+    assert _error(surface, xx, yy, z) <= surface_evaluator(surface).error_bound()
+
+
+@given(surfaces(max_nodes=5))
+def test_the_surface_passes_through_every_control_point_exactly(surface):
+    g = surface.grid
+    xs = np.array([float(v) for v in g.x])
+    exact_x = np.array([Fraction(float(v)) == v for v in g.x])
+    exact_y = np.array([Fraction(float(v)) == v for v in g.y])
+    ys = np.array([float(v) for v in g.y])
+    z = evaluate_grid(surface, xs, ys)
+    xx, yy = np.meshgrid(xs, ys, indexing="ij")
+    zp = evaluate_points(surface, xx, yy)
+    for i in range(len(xs)):
+        for k in range(len(ys)):
+            if exact_x[i] and exact_y[k]:
+                assert z[i, k] == float(g.z[i][k])
+                assert zp[i, k] == float(g.z[i][k])
+
+
+@pytest.mark.parametrize("path", EXAMPLE_FILES, ids=lambda p: p.stem)
+def test_paper_examples_to_the_last_digits(path):
+    surface = lagrange_surface(read_points(path))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(3)
+    x0, x1, y0, y1 = ev.bounds
+    x, y = rng.uniform(x0, x1, 40), rng.uniform(y0, y1, 40)
+    assert _error(surface, x, y, surface.evaluate(x, y)) <= 1e-14 * ev.data_range
+    assert float_error_bound(surface) <= 1e-12
+
+
+@pytest.mark.parametrize("n", [10, 15, 20])
+def test_chebyshev_like_nodes_up_to_20x20_reach_1e12_of_the_data_range(n):
+    nodes = _chebyshev_like(n, 0, 100)
+    surface = lagrange_surface(grid_from_table(nodes, nodes, _rough(n, n, n)))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(n)
+    x, y = rng.uniform(0.5, 99.5, 12), rng.uniform(0.5, 99.5, 12)
+    err = _error(surface, x, y, surface.evaluate(x, y))
+    assert err <= 1e-12 * ev.data_range
+    assert err <= ev.error_bound()
+    assert ev.relative_error_bound() <= 1e-12
+
+
+def test_paper_kind_of_nodes_smooth_data_at_12x12():
+    nodes = [Fraction(k) for k in range(1, 13)]
+    z = [[Fraction(1) + Fraction(i * k, 50) + Fraction((i - 6) ** 2, 40) for k in range(12)] for i in range(12)]
+    surface = lagrange_surface(grid_from_table(nodes, nodes, z))
+    rng = np.random.default_rng(12)
+    x, y = rng.uniform(1, 12, 15), rng.uniform(1, 12, 15)
+    assert _error(surface, x, y, surface.evaluate(x, y)) <= 1e-12 * surface_evaluator(surface).data_range
+    assert float_error_bound(surface) <= 1e-12
+
+
+def test_ill_conditioned_grids_are_flagged_and_the_bound_holds():
+    # 20 equally spaced nodes with rough data: the interpolant swings far beyond the data (Runge)
+    nodes = [Fraction(100 * k, 19) for k in range(20)]
+    surface = lagrange_surface(grid_from_table(nodes, nodes, _rough(20, 20, 7)))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(1)
+    x, y = rng.uniform(0, 100, 10), rng.uniform(0, 100, 10)
+    assert _error(surface, x, y, surface.evaluate(x, y)) <= ev.error_bound()
+    assert float_error_bound(surface) > 1e-12
+    report = check_surface(surface)
+    assert "float_error" in {f.name for f in report.warnings}
+
+
+def test_the_bound_grows_outside_the_control_box():
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    inside = float_error_bound(surface)
+    assert float_error_bound(surface, (0.0, 6.0, 0.0, 6.0)) > inside
+    assert float_error_bound(surface, (2.0, 3.0, 2.0, 3.0)) == inside  # within the box: the same bound
+
+
+def test_chebyshev_transform_is_exact():
+    xs = [Fraction(1, 3), Fraction(2), Fraction(7, 2), Fraction(11, 2)]
+    curve = lagrange_curve(curve_from_points([(x, Fraction(k * k - 3, 7)) for k, x in enumerate(xs)]))
+    offset, scale, a = chebyshev_transform(xs)
+    n = len(xs)
+    d = [Fraction(int(a[k, j].p), int(a[k, j].q)) for k in range(n) for j in range(n)]
+    cheb = [sum(d[k * n + j] * curve.coefficients[j] for j in range(n)) for k in range(n)]
+    for x in (Fraction(0), Fraction(5, 4), Fraction(9, 2), Fraction(6)):
+        s = (x - Fraction(offset)) / Fraction(scale)
+        t = [Fraction(1), s]
+        while len(t) < n:
+            t.append(2 * s * t[-1] - t[-2])
+        assert sum(c * tk for c, tk in zip(cheb, t)) == curve.exact_value(x)
+
+
+def test_chebyshev_matrix_matches_numpy():
+    s = np.linspace(-1.2, 1.2, 25)
+    ours = chebyshev_matrix(s, 7)
+    ref = np.polynomial.chebyshev.chebvander(s, 6).T
+    assert np.allclose(ours, ref, rtol=1e-14, atol=1e-14)
+
+
+def test_evaluate_broadcasts_like_numpy():
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
+    x = np.linspace(1, 5, 4)[:, None]
+    y = np.linspace(2, 4, 3)[None, :]
+    z = surface.evaluate(x, y)
+    assert z.shape == (4, 3)
+    assert np.allclose(z, x**2 + 3 * y, rtol=0, atol=1e-13)
+    assert surface.evaluate(2.0, 3.0).shape == ()
+    assert np.array_equal(z, evaluate_grid(surface, x.ravel(), y.ravel()))
+
+
+def test_scattered_points_in_chunks_match_one_block():
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(0)
+    x, y = rng.uniform(1, 5, 1000), rng.uniform(1, 5, 1000)
+    assert np.array_equal(ev.points(x, y, chunk=64), ev.points(x, y, chunk=4096))
+
+
+def test_curves_agree_with_exact_evaluation():
+    curve = lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 2), (4, 3)]))
+    x = np.linspace(1, 4, 31)
+    got = curve.evaluate(x)
+    assert got.shape == x.shape
+    for a, b in zip(x.tolist(), got.tolist()):
+        assert abs(float(curve.exact_value(Fraction(a))) - b) <= 1e-14
+    assert curve.evaluate(np.array([1.0, 2.0, 3.0, 4.0])).tolist()[:1] == [1.0]
+
+
+def test_lambdify_is_the_exact_expression_as_a_numpy_function():
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-2.json"))
+    f = surface.lambdify()
+    x, y = np.meshgrid(np.linspace(1, 4, 7), np.linspace(1, 4, 5), indexing="ij")
+    assert np.allclose(f(x, y), surface.evaluate(x, y), rtol=0, atol=1e-12)
+    flat = lagrange_surface(grid_from_table([0, 1], [0, 1], [[2, 2], [2, 2]]))
+    assert flat.lambdify()(np.zeros(3), 0.0).tolist() == [2.0, 2.0, 2.0]
+
+
+def test_the_evaluator_is_immutable():
+    ev = surface_evaluator(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ev.x_scale = 2.0
+    with pytest.raises(ValueError):
+        ev.coefficients[0, 0] = 1.0
