@@ -17,10 +17,13 @@ from .errors import (
     ToolpathError,
     TransferError,
 )
+from .evaluate import SurfaceEvaluator, surface_evaluator
+from .export import write_sample
 from .formula import Formula, parse_formula
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
 from .io import read_any_points, read_curve_points, read_points
 from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
+from .sampling import Sample, SampleGrid, sample, sample_grid
 from .surfaces import bezier_surface, bspline_surface, hermite_surface, make_surface
 
 __version__ = "0.1.0"
@@ -37,6 +40,13 @@ __all__ = [
     "make_surface",
     "parse_formula",
     "render_table",
+    "Sample",
+    "SampleGrid",
+    "SurfaceEvaluator",
+    "sample",
+    "sample_grid",
+    "surface_evaluator",
+    "write_sample",
     "ControlGrid",
     "CurvePoints",
     "ExitStatus",

@@ -29,6 +29,7 @@ __all__ = [
     "read_any_points",
     "parse_points",
     "exact_number",
+    "atomic_path",
     "atomic_write",
     "write_text",
 ]
@@ -312,11 +313,13 @@ def _arity(name: str, text: str, kind: str) -> int:
 
 
 @contextlib.contextmanager
-def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None = None) -> Iterator[IO]:
-    """Open a temporary file beside ``path``; it replaces ``path`` only if the block succeeds.
+def atomic_path(path: str | os.PathLike) -> Iterator[str]:
+    """Yield a temporary file name beside ``path``; it replaces ``path`` only if the block succeeds.
 
-    A failure part-way leaves any earlier file at ``path`` untouched and no
-    partial file behind.
+    For libraries that write a file by name (meshio, VTK) as much as for
+    :func:`atomic_write`: a failure part-way leaves any earlier file at
+    ``path`` untouched and no partial file behind.  The finished file gets the
+    permissions a newly created file would (``0o666`` less the umask).
     """
     target = Path(path)
     directory = target.parent if str(target.parent) else Path(".")
@@ -324,18 +327,33 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None =
         raise InputError(f"{path}: the folder {directory} does not exist")
     if target.is_dir():
         raise InputError(f"{path}: is a directory")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=directory)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part" + target.suffix, dir=directory)
+    os.close(fd)
     try:
-        kwargs = {} if "b" in mode else {"encoding": "utf-8", "newline": newline}
-        with os.fdopen(fd, mode, **kwargs) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+        yield tmp
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None = None) -> Iterator[IO]:
+    """Open a temporary file beside ``path``; it replaces ``path`` only if the block succeeds.
+
+    A failure part-way leaves any earlier file at ``path`` untouched and no
+    partial file behind.
+    """
+    with atomic_path(path) as tmp:
+        kwargs = {} if "b" in mode else {"encoding": "utf-8", "newline": newline}
+        with open(tmp, mode, **kwargs) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
 
 
 def write_text(path: str | os.PathLike, text: str, newline: str | None = "") -> None:

@@ -133,3 +133,14 @@ def test_atomic_write_leaves_the_old_file_on_failure(tmp_path):
             raise RuntimeError("disk died")
     assert target.read_text() == "old\n"
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+
+
+def test_written_files_get_the_usual_permissions(tmp_path):
+    import os
+
+    mask = os.umask(0o022)
+    try:
+        write_text(tmp_path / "o.txt", "x\n")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "o.txt").stat().st_mode & 0o777 == 0o644

@@ -26,7 +26,6 @@ from pathlib import Path
 from ..errors import InputError
 from ..io import atomic_write
 from ..sampling import BLOCK_POINTS, SampleGrid, iter_blocks, sample
-from ._files import usual_mode
 from .mesh import MESH_MAX_POINTS, MESHIO_FORMATS, write_meshio, write_stl, write_vts
 from .table import write_csv, write_npy
 
@@ -78,7 +77,6 @@ def write_sample(
         :data:`MESH_MAX_POINTS`.
     """
     _write(path, format_of(path), surface, grid, progress, block_points)
-    usual_mode(path)
 
 
 def _write(path, ext: str, surface, grid: SampleGrid, progress, block_points: int) -> None:

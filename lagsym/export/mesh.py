@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..sampling import Sample
-from ._files import atomic_path
+from ..io import atomic_path
 
 __all__ = ["MESH_MAX_POINTS", "MESHIO_FORMATS", "triangles", "write_meshio", "write_stl", "write_vts"]
 
