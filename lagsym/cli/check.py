@@ -21,7 +21,7 @@ output; the exit status is 0, or 1 with --strict when there is a warning.
 
 examples:
   lagsym check examples/paper-example-4.json
-  lagsym check examples/paper-example-4.json --strict --format json"""
+  lagsym check examples/paper-example-1.json --strict --format json"""
 
 
 def add_arguments(p) -> None:

@@ -1,0 +1,60 @@
+"""Write docs/cli.md from the ``lagsym`` parser itself: ``python3 docs/gen_cli.py``.
+
+tests/test_docs.py checks that the page is current and runs its examples.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+WIDTH = "100"
+if str(HERE.parent) not in sys.path:
+    sys.path.insert(0, str(HERE.parent))
+
+
+def help_text(argv: list[str]) -> str:
+    """What ``lagsym ARGV --help`` prints, at a fixed width."""
+    from lagsym.cli import main
+
+    old = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = WIDTH
+    try:
+        out = io.StringIO()
+        main([*argv, "--help"], out, io.StringIO())
+        return out.getvalue().rstrip() + "\n"
+    finally:
+        if old is None:
+            del os.environ["COLUMNS"]
+        else:
+            os.environ["COLUMNS"] = old
+
+
+def page() -> str:
+    """The whole CLI reference page."""
+    from lagsym.cli import _commands
+
+    parts = [
+        "# CLI reference\n",
+        "Every command of `lagsym`, as its `--help` prints it.  This page is generated from the",
+        "parser (`python3 docs/gen_cli.py`), and the tests check that it is current and run the",
+        "examples under each command, so neither can drift from the program.\n",
+        "Exit statuses: 0 success; 1 a finding (`check --strict` warning, `verify` gouge);",
+        "2 bad input or options (one line on standard error naming the file and value, nothing",
+        "written); 3 a fault on the serial line or at the machine (the message says what to do",
+        "next).  `--traceback` on any command shows the Python traceback of an error.\n",
+        "```",
+        help_text([]).rstrip(),
+        "```\n",
+    ]
+    for mod in _commands():
+        parts += [f"## lagsym {mod.NAME}\n", "```", help_text([mod.NAME]).rstrip(), "```\n"]
+    return "\n".join(parts)
+
+
+if __name__ == "__main__":
+    (HERE / "cli.md").write_text(page())
+    print(f"wrote {HERE / 'cli.md'}")
