@@ -14,7 +14,10 @@ ORDER = 50
 HELP = "draw the surface, its basis functions or a curve (an image with -o, else a window)"
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
---show basis, every basis function L_i(x) L_k(y) as a grid of small pictures.
+--show basis, every basis function L_i(x) L_k(y) as a grid of small pictures;
+with --show compare, the Lagrange, Hermite, Bezier and B-spline surfaces side
+by side with their deviation from the Lagrange surface (the paper's Figure 10);
+with --show toolpath PROGRAM, the moves of a G-code program over the surface.
 A file of [x, y] points draws the curve through them (and, with --show basis,
 its basis polynomials L_i(x)).
 
@@ -25,7 +28,8 @@ examples:
   lagsym plot examples/paper-example-4.json -o surface.png
   lagsym plot examples/paper-example-4.json --show basis -o basis.png
   lagsym plot examples/paper-curve-3rd.json -o curve.png
-  lagsym plot examples/paper-example-1.json --size 800x600 --units in"""
+  lagsym plot examples/paper-example-4.json --show compare -o compare.png
+  lagsym plot examples/paper-example-1.json --size 800x600 --units in -o small.png"""
 
 SHOW = ("surface", "basis", "compare", "toolpath")
 
