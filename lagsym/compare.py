@@ -235,6 +235,8 @@ def sample_axes(grid: ControlGrid, samples: tuple[int, int] = DEFAULT_SAMPLES) -
     Positions are computed exactly and rounded once, so a sample that falls on
     a control node is that node, to the last bit.
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_table
     >>> xs, ys = sample_axes(grid_from_table([0, 3], [1, 2], [[0, 0], [0, 0]]), (4, 3))
     >>> xs.tolist(), ys.tolist()

@@ -34,6 +34,8 @@ def _coeff_dict(obj) -> dict[tuple[int, ...], Fraction]:
 def nested_form(obj) -> sympy.Expr:
     """The polynomial in nested (Horner) form: Horner in x whose coefficients are Horner in y.
 
+    Examples
+    --------
     >>> from lagsym import lagrange_curve, curve_from_points
     >>> nested_form(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 1)])))
     x*(8 - 2*x) - 5
@@ -68,6 +70,8 @@ def _decimal_str(d: Decimal) -> str:
 def decimal_text(obj, digits: int) -> str:
     """The right-hand side with coefficients rounded to ``digits`` significant digits, as the paper prints them.
 
+    Examples
+    --------
     >>> from lagsym import lagrange_curve, curve_from_points
     >>> decimal_text(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 2), (4, 3)])), 4)
     '0.8333*x**3 - 6.5*x**2 + 15.67*x - 9'

@@ -121,6 +121,8 @@ def chebyshev_matrix(s, n: int, out: np.ndarray | None = None) -> np.ndarray:
     of rounding; where ``longdouble`` is plain float64 the bound of
     :meth:`SurfaceEvaluator.error_bound` accounts for it.
 
+    Examples
+    --------
     >>> chebyshev_matrix(np.array([0.5, 1.0]), 3).tolist()
     [[1.0, 1.0], [0.5, 1.0], [-0.5, 1.0]]
     """
@@ -228,6 +230,8 @@ class SurfaceEvaluator:
     def grid(self, xs, ys) -> np.ndarray:
         """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``.
 
+        Examples
+        --------
         >>> from lagsym.grid import grid_from_points
         >>> from lagsym.lagrange import lagrange_surface
         >>> pts = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
@@ -447,6 +451,8 @@ def basis_matrix(nodes, t) -> np.ndarray:
     Returns an array of shape ``t.shape + (len(nodes),)``; entry ``[..., j]``
     is ``L_j(t)``.  At a node the row is exactly one-hot.
 
+    Examples
+    --------
     >>> basis_matrix([0.0, 1.0, 2.0], [0.5, 2.0]).round(6).tolist()
     [[0.375, 0.75, -0.125], [0.0, 0.0, 1.0]]
     """
@@ -486,6 +492,8 @@ def lebesgue_constant(nodes, samples: int = 4001) -> float:
     It bounds how much the interpolant can amplify an error in the data: 1 for
     two nodes, growing like ``2**n / (e n log n)`` for equally spaced nodes.
 
+    Examples
+    --------
     >>> round(lebesgue_constant([0.0, 1.0]), 6)
     1.0
     """

@@ -159,6 +159,8 @@ def grid_from_table(
     The nodes may come in increasing or decreasing order, unevenly spaced; the
     grid is stored with increasing nodes.
 
+    Examples
+    --------
     >>> g = grid_from_table([3, 1], [0, 1], [[30, 31], [10, 11]])
     >>> g.x, g.z[0]
     ((Fraction(1, 1), Fraction(3, 1)), (Fraction(10, 1), Fraction(11, 1)))
@@ -193,6 +195,8 @@ def grid_from_table(
 def grid_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>") -> ControlGrid:
     """Arrange ``(x, y, z)`` triples given in any order into the paper's matrix ``p_ik``.
 
+    Examples
+    --------
     >>> g = grid_from_points([(1, 2, 7), (3, 3, 18), (1, 3, 10), (3, 2, 15)])
     >>> g.shape, g.z
     ((2, 2), ((Fraction(7, 1), Fraction(10, 1)), (Fraction(15, 1), Fraction(18, 1))))
@@ -235,6 +239,8 @@ def grid_from_points(points: Sequence[Sequence[Fraction]], source: str = "<point
 def curve_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>") -> CurvePoints:
     """Sort ``(x, y)`` pairs by x for a 1-D Lagrange curve.
 
+    Examples
+    --------
     >>> curve_from_points([(3, 1), (1, 1), (2, 3)]).x
     (Fraction(1, 1), Fraction(2, 1), Fraction(3, 1))
     """

@@ -47,6 +47,8 @@ class _Bad(Exception):
 def exact_number(text: str) -> Fraction:
     """Read an exact decimal or rational from text.
 
+    Examples
+    --------
     >>> exact_number("1.06"), exact_number("-1/3"), exact_number("2e3")
     (Fraction(53, 50), Fraction(-1, 3), Fraction(2000, 1))
     """
@@ -208,6 +210,8 @@ def _csv_rows(name: str, text: str, arity: int) -> list[tuple[Fraction, ...]]:
 def parse_points(text: str, source: str = "<points>", kind: str = "json") -> ControlGrid:
     """Read surface control points from JSON or CSV text.
 
+    Examples
+    --------
     >>> parse_points('[[1, 2, 7], [1, 3, 10], [3, 2, 15], [3, 3, 18.5]]').z[1][1]
     Fraction(37, 2)
     """

@@ -69,6 +69,8 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
 
     Row ``i`` holds the coefficients of ``L_i`` from the constant term up.
 
+    Examples
+    --------
     >>> basis_coefficients([1, 2, 3])[0]
     (Fraction(3, 1), Fraction(-5, 2), Fraction(1, 2))
     """
@@ -81,6 +83,8 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
 def lagrange_basis(nodes, symbol: sympy.Symbol = X) -> tuple[sympy.Poly, ...]:
     """The Lagrange basis polynomials ``L_i`` on ``nodes`` as exact ``sympy.Poly`` over QQ.
 
+    Examples
+    --------
     >>> [p.as_expr() for p in lagrange_basis([1, 2, 3])][1]
     -x**2 + 4*x - 3
     """
@@ -226,6 +230,8 @@ class LagrangeSurface:
 def lagrange_curve(points: CurvePoints) -> LagrangeCurve:
     """The exact Lagrange curve through ``points`` (paper eq. 1-3).
 
+    Examples
+    --------
     >>> from lagsym.grid import curve_from_points
     >>> lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 1)])).expr
     -2*x**2 + 8*x - 5
@@ -239,6 +245,8 @@ def lagrange_curve(points: CurvePoints) -> LagrangeCurve:
 def lagrange_surface(grid: ControlGrid) -> LagrangeSurface:
     """The exact tensor-product Lagrange surface through ``grid`` (paper eqs. 6-7).
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_points
     >>> pts = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
     ...        (5, 2, 31), (5, 3, 34), (5, 4, 37)]

@@ -747,6 +747,8 @@ def deviation_figure(x, y, deviations: Mapping[str, np.ndarray], *, units: str =
 def image_format(path: str | os.PathLike) -> str:
     """The image format for ``path``, from its suffix (one of :data:`IMAGE_FORMATS`).
 
+    Examples
+    --------
     >>> image_format("surface.PNG"), image_format("a/b.jpg")
     ('png', 'jpeg')
     """

@@ -65,6 +65,8 @@ class Box:
 def _lines(a: Fraction, b: Fraction, n: int) -> np.ndarray:
     """``n`` evenly spaced values from ``a`` to ``b``, each the float nearest the exact value.
 
+    Examples
+    --------
     >>> _lines(Fraction(0), Fraction(3, 10), 4).tolist()
     [0.0, 0.1, 0.2, 0.3]
     """
@@ -276,6 +278,8 @@ def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: Sampl
     ``grid``.  The heights come from the stable evaluator, never from the
     expanded power basis.
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_table
     >>> from lagsym.lagrange import lagrange_surface
     >>> s = lagrange_surface(grid_from_table([0, 1, 2], [0, 2], [[0, 0], [1, 1], [4, 4]]))

@@ -38,6 +38,8 @@ STREAMED = (".csv", ".npy")
 def format_of(path: str | os.PathLike) -> str:
     """The output format of ``path``, from its extension (lower case, with the dot).
 
+    Examples
+    --------
     >>> format_of("part.STL")
     '.stl'
     """

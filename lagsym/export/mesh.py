@@ -30,6 +30,8 @@ def triangles(nx: int, ny: int) -> np.ndarray:
 
     Counter-clockwise seen from +z, so the normals of a surface point up.
 
+    Examples
+    --------
     >>> triangles(2, 2).tolist()
     [[0, 2, 3], [0, 3, 1]]
     """

@@ -27,6 +27,8 @@ def write_csv(stream: IO[str], blocks: Iterable[Block], progress: Progress | Non
     float, so the file loses nothing; a sampled file is itself a valid
     points file for ``lagsym``.
 
+    Examples
+    --------
     >>> import io
     >>> from lagsym.sampling import Block
     >>> buf = io.StringIO()

@@ -21,6 +21,8 @@ def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = Fal
 
     With ``trim`` the trailing zeros go, but the point stays (``12.`` not ``12``).
 
+    Examples
+    --------
     >>> fixed(12, 3), fixed(0.0008, 4), fixed(-0.0001, 3), fixed(12.5, 3, trim=True), fixed(12, 3, trim=True)
     ('12.000', '0.0008', '0.000', '12.5', '12.')
     """
@@ -44,6 +46,8 @@ def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = Fal
 def constant(value: float | Fraction, significant: int = 15) -> str:
     """A constant in a macro expression: ``significant`` significant digits, decimal point, no exponent.
 
+    Examples
+    --------
     >>> constant(Fraction(1, 3), 8), constant(2.5e-7, 8), constant(-1200, 8)
     ('0.33333333', '0.00000025', '-1200.')
     """

@@ -65,6 +65,8 @@ def bernstein_matrix(degree: int, t) -> np.ndarray:
 class BernsteinBasis:
     """The Bernstein basis of one degree on ``[0, 1]``.
 
+    Examples
+    --------
     >>> BernsteinBasis(3).size
     4
     """
@@ -90,6 +92,8 @@ def bezier_surface(grid: ControlGrid) -> ParametricSurface:
 
     It meets the control net at the four corners and nowhere else in general.
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_table
     >>> s = bezier_surface(grid_from_table([0, 1, 2], [0, 1], [[0, 0], [4, 4], [0, 0]]))
     >>> float(s.evaluate(1.0, 0.5))

@@ -27,6 +27,8 @@ def clamped_uniform_knots(size: int, degree: int) -> tuple[Fraction, ...]:
     ``degree + 1`` zeros, ``size - degree - 1`` interior knots ``j / (size - degree)``
     and ``degree + 1`` ones: ``size + degree + 1`` knots in all.
 
+    Examples
+    --------
     >>> [str(k) for k in clamped_uniform_knots(5, 2)]
     ['0', '0', '0', '1/3', '2/3', '1', '1', '1']
     """
@@ -69,6 +71,8 @@ class BSplineBasis:
 def bspline_basis(size: int, degree: int) -> BSplineBasis:
     """The clamped uniform B-spline basis of ``degree`` with ``size`` functions.
 
+    Examples
+    --------
     >>> bspline_basis(4, 3).evaluate([0.5]).round(6).tolist()
     [[0.125, 0.375, 0.375, 0.125]]
     """

@@ -46,6 +46,8 @@ def difference_matrix(nodes) -> np.ndarray:
 
     Central differences inside, one-sided differences at the two ends.
 
+    Examples
+    --------
     >>> difference_matrix([0.0, 1.0, 3.0]).tolist()
     [[-1.0, 1.0, 0.0], [-0.3333333333333333, 0.0, 0.3333333333333333], [0.0, -0.5, 0.5]]
     """
@@ -72,6 +74,8 @@ class HermiteBasis:
     ``values(t)[p, i]`` and ``slopes(t)[p, i]`` are the weights of the value and of
     the slope at ``nodes[i]`` in the cubic through ``t[p]``'s interval.
 
+    Examples
+    --------
     >>> b = HermiteBasis((0.0, 2.0))
     >>> b.values([1.0]).tolist(), b.slopes([1.0]).tolist()
     ([[0.5, 0.5]], [[0.25, -0.25]])
@@ -147,6 +151,8 @@ class HermiteSurface:
 def hermite_surface(grid: ControlGrid, kind: str = "corner") -> HermiteSurface:
     """The bicubic Hermite surface of ``grid``, of kind ``"corner"`` or ``"piecewise"``.
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_table
     >>> g = grid_from_table([0, 1, 2], [0, 1], [[0, 0], [1, 1], [4, 4]])
     >>> hermite_surface(g, "piecewise").evaluate(1.0, 0.5).item()
