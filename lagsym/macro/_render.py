@@ -1,0 +1,42 @@
+"""What the dialect renderers share: variable numbering, constants and fully bracketed expressions."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from ..errors import ProgramError
+from ..post.numbers import constant
+from .model import Const, Op, Var, variables
+
+__all__ = ["number_variables", "expression", "literal"]
+
+
+def number_variables(body, base: int, ranges: tuple[tuple[int, int], ...], letter: str = "#") -> dict[str, int]:
+    """Give every variable of ``body`` a number from ``base`` up; it must stay in one of ``ranges``."""
+    names = variables(body)
+    last = base + len(names) - 1
+    if not any(lo <= base and last <= hi for lo, hi in ranges):
+        allowed = ", ".join(f"{letter}{lo}-{letter}{hi}" for lo, hi in ranges)
+        raise ProgramError(f"variables {letter}{base}-{letter}{last} ({len(names)} needed) are outside the "
+                           f"ranges the control allows ({allowed}); choose another variable base")
+    return {name: base + n for n, name in enumerate(names)}
+
+
+def literal(value: Fraction, precision: int) -> str:
+    """A constant with ``precision`` significant digits, decimal point, no exponent."""
+    return constant(value, precision)
+
+
+def expression(e, name, precision: int) -> str:
+    """``e`` with every binary operation in ``[ ]``; ``name(var)`` writes a variable.
+
+    Adding a negative constant is written as a subtraction, so ``+-`` never appears.
+    """
+    if isinstance(e, Var):
+        return name(e)
+    if isinstance(e, Const):
+        return literal(e.value, precision)
+    op, b = e.op, e.b
+    if isinstance(b, Const) and b.value < 0 and op in "+-":
+        op, b = ("-" if op == "+" else "+"), Const(-b.value)
+    return f"[{expression(e.a, name, precision)}{op}{expression(b, name, precision)}]"

@@ -1,0 +1,165 @@
+"""The shared program model: the few statements every dialect's macro is made of.
+
+A macro is a tree of :class:`Assign`, :class:`Clamp`, :class:`Loop` and
+:class:`Move` over named variables.  Each dialect module renders the tree in
+its own syntax (``#105``, ``#<z>``, ``Q6``); :func:`run` executes the
+straight-line parts on the PC in decimal arithmetic of a chosen precision,
+rounding after every operation as the control does, which is how lagsym
+predicts a program's arithmetic error before it is written.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import ROUND_HALF_EVEN, Context, Decimal
+from fractions import Fraction
+from typing import Union
+
+__all__ = ["Var", "Const", "Op", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
+           "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables"]
+
+
+@dataclass(frozen=True)
+class Var:
+    """A variable, by its role name (``"z"``, ``"g3"``); dialects map names to numbers."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Const:
+    """An exact constant; the dialect writes it with the control's number of significant digits."""
+
+    value: Fraction
+
+
+@dataclass(frozen=True)
+class Op:
+    """A binary operation ``a op b`` with ``op`` one of ``+ - * /``."""
+
+    op: str
+    a: "Expr"
+    b: "Expr"
+
+
+Expr = Union[Var, Const, Op]
+
+
+@dataclass(frozen=True)
+class Assign:
+    """``target = expr``."""
+
+    target: Var
+    expr: Expr
+
+
+@dataclass(frozen=True)
+class Clamp:
+    """``if target > limit: target = limit``: the last row or point stops at the box edge."""
+
+    target: Var
+    limit: Const
+
+
+@dataclass(frozen=True)
+class Loop:
+    """``counter = 0; while counter <= last: body; counter = counter + 1``. Runs at least once (``last >= 0``)."""
+
+    counter: Var
+    last: int
+    body: tuple
+
+
+@dataclass(frozen=True)
+class Move:
+    """A straight feed move to the values of three variables (X, Y, Z)."""
+
+    x: Var
+    y: Var
+    z: Var
+
+
+Statement = Union[Assign, Clamp, Loop, Move]
+
+
+def var(name: str) -> Var:
+    """A variable by role name."""
+    return Var(name)
+
+
+def const(value) -> Const:
+    """An exact constant."""
+    return Const(Fraction(value))
+
+
+def add(a: Expr, b: Expr) -> Op:
+    """``a + b``."""
+    return Op("+", a, b)
+
+
+def sub(a: Expr, b: Expr) -> Op:
+    """``a - b``."""
+    return Op("-", a, b)
+
+
+def mul(a: Expr, b: Expr) -> Op:
+    """``a * b``."""
+    return Op("*", a, b)
+
+
+def decimal_context(precision: int) -> Context:
+    """Decimal arithmetic with ``precision`` significant digits, rounding half to even."""
+    return Context(prec=precision, rounding=ROUND_HALF_EVEN, Emin=-999, Emax=999)
+
+
+def _constant(value: Fraction, ctx: Context) -> Decimal:
+    return ctx.divide(Decimal(value.numerator), Decimal(value.denominator))
+
+
+def _eval(e: Expr, env: dict, ctx: Context) -> Decimal:
+    if isinstance(e, Var):
+        return env[e.name]
+    if isinstance(e, Const):
+        return _constant(e.value, ctx)
+    a, b = _eval(e.a, env, ctx), _eval(e.b, env, ctx)
+    if e.op == "+":
+        return ctx.add(a, b)
+    if e.op == "-":
+        return ctx.subtract(a, b)
+    if e.op == "*":
+        return ctx.multiply(a, b)
+    return ctx.divide(a, b)
+
+
+def run(statements, env: dict, ctx: Context) -> dict:
+    """Execute straight-line ``Assign`` and ``Clamp`` statements on ``env`` (name -> Decimal); returns ``env``."""
+    for s in statements:
+        if isinstance(s, Assign):
+            env[s.target.name] = _eval(s.expr, env, ctx)
+        elif isinstance(s, Clamp):
+            limit = _constant(s.limit.value, ctx)
+            if env[s.target.name] > limit:
+                env[s.target.name] = limit
+        else:
+            raise TypeError(f"run() executes straight-line code only, not {type(s).__name__}")
+    return env
+
+
+def variables(statements) -> list[str]:
+    """Every variable name the statements assign or count with, in order of first appearance."""
+    names: list[str] = []
+
+    def see(v: Var):
+        if v.name not in names:
+            names.append(v.name)
+
+    def walk(stmts):
+        for s in stmts:
+            if isinstance(s, (Assign, Clamp)):
+                see(s.target)
+            elif isinstance(s, Loop):
+                see(s.counter)
+                walk(s.body)
+
+    walk(statements)
+    return names

@@ -1,0 +1,88 @@
+"""How big a macro program is next to the point list it replaces, and how long each takes down a serial line.
+
+The point-list size is an estimate, not a rendered program: one block
+``G1 X... Y... Z...`` per raster point with the machine's decimals and line
+ending, the coordinates written as :func:`lagsym.post.numbers.fixed` writes
+them, plus the same preamble and postamble as the macro.  A real point-list
+post may add block numbers or drop unchanged words; the estimate is within a
+few per cent of a plain one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["ProgramStats", "point_list_size", "transfer_seconds", "program_stats", "BITS_PER_CHAR_7E2"]
+
+BITS_PER_CHAR_7E2 = 11  # start bit, 7 data bits, even parity, 2 stop bits
+
+
+def transfer_seconds(size_bytes: int, baud: int = 9600, bits_per_char: int = BITS_PER_CHAR_7E2) -> float:
+    """Seconds to send ``size_bytes`` characters at ``baud`` (7E2: 11 bits a character).
+
+    >>> round(transfer_seconds(9600), 1)
+    11.0
+    """
+    return size_bytes * bits_per_char / baud
+
+
+def _width(values: np.ndarray, decimals: int) -> int:
+    # Characters of fixed(v, decimals) summed over values, without formatting each one.
+    a = np.round(np.abs(values), decimals)
+    ints = np.floor(a)
+    digits = np.where(ints >= 1, np.floor(np.log10(np.maximum(ints, 1))) + 1, 1)
+    neg = (np.round(values, decimals) < 0) & (a > 0)
+    return int(np.sum(digits + 1 + decimals + neg))
+
+
+def point_list_size(points: np.ndarray, decimals: int = 3, eol: str = "\n", overhead: int = 0) -> int:
+    """Bytes of a plain point list: ``G1 X.. Y.. Z..`` and a line ending per point, plus ``overhead``.
+
+    >>> point_list_size(np.array([[1.0, 2.0, -0.5]]), 3)
+    26
+    """
+    pts = np.asarray(points, dtype=float)
+    n = len(pts)
+    return (n * (len("G1 X Y Z") + len(eol)) + sum(_width(pts[:, c], decimals) for c in range(3)) + overhead)
+
+
+@dataclass(frozen=True)
+class ProgramStats:
+    """Sizes (bytes) and 9600-baud 7E2 transfer times (seconds) of a macro and its point list."""
+
+    points: int
+    macro_bytes: int
+    point_list_bytes: int
+    macro_seconds: float
+    point_list_seconds: float
+
+    def text(self) -> str:
+        """The comparison as a few lines of text."""
+        ratio = self.point_list_bytes / self.macro_bytes
+        return (f"raster points:     {self.points}\n"
+                f"macro program:     {self.macro_bytes} bytes, {self.macro_seconds:.1f} s at 9600 baud 7E2\n"
+                f"point-list program: {self.point_list_bytes} bytes, {_duration(self.point_list_seconds)} at 9600 baud 7E2 "
+                f"(estimate)\n"
+                f"the point list is {ratio:.1f} times larger")
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.1f} s"
+    return f"{seconds / 60:.1f} min" if seconds < 7200 else f"{seconds / 3600:.2f} h"
+
+
+def program_stats(program, points: np.ndarray, settings) -> ProgramStats:
+    """Compare ``program`` (a MacroProgram) with the point list over ``points`` (the planned (N, 3) points)."""
+    text = program.text
+    # The point list keeps the macro's preamble and postamble: everything outside the loops.
+    eol = settings.eol
+    lines = text.split(eol)
+    frame = sum(len(line) + len(eol) for line in lines
+                if line.startswith(("%", "O", "(", "G", "T", "S", "M", "F", "0", "1", "BEGIN", "END"))
+                and not line.startswith("G1 X#") and "#" not in line and "Q" not in line)
+    plist = point_list_size(points, settings.digits, eol, overhead=frame)
+    return ProgramStats(points=len(points), macro_bytes=program.size, point_list_bytes=plist,
+                        macro_seconds=transfer_seconds(program.size), point_list_seconds=transfer_seconds(plist))
