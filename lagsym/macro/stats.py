@@ -41,7 +41,7 @@ def point_list_size(points: np.ndarray, decimals: int = 3, eol: str = "\n", over
     """Bytes of a plain point list: ``G1 X.. Y.. Z..`` and a line ending per point, plus ``overhead``.
 
     >>> point_list_size(np.array([[1.0, 2.0, -0.5]]), 3)
-    26
+    25
     """
     pts = np.asarray(points, dtype=float)
     n = len(pts)
