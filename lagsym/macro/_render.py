@@ -36,7 +36,16 @@ def expression(e, name, precision: int) -> str:
         return name(e)
     if isinstance(e, Const):
         return literal(e.value, precision)
+    return f"[{_chain(e, name, precision)}]"
+
+
+def _chain(e, name, precision: int) -> str:
+    # A left operand with the same precedence is written without its own brackets:
+    # [a*b*c] and [a+b-c] are evaluated left to right, as the Op tree says.
     op, b = e.op, e.b
     if isinstance(b, Const) and b.value < 0 and op in "+-":
         op, b = ("-" if op == "+" else "+"), Const(-b.value)
-    return f"[{expression(e.a, name, precision)}{op}{expression(b, name, precision)}]"
+    a = e.a
+    same = isinstance(a, Op) and ((a.op in "+-" and op in "+-") or (a.op in "*/" and op in "*"))
+    left = _chain(a, name, precision) if same else expression(a, name, precision)
+    return f"{left}{op}{expression(b, name, precision)}"

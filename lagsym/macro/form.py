@@ -1,4 +1,4 @@
-"""The well-conditioned form of the surface for the control: normalized coordinates and nested Horner.
+"""The well-conditioned forms of the surface for the control: normalized coordinates, then Horner or Lagrange basis.
 
 The expanded polynomial in millimetre coordinates is useless on a control that
 rounds every result to 8 significant digits: its monomial coefficients run to
@@ -15,6 +15,18 @@ across the rows, and the height in program units is
 (Horner in ``V``) and per point runs one Horner in ``U`` of ``n - 1`` steps.
 The coefficients ``K`` are exact rationals; the program writes them with the
 control's number of significant digits.
+
+That *Horner* form is short, and exact enough for 15-digit arithmetic, but its
+coefficients grow with the degree (to about 400 times the heights at 7x7
+equally spaced nodes) and with 8 significant digits a 7x7 surface loses up to
+a micrometre.  The *Lagrange* form evaluates the tensor-product basis itself,
+
+    Z = ZO + sum_i L_i(U) * G_i(V),    G_i(V) = sum_k L_k(V) * H[i][k],
+    L_i(U) = W_i * prod_{j != i} (U - U_j),
+
+whose constants are the scaled heights ``H`` and the weights ``W``; its error
+is bounded by the Lebesgue constants, some 70 times below Horner's at 7x7 with
+8 digits, for about a third more program text.
 """
 
 from __future__ import annotations
@@ -28,7 +40,9 @@ from ..machine import MachineSettings
 from .model import Assign, Const, Var, add, const, mul, sub, var
 from .plan import exact
 
-__all__ = ["RowForm", "row_form", "row_statements", "point_statements"]
+__all__ = ["FORMS", "RowForm", "row_form", "row_statements", "point_statements"]
+
+FORMS = ("horner", "lagrange")
 
 
 @dataclass(frozen=True)
@@ -45,6 +59,12 @@ class RowForm:
         Centre and inverse half-width of the ``P`` and ``R`` axes, in program units.
     z0 : Fraction
         Height offset added last (Z origin plus stock to leave).
+    kind : str
+        ``"horner"`` or ``"lagrange"``: which statements the control runs.
+    p_nodes, r_nodes : tuple of Fraction
+        The normalized nodes on each axis (for the Lagrange form).
+    heights : tuple of tuple of Fraction
+        ``heights[i][k]``: the scaled height at ``(p_nodes[i], r_nodes[k])``.
     """
 
     direction: str
@@ -54,6 +74,10 @@ class RowForm:
     rc: Fraction
     rk: Fraction
     z0: Fraction
+    kind: str = "horner"
+    p_nodes: tuple[Fraction, ...] = ()
+    r_nodes: tuple[Fraction, ...] = ()
+    heights: tuple[tuple[Fraction, ...], ...] = ()
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -67,7 +91,8 @@ def _norm(nodes, scale, origin):
     return centre, 1 / half, tuple((n * scale + origin - centre) / half for n in nodes)
 
 
-def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str = "x") -> RowForm:
+def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str = "x",
+             kind: str = "horner") -> RowForm:
     """The normalized Horner form of ``surface`` in program units, for rows along ``direction``.
 
     >>> from lagsym.grid import grid_from_table
@@ -85,10 +110,14 @@ def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str
     zn = [[z * s for z in row] for row in g.z]
     c = lagrange_surface(grid_from_table(un, vn, zn)).coefficients
     z0 = oz + exact(settings.stock_to_leave_mm) * uf
+    zt = tuple(tuple(row) for row in zn)
+    if kind not in FORMS:
+        raise ValueError(f"form {kind!r} is not one of {', '.join(FORMS)}")
     if direction == "x":
-        return RowForm("x", c, xc, xk, yc, yk, z0)
+        return RowForm("x", c, xc, xk, yc, yk, z0, kind, un, vn, zt)
     ct = tuple(tuple(c[a][b] for a in range(len(c))) for b in range(len(c[0])))
-    return RowForm("y", ct, yc, yk, xc, xk, z0)
+    ht = tuple(tuple(zt[i][k] for i in range(len(zt))) for k in range(len(zt[0])))
+    return RowForm("y", ct, yc, yk, xc, xk, z0, kind, vn, un, ht)
 
 
 def _horner(target: Var, coeffs, x: Var) -> list[Assign]:
@@ -101,10 +130,56 @@ def _horner(target: Var, coeffs, x: Var) -> list[Assign]:
     return out
 
 
+def _weights(nodes) -> list[Fraction]:
+    out = []
+    for i, a in enumerate(nodes):
+        w = Fraction(1)
+        for j, b in enumerate(nodes):
+            if j != i:
+                w /= a - b
+        out.append(w)
+    return out
+
+
+def _basis(t: Var, nodes, tag: str) -> list[Assign]:
+    """``e_j = t - t_j`` and ``L_i = W_i * prod_{j != i} e_j`` (a left-to-right product)."""
+    out = [Assign(var(f"e{tag}{j}"), sub(t, const(x)) if x else t) for j, x in enumerate(nodes)]
+    for i, w in enumerate(_weights(nodes)):
+        acc = const(w)
+        for j in range(len(nodes)):
+            if j != i:
+                acc = mul(acc, var(f"e{tag}{j}"))
+        out.append(Assign(var(f"l{tag}{i}"), acc))
+    return out
+
+
+def _dot(target: Var, terms, chunk: int = 4) -> list[Assign]:
+    """``target = sum of terms`` (each ``(factor, const-or-var, sign)``), left to right, ``chunk`` terms a block."""
+    out: list[Assign] = []
+    acc = None
+    for n, (a, b, negative) in enumerate(terms):
+        term = mul(a, b)
+        if acc is None:
+            acc = sub(const(0), term) if negative else term
+        else:
+            acc = sub(acc, term) if negative else add(acc, term)
+        if (n + 1) % chunk == 0 and n + 1 < len(terms):
+            out.append(Assign(target, acc))
+            acc = target
+    out.append(Assign(target, acc if acc is not None else const(0)))
+    return out
+
+
 def row_statements(form: RowForm, r: Var, prefix: str = "g") -> list[Assign]:
     """Statements run once per row: ``v`` from ``r``, then every ``G_a(v)`` into ``g0 .. g(n-1)``."""
     v = var("v")
     out = [Assign(v, mul(sub(r, const(form.rc)), const(form.rk)))]
+    if form.kind == "lagrange":
+        out += _basis(v, form.r_nodes, "")
+        for i, row in enumerate(form.heights):
+            terms = [(var(f"l{k}"), const(abs(h)), h < 0) for k, h in enumerate(row) if h]
+            out += _dot(var(f"{prefix}{i}"), terms)
+        return out
     for a, row in enumerate(form.coefficients):
         out += _horner(var(f"{prefix}{a}"), [const(c) for c in row], v)
     return out
@@ -115,7 +190,11 @@ def point_statements(form: RowForm, p: Var, z: Var, prefix: str = "g") -> list[A
     u = var("u")
     n = form.shape[0]
     out = [Assign(u, mul(sub(p, const(form.pc)), const(form.pk)))]
-    out += _horner(z, [var(f"{prefix}{a}") for a in range(n)], u)
+    if form.kind == "lagrange":
+        out += _basis(u, form.p_nodes, "")
+        out += _dot(z, [(var(f"l{i}"), var(f"{prefix}{i}"), False) for i in range(n)])
+    else:
+        out += _horner(z, [var(f"{prefix}{a}") for a in range(n)], u)
     if form.z0:
         out.append(Assign(z, add(z, const(form.z0))))
     return out

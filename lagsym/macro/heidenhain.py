@@ -20,6 +20,13 @@ VARIABLE_RANGES = ((0, 99),)
 DEFAULT_BASE = 1
 MAX_LABEL = 254
 _FN = {"+": 1, "-": 2, "*": 3, "/": 4}
+SCRATCH = 6  # scratch Q parameters for the parts of an expression
+
+
+def _reads(e, v: Var) -> bool:
+    if isinstance(e, Var):
+        return e == v
+    return isinstance(e, Op) and (_reads(e.a, v) or _reads(e.b, v))
 
 
 def _signed(text: str) -> str:
@@ -32,7 +39,7 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
     from .model import variables
 
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
-    names = variables(plan.body) + ["h0", "h1"]
+    names = variables(plan.body) + [f"h{n}" for n in range(SCRATCH)]
     number = number_variables([Assign(Var(n), Const(0)) for n in names], base, VARIABLE_RANGES, letter="Q")
     dp = settings.digits
     unit = "MM" if settings.units == "mm" else "INCH"
@@ -49,7 +56,7 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
         return _signed(fixed(v, dp))
 
     out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}",
-                      f"; lagsym surface macro, {plan.form.shape[0]}x{plan.form.shape[1]} normalized Horner",
+                      f"; lagsym surface macro, {plan.form.shape[0]}x{plan.form.shape[1]} normalized {plan.form.kind} form",
                       f"; {plan.raster.size} points, rows along {plan.raster.direction}, {precision}-digit arithmetic",
                       f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
                       f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M3"]
@@ -60,17 +67,19 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
     labels = iter(range(1, MAX_LABEL + 1))
 
     def assign(target: Var, e, depth: int = 0) -> None:
+        # One FN block per operation.  The left operand is built in the target itself
+        # (unless the right operand reads the target), the right one in a scratch Q.
         if isinstance(e, (Var, Const)):
             out.append(f"FN 0: {q(target)} = {operand(e)}")
             return
         a, b = e.a, e.b
         if isinstance(a, Op):
-            tmp = Var(f"h{depth}")
-            assign(tmp, a, depth + 1)
-            a = tmp
+            dest = Var(f"h{depth}") if _reads(b, target) else target
+            assign(dest, a, depth + 1)
+            a = dest
         if isinstance(b, Op):
-            tmp = Var(f"h{depth + (1 if isinstance(e.a, Op) else 0)}")
-            assign(tmp, b, depth + 1)
+            tmp = Var(f"h{depth + 1}")
+            assign(tmp, b, depth + 2)
             b = tmp
         out.append(f"FN {_FN[e.op]}: {q(target)} = {operand(a)} {e.op} {operand(b)}")
 

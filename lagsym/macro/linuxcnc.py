@@ -27,7 +27,7 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
 
     dp = settings.digits
     out = ["%", f"(lagsym surface macro, program {settings.program_number})",
-           f"(surface {plan.form.shape[0]}x{plan.form.shape[1]}, normalized Horner, {precision}-digit arithmetic)",
+           f"(surface {plan.form.shape[0]}x{plan.form.shape[1]}, normalized {plan.form.kind} form, {precision}-digit arithmetic)",
            f"({plan.raster.size} points, rows along {plan.raster.direction})",
            f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90 G64 P0.001",
            settings.work_offset,

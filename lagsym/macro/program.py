@@ -34,16 +34,17 @@ import numpy as np
 from ..errors import ProgramError
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool, choice
-from .form import RowForm, point_statements, row_form, row_statements
+from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
 from .plan import MacroRaster, exact, macro_raster
 
-__all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "MacroPlan", "MacroProgram",
+__all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", "MacroPlan", "MacroProgram",
            "macro_plan", "macro_program", "predicted_error"]
 
 MACRO_DIALECTS = ("fanuc", "linuxcnc", "heidenhain")
 PRECISIONS = (8, 15)
 DEFAULT_PRECISION = {"fanuc": 8, "linuxcnc": 15, "heidenhain": 8}
+DEFAULT_FORM = {8: "lagrange", 15: "horner"}
 
 
 @dataclass(frozen=True)
@@ -81,10 +82,10 @@ def _exact_z(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
 
 
 def macro_plan(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
-               tool: Tool | None = None) -> MacroPlan:
-    """The loop plan for ``surface``: counted rows and points and the Horner statements of the height."""
+               tool: Tool | None = None, form: str = "horner") -> MacroPlan:
+    """The loop plan for ``surface``: counted rows and points and the statements of the height (``form``)."""
     plan = macro_raster(surface, settings, raster)
-    form = row_form(surface, settings, plan.direction)
+    form = row_form(surface, settings, plan.direction, form)
     rows, pts = plan.rows, plan.points
     j, d, i, k, t = var("j"), var("d"), var("i"), var("k"), var("t")
     r, p, z = var("r"), var("p"), var("z")
@@ -175,7 +176,7 @@ class MacroProgram:
 
 def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
                   tool: Tool | None = None, *, precision: int | None = None, tolerance_mm: float = 0.001,
-                  variable_base: int | None = None) -> MacroProgram:
+                  variable_base: int | None = None, form: str | None = None) -> MacroProgram:
     """A parametric program that evaluates ``surface`` on the control while it cuts the raster.
 
     Parameters
@@ -195,6 +196,9 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
         Largest arithmetic error accepted; a program predicted to exceed it is refused.
     variable_base : int, optional
         First variable number (Fanuc ``#100`` or ``#500``, Heidenhain ``Q1``).
+    form : str, optional
+        ``"horner"`` (shortest) or ``"lagrange"`` (tensor-product basis, the most
+        accurate); by default Lagrange for 8 digits and Horner for 15.
 
     Raises
     ------
@@ -205,17 +209,18 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
     precision = DEFAULT_PRECISION[dialect] if precision is None else int(precision)
     if precision not in PRECISIONS:
         raise ProgramError(f"precision {precision} is not one of {', '.join(map(str, PRECISIONS))} significant digits")
+    form = DEFAULT_FORM[precision] if form is None else choice(form, FORMS, "form")
     if tool is not None and tool.shape == "ball" and tool.diameter_mm > 0:
         from .ballend import ballend_plan
 
-        plan = ballend_plan(surface, settings, raster, tool)
+        plan = ballend_plan(surface, settings, raster, tool, form)
     else:
-        plan = macro_plan(surface, settings, raster, tool)
+        plan = macro_plan(surface, settings, raster, tool, form)
     err = predicted_error(plan, precision) / settings.unit_factor
     if err > tolerance_mm:
         raise ProgramError(
             f"{surface.grid.source}: a {surface.grid.shape[0]}x{surface.grid.shape[1]} surface evaluated with "
-            f"{precision} significant digits is predicted to be off by {err:.3g} mm, more than the tolerance "
+            f"{precision} significant digits in the {form} form is predicted to be off by {err:.3g} mm, more than the tolerance "
             f"{tolerance_mm:g} mm; use a control with 15-digit arithmetic (--precision 15), fewer control points, "
             f"or the point-list toolpath")
     module = importlib.import_module(f"{__package__}.{dialect}")
