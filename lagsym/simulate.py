@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from decimal import ROUND_FLOOR, ROUND_CEILING, ROUND_HALF_UP, Context, Decimal, InvalidOperation
+from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND_UP, Context, Decimal, InvalidOperation
 
 from .errors import ProgramError
 
@@ -339,10 +339,10 @@ class _Machine:
             return c.sqrt(a)
         if name == "ABS":
             return c.abs(a)
-        if name == "FIX":
-            return a.to_integral_value(rounding=ROUND_FLOOR)
-        if name == "FUP":
-            return a.to_integral_value(rounding=ROUND_CEILING)
+        if name == "FIX":  # Fanuc drops the fraction (toward zero); LinuxCNC rounds down
+            return a.to_integral_value(rounding=ROUND_DOWN if self.dialect == "fanuc" else ROUND_FLOOR)
+        if name == "FUP":  # Fanuc raises the magnitude (away from zero); LinuxCNC rounds up
+            return a.to_integral_value(rounding=ROUND_UP if self.dialect == "fanuc" else ROUND_CEILING)
         if name == "ROUND":
             return a.to_integral_value(rounding=ROUND_HALF_UP)
         if name == "EXP":
@@ -387,6 +387,7 @@ class _Block:
 
 
 _AXIS_DECIMAL = set("XYZABCIJKRUVW")
+_FUNC_NAME = re.compile(r"(?i)(SQRT|ABS|FIX|FUP|ROUND|SIN|COS|TAN|ATAN|ASIN|ACOS|EXP|LN)(?=\s*\[)")
 _WORD = re.compile(r"([A-Z])\s*")
 
 
@@ -413,6 +414,10 @@ def _split_words(text: str) -> list[tuple[str, str]]:
         start, depth = i, 0
         while i < len(s):
             ch = s[i]
+            fn = _FUNC_NAME.match(s, i) if depth == 0 and s[start:i].strip() in ("", "-", "+") else None
+            if fn:  # X SQRT[..]: a function name is part of the value, not the next address
+                i = fn.end()
+                continue
             if s.startswith("#<", i):
                 close = s.find(">", i)
                 if close < 0:
@@ -742,11 +747,15 @@ def _step(m: _Machine, blocks, pc: int, b: _Block, labels) -> int | None:
             return b.target + 1
     elif k == "oendwhile":
         return b.target
-    elif k in ("oif", "oelseif"):
-        if not b.a(m):
-            return b.target if blocks[b.target].kind != "oendif" else b.target + 1
-    elif k == "oelse":
-        pass
+    elif k == "oif":
+        j = pc
+        while not blocks[j].a(m):  # try the if, then each elseif, in turn
+            j = blocks[j].target
+            if blocks[j].kind in ("oendif", "oelse"):
+                break
+        return j + 1
+    elif k in ("oelse", "oelseif"):
+        return _if_chain_end(blocks, pc) + 1  # reached from a branch that ran: skip the rest
     elif k == "oendif":
         pass
     elif k == "if_then":
@@ -766,9 +775,6 @@ def _step(m: _Machine, blocks, pc: int, b: _Block, labels) -> int | None:
         return None
     elif k == "words":
         return _words(m, b, pc)
-    # An "else" or "elseif" reached by falling through ends its if: skip to the endif.
-    if pc + 1 < len(blocks) and blocks[pc + 1].kind in ("oelse", "oelseif") and k not in ("oif", "oelseif", "oelse"):
-        return _if_chain_end(blocks, pc + 1) + 1
     return pc + 1
 
 
