@@ -84,7 +84,7 @@ def detect_dialect(text: str) -> str:
     """Guess the dialect of a program: ``BEGIN PGM`` is Heidenhain, ``o100 while`` LinuxCNC, else Fanuc."""
     if re.search(r"^\s*\d*\s*BEGIN\s+PGM", text, re.M | re.I):
         return "heidenhain"
-    if re.search(r"^\s*o\s*[\d<]\S*\s+(while|if|do|sub|repeat)\b", text, re.M | re.I) or "#<" in text:
+    if re.search(r"^[ \t]*o[ \t]*[\d<]\S*[ \t]+(while|if|do|sub|repeat)\b", text, re.M | re.I) or "#<" in text:
         return "linuxcnc"
     return "fanuc"
 

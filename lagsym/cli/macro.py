@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
+from ..macro.form import FORMS
 from ..macro import MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, program_stats
 from ._common import emit
 
@@ -43,6 +44,9 @@ def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help="control language (default fanuc)")
     p.add_argument("--precision", type=int, choices=PRECISIONS,
                    help="significant digits of the control's arithmetic (default 8 for fanuc and heidenhain, 15 for linuxcnc)")
+    p.add_argument("--form", choices=FORMS,
+                   help="horner (shortest) or lagrange (tensor-product basis, most accurate); "
+                        "default lagrange at 8 digits, horner at 15")
     p.add_argument("--tolerance", type=float, default=0.001, metavar="MM",
                    help="largest arithmetic error accepted on the control, mm (default 0.001)")
     p.add_argument("--variable-base", type=int, metavar="N",
@@ -87,7 +91,7 @@ def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.file))
     settings, raster, tool = settings_from(args)
     program = macro_program(surface, settings, raster, tool, precision=args.precision,
-                            tolerance_mm=args.tolerance, variable_base=args.variable_base)
+                            tolerance_mm=args.tolerance, variable_base=args.variable_base, form=args.form)
     emit(program.text, args.output, out)
     if args.stats:
         stats = program_stats(program, planned_points(surface, settings, raster, tool), settings)
