@@ -546,6 +546,7 @@ def _heidenhain_statement(line: int, raw: str, t: str) -> _Block:
     m = re.fullmatch(r"LBL\s+(\d+)", t, re.I)
     if m:
         return _Block(line, raw, "label", None, int(m.group(1)))
+    t = re.sub(r"^(FN\s*5\s*:\s*Q\d+\s*=\s*)SQRT\s*", r"\1", t, flags=re.I)
     m = re.fullmatch(r"FN\s*(\d+)\s*:\s*Q(\d+)\s*=\s*" + _HH_OPERAND + r"(?:\s*([-+*/])\s*" + _HH_OPERAND + r")?", t, re.I)
     if m:
         fn, q, a, op, b = int(m.group(1)), int(m.group(2)), m.group(3), m.group(4), m.group(5)

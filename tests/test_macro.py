@@ -326,3 +326,76 @@ def test_cli_macro_refuses_with_exit_2(run_cli, tmp_path):
     status, out, err = run_cli("macro", f, "--dialect", "fanuc", "--form", "horner", "--tool-diameter", 0,
                                "--stepover", 5, "--step", 5)
     assert status == 2 and "predicted to be off by" in err
+
+
+# ---------------------------------------------------------------- ball-end cutter
+
+BALL = Tool("ball", 4.0)
+
+
+@pytest.mark.parametrize("direction", ["x", "y"])
+def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, direction):
+    s = surface("paper-example-4")
+    settings = MachineSettings(dialect="linuxcnc", scale=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
+    raster = RasterSpec(direction, 5.0, 2.0)
+    path = tmp_path / "ball.ngc"
+    path.write_text(macro_program(s, settings, raster, BALL).text)
+    got = feeds(rs274.run(path).stdout)[1:]
+    want = planned_points(s, settings, raster, BALL)
+    np.testing.assert_allclose(got, want, atol=1e-3, rtol=0)
+
+
+@pytest.mark.parametrize("form", ["horner", "lagrange"])
+@pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
+def test_ball_end_macro_through_the_simulator(dialect, form):
+    s = surface("paper-example-3")
+    settings = MachineSettings(dialect=dialect, scale=25.0)
+    raster = RasterSpec("y", 12.0, 5.0)
+    program = macro_program(s, settings, raster, BALL, form=form)
+    got = simulate(program.text, dialect, 8).feed_points()[1:]
+    np.testing.assert_allclose(got, planned_points(s, settings, raster, BALL), atol=1e-3, rtol=0)
+
+
+def test_ball_end_tip_is_one_radius_off_the_surface():
+    s = surface("paper-example-4")
+    settings = MachineSettings(scale=20.0)
+    tips = planned_points(s, settings, RasterSpec("x", 10.0, 4.0), BALL)
+    centres = tips + [0.0, 0.0, 2.0]
+    xs = np.linspace(20.0, 100.0, 401)
+    X, Y = np.meshgrid(xs, xs)
+    cloud = np.column_stack([X.ravel(), Y.ravel(), 20.0 * s.evaluate(X.ravel() / 20.0, Y.ravel() / 20.0)])
+    # away from the box edges, where the sampled surface ends
+    inner = [c for c in centres if 25 < c[0] < 95 and 25 < c[1] < 95]
+    near = [np.min(np.linalg.norm(cloud - c, axis=1)) for c in inner[::4]]
+    assert len(near) > 20
+    assert min(near) == pytest.approx(2.0, abs=0.01)  # never closer than the radius: no gouge
+    assert max(near) == pytest.approx(2.0, abs=0.01)  # and touching
+
+
+def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
+    from lagsym.macro.model import decimal_context, run
+    from lagsym.lagrange import X, Y
+
+    s = surface("paper-example-3")
+    plan = macro_plan(s, MachineSettings(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
+    ctx = decimal_context(30)
+    env = run(plan.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
+    env["p"] = ctx.create_decimal("1.75")
+    run(plan.point_code, env, ctx)
+    fx = s.derivative(1, 0).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
+    fy = s.derivative(0, 1).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
+    assert float(env["zp"]) == pytest.approx(float(fx), rel=1e-20, abs=1e-20)
+    assert float(env["zr"]) == pytest.approx(float(fy), rel=1e-20, abs=1e-20)
+
+
+def test_ball_end_gouge_is_refused_with_a_suggestion():
+    s = surface("paper-example-4")
+    with pytest.raises(ToolpathError, match=r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"):
+        macro_program(s, MachineSettings(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
+
+
+def test_flat_tool_and_zero_diameter_program_the_surface():
+    s = surface("paper-example-1")
+    a = macro_program(s, MachineSettings(), RasterSpec(), Tool("flat", 10.0)).text
+    b = macro_program(s, MachineSettings(), RasterSpec(), Tool("ball", 0.0)).text
+    assert a == b and "SQRT" not in a

@@ -6,7 +6,7 @@ from fractions import Fraction
 
 from ..errors import ProgramError
 from ..post.numbers import constant
-from .model import Const, Op, Var, variables
+from .model import Const, Op, Sqrt, Var, variables
 
 __all__ = ["number_variables", "expression", "literal"]
 
@@ -36,7 +36,14 @@ def expression(e, name, precision: int) -> str:
         return name(e)
     if isinstance(e, Const):
         return literal(e.value, precision)
+    if isinstance(e, Sqrt):
+        return f"SQRT[{_inner(e.a, name, precision)}]"
     return f"[{_chain(e, name, precision)}]"
+
+
+def _inner(e, name, precision: int) -> str:
+    # Inside a function's own brackets an operation needs no second pair.
+    return _chain(e, name, precision) if isinstance(e, Op) else expression(e, name, precision)
 
 
 def _chain(e, name, precision: int) -> str:

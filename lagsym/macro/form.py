@@ -40,7 +40,7 @@ from ..machine import MachineSettings
 from .model import Assign, Const, Var, add, const, mul, sub, var
 from .plan import exact
 
-__all__ = ["FORMS", "RowForm", "row_form", "row_statements", "point_statements"]
+__all__ = ["FORMS", "RowForm", "row_form", "row_statements", "point_statements", "differentiation_matrix"]
 
 FORMS = ("horner", "lagrange")
 
@@ -170,8 +170,31 @@ def _dot(target: Var, terms, chunk: int = 4) -> list[Assign]:
     return out
 
 
-def row_statements(form: RowForm, r: Var, prefix: str = "g") -> list[Assign]:
-    """Statements run once per row: ``v`` from ``r``, then every ``G_a(v)`` into ``g0 .. g(n-1)``."""
+def differentiation_matrix(nodes) -> list[list[Fraction]]:
+    """``D[i][j] = L_j'(t_i)``: derivative values at the nodes from values at the nodes, exact.
+
+    >>> differentiation_matrix([-1, 0, 1])[1]
+    [Fraction(-1, 2), Fraction(0, 1), Fraction(1, 2)]
+    """
+    t = [Fraction(x) for x in nodes]
+    w = _weights(t)
+    n = len(t)
+    d = [[Fraction(0)] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(n):
+            if i != j:
+                d[i][j] = w[j] / w[i] / (t[i] - t[j])
+        d[i][i] = -sum(d[i][j] for j in range(n) if j != i)
+    return d
+
+
+def row_statements(form: RowForm, r: Var, prefix: str = "g", slopes: bool = False) -> list[Assign]:
+    """Statements run once per row: ``v`` from ``r``, then every ``G_a(v)`` into ``g0 .. g(n-1)``.
+
+    With ``slopes`` also what the partial derivatives need: ``dG_a/dv`` into
+    ``gv0 ..`` and, for the Lagrange form, the ``u``-derivative values at the
+    nodes into ``gu0 ..``.
+    """
     v = var("v")
     out = [Assign(v, mul(sub(r, const(form.rc)), const(form.rk)))]
     if form.kind == "lagrange":
@@ -179,22 +202,47 @@ def row_statements(form: RowForm, r: Var, prefix: str = "g") -> list[Assign]:
         for i, row in enumerate(form.heights):
             terms = [(var(f"l{k}"), const(abs(h)), h < 0) for k, h in enumerate(row) if h]
             out += _dot(var(f"{prefix}{i}"), terms)
+        if slopes:
+            dv = differentiation_matrix(form.r_nodes)
+            for i, row in enumerate(form.heights):
+                slope = [sum(dv[k][q] * row[q] for q in range(len(row))) for k in range(len(row))]
+                out += _dot(var(f"{prefix}v{i}"), [(var(f"l{k}"), const(abs(h)), h < 0) for k, h in enumerate(slope) if h])
+            du = differentiation_matrix(form.p_nodes)
+            for i, drow in enumerate(du):
+                out += _dot(var(f"{prefix}u{i}"),
+                            [(const(abs(c)), var(f"{prefix}{j}"), c < 0) for j, c in enumerate(drow) if c])
         return out
     for a, row in enumerate(form.coefficients):
         out += _horner(var(f"{prefix}{a}"), [const(c) for c in row], v)
+    if slopes:
+        for a, row in enumerate(form.coefficients):
+            out += _horner(var(f"{prefix}v{a}"), [const(b * c) for b, c in enumerate(row)][1:] or [const(0)], v)
     return out
 
 
-def point_statements(form: RowForm, p: Var, z: Var, prefix: str = "g") -> list[Assign]:
-    """Statements run once per point: ``u`` from ``p``, then ``z = ZO + sum_a u**a * g_a``."""
+def point_statements(form: RowForm, p: Var, z: Var, prefix: str = "g", slopes: bool = False) -> list[Assign]:
+    """Statements run once per point: ``u`` from ``p``, then ``z = ZO + sum_a u**a * g_a``.
+
+    With ``slopes`` also the exact partial derivatives in program units:
+    ``zp = dZ/dP`` and ``zr = dZ/dR``.
+    """
     u = var("u")
     n = form.shape[0]
     out = [Assign(u, mul(sub(p, const(form.pc)), const(form.pk)))]
     if form.kind == "lagrange":
         out += _basis(u, form.p_nodes, "")
         out += _dot(z, [(var(f"l{i}"), var(f"{prefix}{i}"), False) for i in range(n)])
+        if slopes:
+            out += _dot(var("zp"), [(var(f"l{i}"), var(f"{prefix}u{i}"), False) for i in range(n)])
+            out += _dot(var("zr"), [(var(f"l{i}"), var(f"{prefix}v{i}"), False) for i in range(n)])
     else:
         out += _horner(z, [var(f"{prefix}{a}") for a in range(n)], u)
+        if slopes:
+            out += _horner(var("zp"), [mul(const(a), var(f"{prefix}{a}")) for a in range(1, n)], u)
+            out += _horner(var("zr"), [var(f"{prefix}v{a}") for a in range(n)], u)
+    if slopes:
+        out.append(Assign(var("zp"), mul(var("zp"), const(form.pk))))
+        out.append(Assign(var("zr"), mul(var("zr"), const(form.rk))))
     if form.z0:
         out.append(Assign(z, add(z, const(form.z0))))
     return out

@@ -12,7 +12,7 @@ from __future__ import annotations
 from ..errors import ProgramError
 from ..post.numbers import fixed
 from ._render import literal, number_variables
-from .model import Assign, Clamp, Const, Loop, Move, Op, Var
+from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var
 
 __all__ = ["render", "VARIABLE_RANGES", "DEFAULT_BASE", "MAX_LABEL"]
 
@@ -26,6 +26,8 @@ SCRATCH = 6  # scratch Q parameters for the parts of an expression
 def _reads(e, v: Var) -> bool:
     if isinstance(e, Var):
         return e == v
+    if isinstance(e, Sqrt):
+        return _reads(e.a, v)
     return isinstance(e, Op) and (_reads(e.a, v) or _reads(e.b, v))
 
 
@@ -72,12 +74,19 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
         if isinstance(e, (Var, Const)):
             out.append(f"FN 0: {q(target)} = {operand(e)}")
             return
+        if isinstance(e, Sqrt):
+            arg = e.a
+            if isinstance(arg, (Op, Sqrt)):
+                assign(target, arg, depth)
+                arg = target
+            out.append(f"FN 5: {q(target)} = SQRT {operand(arg)}")
+            return
         a, b = e.a, e.b
-        if isinstance(a, Op):
+        if isinstance(a, (Op, Sqrt)):
             dest = Var(f"h{depth}") if _reads(b, target) else target
             assign(dest, a, depth + 1)
             a = dest
-        if isinstance(b, Op):
+        if isinstance(b, (Op, Sqrt)):
             tmp = Var(f"h{depth + 1}")
             assign(tmp, b, depth + 2)
             b = tmp

@@ -15,7 +15,7 @@ from decimal import ROUND_HALF_EVEN, Context, Decimal
 from fractions import Fraction
 from typing import Union
 
-__all__ = ["Var", "Const", "Op", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
+__all__ = ["Var", "Const", "Op", "Sqrt", "div", "sqrt", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
            "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables"]
 
 
@@ -42,7 +42,14 @@ class Op:
     b: "Expr"
 
 
-Expr = Union[Var, Const, Op]
+@dataclass(frozen=True)
+class Sqrt:
+    """The square root of an expression (``SQRT[..]``, ``FN 5``)."""
+
+    a: "Expr"
+
+
+Expr = Union[Var, Const, Op, Sqrt]
 
 
 @dataclass(frozen=True)
@@ -107,6 +114,16 @@ def mul(a: Expr, b: Expr) -> Op:
     return Op("*", a, b)
 
 
+def div(a: Expr, b: Expr) -> Op:
+    """``a / b``."""
+    return Op("/", a, b)
+
+
+def sqrt(a: Expr) -> Sqrt:
+    """``SQRT[a]``."""
+    return Sqrt(a)
+
+
 def decimal_context(precision: int) -> Context:
     """Decimal arithmetic with ``precision`` significant digits, rounding half to even."""
     return Context(prec=precision, rounding=ROUND_HALF_EVEN, Emin=-999, Emax=999)
@@ -121,6 +138,8 @@ def _eval(e: Expr, env: dict, ctx: Context) -> Decimal:
         return env[e.name]
     if isinstance(e, Const):
         return _constant(e.value, ctx)
+    if isinstance(e, Sqrt):
+        return ctx.sqrt(_eval(e.a, env, ctx))
     a, b = _eval(e.a, env, ctx), _eval(e.b, env, ctx)
     if e.op == "+":
         return ctx.add(a, b)

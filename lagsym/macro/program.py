@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass, field
+from decimal import Decimal
 from fractions import Fraction
 
 import numpy as np
@@ -39,7 +40,7 @@ from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, 
 from .plan import MacroRaster, exact, macro_raster
 
 __all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", "MacroPlan", "MacroProgram",
-           "macro_plan", "macro_program", "predicted_error"]
+           "macro_plan", "macro_program", "predicted_error", "exact_height", "loop_plan"]
 
 MACRO_DIALECTS = ("fanuc", "linuxcnc", "heidenhain")
 PRECISIONS = (8, 15)
@@ -58,19 +59,46 @@ class MacroPlan:
     raster : MacroRaster
         The counted raster, in program units.
     form : RowForm
-        The normalized Horner form the statements evaluate.
-    start : tuple of Fraction
-        The first point (X, Y, Z), exact, for the rapid approach and the plunge.
+        The normalized form the statements evaluate.
+    start : tuple
+        The first programmed point (X, Y, Z), for the rapid approach and the plunge.
+    row_code, point_code : tuple
+        The straight-line statements run once per row (from ``r``) and once per
+        point (from ``p``); :func:`predicted_error` runs them on the PC.
+    outputs : tuple of str
+        The variables moved to, in the order (P, R, Z): along the row, across, height.
+    ball_radius, ball_offset : float
+        For a ball-end cutter, its radius and the distance of its centre from the
+        surface (radius plus stock), in program units; 0 for a point on the surface.
     """
 
     body: tuple
     raster: MacroRaster
     form: RowForm
-    start: tuple[Fraction, Fraction, Fraction]
-    tool: Tool | None = None
+    start: tuple
+    row_code: tuple = ()
+    point_code: tuple = ()
+    outputs: tuple[str, str, str] = ("p", "r", "z")
+    ball_radius: float = 0.0
+    ball_offset: float = 0.0
+
+    def reference(self, p: Fraction, r: Fraction) -> tuple:
+        """The point (P, R, Z) the program should reach at raster position (p, r), computed on the PC.
+
+        Exact rationals for a point on the surface; for a ball-end cutter, floats
+        from the stable evaluation of the exact derivatives.
+        """
+        if not self.ball_radius:
+            return p, r, exact_height(self.form, p, r)
+        from .ballend import offset_points
+
+        pt, rt, zt = offset_points(self.form, self.ball_radius, self.ball_offset,
+                                   np.array([float(p)]), np.array([float(r)]))
+        return float(pt[0]), float(rt[0]), float(zt[0])
 
 
-def _exact_z(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
+def exact_height(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
+    """The height of ``form`` at raster position (p, r), exact."""
     u, v = (p - form.pc) * form.pk, (r - form.rc) * form.rk
     acc = Fraction(0)
     for row in reversed(form.coefficients):
@@ -81,33 +109,49 @@ def _exact_z(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
     return acc + form.z0
 
 
-def macro_plan(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
-               tool: Tool | None = None, form: str = "horner") -> MacroPlan:
-    """The loop plan for ``surface``: counted rows and points and the statements of the height (``form``)."""
-    plan = macro_raster(surface, settings, raster)
-    form = row_form(surface, settings, plan.direction, form)
+def loop_plan(plan: MacroRaster, form: RowForm, row_code, point_code, outputs=("p", "r", "z")) -> tuple:
+    """The counted zig-zag loops around the per-row and per-point statements (see the module docstring)."""
     rows, pts = plan.rows, plan.points
     j, d, i, k, t = var("j"), var("d"), var("i"), var("k"), var("t")
-    r, p, z = var("r"), var("p"), var("z")
+    r, p = var("r"), var("p")
+    mp, mr, mz = (var(n) for n in outputs)
     point_body = [
         Assign(t, sub(const(pts.count), mul(const(2), i))),
         Assign(k, add(i, mul(d, t))),
         Assign(p, add(const(pts.start), mul(k, const(pts.step)))),
         Clamp(p, const(pts.end)),
-        *point_statements(form, p, z),
-        Move(p, r, z) if plan.direction == "x" else Move(r, p, z),
+        *point_code,
+        Move(mp, mr, mz) if plan.direction == "x" else Move(mr, mp, mz),
     ]
     row_body = [
         Assign(r, add(const(rows.start), mul(j, const(rows.step)))),
         Clamp(r, const(rows.end)),
-        *row_statements(form, r),
+        *row_code,
         Loop(i, pts.count, tuple(point_body)),
         Assign(d, sub(const(1), d)),
     ]
-    body = (Assign(d, const(0)), Loop(j, rows.count, tuple(row_body)))
-    z0 = _exact_z(form, pts.start, rows.start)
-    start = (pts.start, rows.start, z0) if plan.direction == "x" else (rows.start, pts.start, z0)
-    return MacroPlan(body=body, raster=plan, form=form, start=start, tool=tool)
+    return (Assign(d, const(0)), Loop(j, rows.count, tuple(row_body)))
+
+
+def macro_plan(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
+               tool: Tool | None = None, form: str = "horner") -> MacroPlan:
+    """The loop plan for ``surface``: counted rows and points and the statements of the height (``form``).
+
+    A ball-end ``tool`` with a diameter gets the normal offset of :mod:`lagsym.macro.ballend`.
+    """
+    if tool is not None and tool.shape == "ball" and tool.diameter_mm > 0:
+        from .ballend import ballend_plan
+
+        return ballend_plan(surface, settings, raster, tool, form)
+    plan = macro_raster(surface, settings, raster)
+    rf = row_form(surface, settings, plan.direction, form)
+    row_code = tuple(row_statements(rf, var("r")))
+    point_code = tuple(point_statements(rf, var("p"), var("z")))
+    z0 = exact_height(rf, plan.points.start, plan.rows.start)
+    p0, r0 = plan.points.start, plan.rows.start
+    start = (p0, r0, z0) if plan.direction == "x" else (r0, p0, z0)
+    return MacroPlan(body=loop_plan(plan, rf, row_code, point_code), raster=plan, form=rf, start=start,
+                     row_code=row_code, point_code=point_code)
 
 
 def _sample(axis, limit: int) -> list[Fraction]:
@@ -116,31 +160,28 @@ def _sample(axis, limit: int) -> list[Fraction]:
 
 
 def predicted_error(plan: MacroPlan, precision: int, rows: int = 25, points: int = 41) -> float:
-    """Largest difference between the control's arithmetic and exact evaluation over a sample of the raster.
+    """Largest difference between the control's arithmetic and the PC's over a sample of the raster.
 
     The row and point statements of ``plan`` are run in decimal arithmetic
     with ``precision`` significant digits, rounding after every operation, at
     up to ``rows`` x ``points`` raster positions (always including the edges),
-    and compared with exact rational evaluation of the same form.  Returns the
-    largest absolute difference in program units.
+    and compared with :meth:`MacroPlan.reference`.  Returns the largest
+    coordinate difference in program units.
     """
     ctx = decimal_context(precision)
-    form = plan.form
-    row_code = row_statements(form, var("r"))
-    point_code = point_statements(form, var("p"), var("z"))
     worst = Fraction(0)
     for r in _sample(plan.raster.rows, rows):
-        env = run(row_code, {"r": _dec(r, ctx)}, ctx)
+        env = run(plan.row_code, {"r": _decimal(r, ctx)}, ctx)
         for p in _sample(plan.raster.points, points):
-            env["p"] = _dec(p, ctx)
-            run(point_code, env, ctx)
-            worst = max(worst, abs(Fraction(env["z"]) - _exact_z(form, Fraction(env["p"]), Fraction(env["r"]))))
+            env["p"] = _decimal(p, ctx)
+            run(plan.point_code, env, ctx)
+            ref = plan.reference(Fraction(env["p"]), Fraction(env["r"]))
+            for name, want in zip(plan.outputs, ref):
+                worst = max(worst, abs(Fraction(env[name]) - Fraction(want)))
     return float(worst)
 
 
-def _dec(v: Fraction, ctx):
-    from decimal import Decimal
-
+def _decimal(v: Fraction, ctx) -> Decimal:
     return ctx.divide(Decimal(v.numerator), Decimal(v.denominator))
 
 
@@ -210,12 +251,7 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
     if precision not in PRECISIONS:
         raise ProgramError(f"precision {precision} is not one of {', '.join(map(str, PRECISIONS))} significant digits")
     form = DEFAULT_FORM[precision] if form is None else choice(form, FORMS, "form")
-    if tool is not None and tool.shape == "ball" and tool.diameter_mm > 0:
-        from .ballend import ballend_plan
-
-        plan = ballend_plan(surface, settings, raster, tool, form)
-    else:
-        plan = macro_plan(surface, settings, raster, tool, form)
+    plan = macro_plan(surface, settings, raster, tool, form)
     err = predicted_error(plan, precision) / settings.unit_factor
     if err > tolerance_mm:
         raise ProgramError(
