@@ -9,6 +9,7 @@ constant.  It returns the moves the control would make, or raises
 
 * unbalanced ``WHILE .. DOm`` / ``ENDm`` or ``o.. while`` / ``o.. endwhile``, ``DO`` beyond 3 levels;
 * ``[ ]`` nested deeper than 5 (Fanuc alarm 118);
+* a constant with more digits than the control reads (Fanuc alarm 003);
 * a constant on an axis word without a decimal point (a Fanuc reads ``X12`` as
   0.012 mm; lagsym refuses it rather than guess);
 * a variable outside the range the dialect allows;
@@ -35,7 +36,7 @@ __all__ = ["ControlAlarm", "SimMove", "Simulation", "simulate", "detect_dialect"
 SIM_DIALECTS = ("fanuc", "linuxcnc", "heidenhain")
 VARIABLE_RANGES = {
     "fanuc": ((1, 33), (100, 199), (500, 999)),
-    "linuxcnc": ((1, 5399),),
+    "linuxcnc": ((1, 5602),),
     "heidenhain": ((0, 99),),
 }
 MAX_BLOCK = {"fanuc": 128, "linuxcnc": 255, "heidenhain": 128}
@@ -292,6 +293,7 @@ class _Machine:
         self.dialect, self.precision, self.ranges = dialect, precision, ranges
         self.ctx = Context(prec=precision, Emin=-99, Emax=99)
         self.vars: dict[int, Decimal] = {}
+        self.constants: dict[str, Decimal] = {}
         self.names: dict[str, Decimal] = {}
         self.pos = [Decimal(0)] * 3
         self.motion = "G0"
@@ -300,7 +302,15 @@ class _Machine:
         self.moves: list[SimMove] = []
 
     def const(self, text: str) -> Decimal:
-        return self.ctx.create_decimal(text)
+        value = self.constants.get(text)
+        if value is None:
+            if self.dialect == "fanuc":
+                whole, _, frac = text.lstrip("+-").partition(".")
+                digits = len(whole.lstrip("0")) + len(frac)
+                if digits > self.precision:
+                    raise _Syntax("003", f"{text} has {digits} digits, more than the {self.precision} the control reads")
+            value = self.constants[text] = self.ctx.create_decimal(text)
+        return value
 
     def check(self, n: int) -> int:
         if not any(lo <= n <= hi for lo, hi in self.ranges):
@@ -679,7 +689,7 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         Significant digits of every stored value and every operation's result (8 or 15).
     variable_ranges : tuple of (int, int), optional
         Variable numbers the program may use; by default the dialect's (Fanuc
-        #1-#33, #100-#199, #500-#999; LinuxCNC #1-#5399; Heidenhain Q0-Q99).
+        #1-#33, #100-#199, #500-#999; LinuxCNC #1-#5602; Heidenhain Q0-Q99).
     max_blocks : int
         Blocks executed before the run is stopped as a runaway loop.
 

@@ -33,7 +33,7 @@ def test_eight_digits_round_every_result():
 
 
 def test_constants_are_rounded_on_reading():
-    assert xs("G1 X1.23456789012 Y0. Z0. F1.\n", precision=8) == [1.2345679]
+    assert xs("G1 X1.23456789012 Y0 Z0 F1\n", "linuxcnc", precision=8) == [1.2345679]
 
 
 @pytest.mark.parametrize("expr, value", [
@@ -145,6 +145,7 @@ def test_moves_csv():
     ("GOTO 50\n", "128"),
     ("#1=1. (" + "X" * 140 + ")\n", "block"),
     ("N1 GOTO 1\n", "runaway"),
+    ("#1=0.000123456\n", "003"),                                         # nine digits on an 8-digit control
 ])
 def test_fanuc_alarms(text, alarm):
     with pytest.raises(ControlAlarm) as e:

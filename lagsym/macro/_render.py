@@ -5,8 +5,8 @@ from __future__ import annotations
 from fractions import Fraction
 
 from ..errors import ProgramError
-from ..post.numbers import constant
-from .model import Const, Op, Sqrt, Var, variables
+from ..post.numbers import fixed
+from .model import Const, Op, Sqrt, Var, variables, written
 
 __all__ = ["number_variables", "expression", "literal"]
 
@@ -23,8 +23,9 @@ def number_variables(body, base: int, ranges: tuple[tuple[int, int], ...], lette
 
 
 def literal(value: Fraction, precision: int) -> str:
-    """A constant with ``precision`` significant digits, decimal point, no exponent."""
-    return constant(value, precision)
+    """A constant with at most ``precision`` digits (see :func:`.model.written`), decimal point, no exponent."""
+    d = written(Fraction(value), precision)
+    return fixed(d, max(-d.as_tuple().exponent, 0), trim=True)
 
 
 def expression(e, name, precision: int) -> str:

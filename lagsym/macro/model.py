@@ -11,12 +11,12 @@ predicts a program's arithmetic error before it is written.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from decimal import ROUND_HALF_EVEN, Context, Decimal
+from decimal import ROUND_HALF_EVEN, Context, Decimal, localcontext
 from fractions import Fraction
 from typing import Union
 
 __all__ = ["Var", "Const", "Op", "Sqrt", "div", "sqrt", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
-           "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables"]
+           "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables", "written"]
 
 
 @dataclass(frozen=True)
@@ -129,8 +129,28 @@ def decimal_context(precision: int) -> Context:
     return Context(prec=precision, rounding=ROUND_HALF_EVEN, Emin=-999, Emax=999)
 
 
+def written(value: Fraction, digits: int) -> Decimal:
+    """``value`` as a program writes it: at most ``digits`` digits, a lone leading zero not counted.
+
+    Controls limit the digits of a constant (a Fanuc 16/18 reads at most 8),
+    so a small constant keeps fewer significant digits: 1/3 is 0.33333333,
+    1/3000 is 0.00033333.
+
+    >>> written(Fraction(1, 3), 8), written(Fraction(1, 3000), 8), written(Fraction(-400, 3), 8)
+    (Decimal('0.33333333'), Decimal('0.00033333'), Decimal('-133.33333'))
+    """
+    if value == 0:
+        return Decimal(0)
+    with localcontext() as ctx:
+        ctx.prec = 80
+        d = Decimal(value.numerator) / Decimal(value.denominator)
+        integer_digits = max(d.adjusted() + 1, 0)
+        decimals = max(digits - integer_digits, 0)
+        return d.quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_EVEN)
+
+
 def _constant(value: Fraction, ctx: Context) -> Decimal:
-    return ctx.divide(Decimal(value.numerator), Decimal(value.denominator))
+    return ctx.plus(written(value, ctx.prec))
 
 
 def _eval(e: Expr, env: dict, ctx: Context) -> Decimal:
