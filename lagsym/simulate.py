@@ -451,7 +451,7 @@ def _word_value(letter: str, text: str, dialect: str):
         raise _Syntax("114", f"address {letter} without a value")
     if re.fullmatch(r"[-+]?(\d+\.?\d*|\.\d+)", t):
         if letter in _AXIS_DECIMAL and "." not in t and dialect == "fanuc":
-            raise _Syntax("007", f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
+            raise _Syntax("decimal-point", f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
         return lambda m, v=t: m.const(v)
     return _expression(t)
 

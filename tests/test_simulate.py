@@ -137,7 +137,7 @@ def test_moves_csv():
     ("WHILE [1. LT 2.] DO4\nEND4\n", "126"),                             # loop number beyond 3
     ("#1=[[[[[[1.]]]]]]\n", "118"),                                      # six bracket levels
     ("#1=[1.+2.\n", "118"),                                              # unbalanced
-    ("G1 X12 Y0. Z0. F100.\n", "007"),                                   # no decimal point on an axis word
+    ("G1 X12 Y0. Z0. F100.\n", "decimal-point"),                                 # no decimal point on an axis word
     ("#200=1.\n", "115"),                                                # outside #1-#33, #100-#199, #500-#999
     ("#1=#1000\n", "115"),
     ("#1=[1./0.]\n", "112"),

@@ -10,11 +10,12 @@ few per cent of a plain one.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ProgramStats", "point_list_size", "transfer_seconds", "program_stats", "BITS_PER_CHAR_7E2"]
+__all__ = ["ProgramStats", "point_list_size", "transfer_seconds", "program_stats", "frame_bytes", "BITS_PER_CHAR_7E2"]
 
 BITS_PER_CHAR_7E2 = 11  # start bit, 7 data bits, even parity, 2 stop bits
 
@@ -61,8 +62,8 @@ class ProgramStats:
     def text(self) -> str:
         """The comparison as a few lines of text."""
         ratio = self.point_list_bytes / self.macro_bytes
-        return (f"raster points:     {self.points}\n"
-                f"macro program:     {self.macro_bytes} bytes, {self.macro_seconds:.1f} s at 9600 baud 7E2\n"
+        return (f"raster points:      {self.points}\n"
+                f"macro program:      {self.macro_bytes} bytes, {self.macro_seconds:.1f} s at 9600 baud 7E2\n"
                 f"point-list program: {self.point_list_bytes} bytes, {_duration(self.point_list_seconds)} at 9600 baud 7E2 "
                 f"(estimate)\n"
                 f"the point list is {ratio:.1f} times larger")
@@ -74,15 +75,25 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 60:.1f} min" if seconds < 7200 else f"{seconds / 3600:.2f} h"
 
 
-def program_stats(program, points: np.ndarray, settings) -> ProgramStats:
-    """Compare ``program`` (a MacroProgram) with the point list over ``points`` (the planned (N, 3) points)."""
-    text = program.text
-    # The point list keeps the macro's preamble and postamble: everything outside the loops.
-    eol = settings.eol
+_MACRO_LINE = re.compile(r"#|\bFN\b|\bLBL\b|\bWHILE\b|\bEND\d|\bendwhile\b|\bendif\b|^\s*o\d", re.I)
+
+
+def frame_bytes(text: str, eol: str) -> int:
+    """Bytes of a program outside its macro part: the lines before the first and after the last macro statement."""
     lines = text.split(eol)
-    frame = sum(len(line) + len(eol) for line in lines
-                if line.startswith(("%", "O", "(", "G", "T", "S", "M", "F", "0", "1", "BEGIN", "END"))
-                and not line.startswith("G1 X#") and "#" not in line and "Q" not in line)
-    plist = point_list_size(points, settings.digits, eol, overhead=frame)
+    marks = [n for n, line in enumerate(lines) if _MACRO_LINE.search(line)]
+    if not marks:
+        return len(text)
+    keep = lines[:marks[0]] + lines[marks[-1] + 1:]
+    return sum(len(line) + len(eol) for line in keep if line)
+
+
+def program_stats(program, points: np.ndarray, settings) -> ProgramStats:
+    """Compare ``program`` (a MacroProgram) with the point list over ``points`` (the planned (N, 3) points).
+
+    The point list keeps the macro's preamble and postamble (:func:`frame_bytes`)
+    and has one block per point (:func:`point_list_size`).
+    """
+    plist = point_list_size(points, settings.digits, settings.eol, overhead=frame_bytes(program.text, settings.eol))
     return ProgramStats(points=len(points), macro_bytes=program.size, point_list_bytes=plist,
                         macro_seconds=transfer_seconds(program.size), point_list_seconds=transfer_seconds(plist))
