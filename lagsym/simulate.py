@@ -308,7 +308,8 @@ class _Machine:
                 whole, _, frac = text.lstrip("+-").partition(".")
                 digits = len(whole.lstrip("0")) + len(frac)
                 if digits > self.precision:
-                    raise _Syntax("003", f"{text} has {digits} digits, more than the {self.precision} the control reads")
+                    raise _Syntax("003", f"{text} has {digits} digits, "
+                                         f"more than the {self.precision} the control reads")
             value = self.constants[text] = self.ctx.create_decimal(text)
         return value
 
@@ -319,8 +320,8 @@ class _Machine:
         return n
 
     def index(self, value: Decimal) -> int:
-        n = int(value.to_integral_value(rounding=ROUND_HALF_UP))
-        return n
+        """A computed variable or sequence number, rounded to the nearest integer as the control does."""
+        return int(value.to_integral_value(rounding=ROUND_HALF_UP))
 
     def get(self, n: int) -> Decimal:
         if n == 0 and self.dialect == "fanuc":
@@ -451,7 +452,8 @@ def _word_value(letter: str, text: str, dialect: str):
         raise _Syntax("114", f"address {letter} without a value")
     if re.fullmatch(r"[-+]?(\d+\.?\d*|\.\d+)", t):
         if letter in _AXIS_DECIMAL and "." not in t and dialect == "fanuc":
-            raise _Syntax("decimal-point", f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
+            raise _Syntax("decimal-point",
+                          f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
         return lambda m, v=t: m.const(v)
     return _expression(t)
 
@@ -513,7 +515,9 @@ def _words_block(line: int, raw: str, t: str, dialect: str) -> _Block:
 def _linuxcnc_statement(line: int, raw: str, t: str) -> _Block:
     if not t:
         return _Block(line, raw, "nop")
-    m = re.fullmatch(r"[oO]\s*(\d+|<[^>]+>)\s*(while|endwhile|if|elseif|else|endif|do|break|continue)\s*(.*)", t, re.I)
+    m = re.fullmatch(r"[oO]\s*(\d+|<[^>]+>)\s*([a-z]+)\s*(.*)", t, re.I)
+    if m and m.group(2).lower() not in ("while", "endwhile", "if", "elseif", "else", "endif"):
+        raise _Syntax("o-word", f"o-word {m.group(2)!r} is outside what the simulator runs")
     if m:
         label, word, rest = m.group(1).lower(), m.group(2).lower(), m.group(3).strip()
         cond = _expression(rest) if word in ("while", "if", "elseif") else None
@@ -557,7 +561,8 @@ def _heidenhain_statement(line: int, raw: str, t: str) -> _Block:
     if m:
         return _Block(line, raw, "label", None, int(m.group(1)))
     t = re.sub(r"^(FN\s*5\s*:\s*Q\d+\s*=\s*)SQRT\s*", r"\1", t, flags=re.I)
-    m = re.fullmatch(r"FN\s*(\d+)\s*:\s*Q(\d+)\s*=\s*" + _HH_OPERAND + r"(?:\s*([-+*/])\s*" + _HH_OPERAND + r")?", t, re.I)
+    m = re.fullmatch(r"FN\s*(\d+)\s*:\s*Q(\d+)\s*=\s*" + _HH_OPERAND
+                     + r"(?:\s*([-+*/])\s*" + _HH_OPERAND + r")?", t, re.I)
     if m:
         fn, q, a, op, b = int(m.group(1)), int(m.group(2)), m.group(3), m.group(4), m.group(5)
         fa = _hh_operand(a)
@@ -576,7 +581,8 @@ def _heidenhain_statement(line: int, raw: str, t: str) -> _Block:
     m = re.fullmatch(r"FN\s*(9|10|11|12)\s*:\s*IF\s+" + _HH_OPERAND + r"\s+(EQU|NE|GT|LT)\s+" + _HH_OPERAND
                      + r"\s+GOTO\s+LBL\s+(\d+)", t, re.I)
     if m:
-        fn, a, rel, b, lbl = int(m.group(1)), _hh_operand(m.group(2)), m.group(3).upper(), _hh_operand(m.group(4)), int(m.group(5))
+        fn, rel, lbl = int(m.group(1)), m.group(3).upper(), int(m.group(5))
+        a, b = _hh_operand(m.group(2)), _hh_operand(m.group(4))
         want = {9: "EQU", 10: "NE", 11: "GT", 12: "LT"}[fn]
         if rel != want:
             raise _Syntax("114", f"FN {fn} compares with {want}, not {rel}")
@@ -606,7 +612,8 @@ def _compile(text: str, dialect: str) -> list[_Block]:
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     for n, raw in enumerate(lines, start=1):
         if len(raw) > limit:
-            raise ControlAlarm("block", f"block of {len(raw)} characters, more than the {limit} the control reads", n, raw)
+            raise ControlAlarm("block", f"block of {len(raw)} characters, more than the {limit} the control reads",
+                               n, raw)
         t = raw.strip()
         if t == "%" or not t or t.startswith("/"):
             continue
@@ -700,7 +707,8 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
 
     Examples
     --------
-    >>> sim = simulate("#100=0.\\nWHILE [#100 LE 2.] DO1\\nG1 X#100 Y0. Z[#100*#100] F100.\\n#100=[#100+1.]\\nEND1\\nM30")
+    >>> program = "#100=0.\\nWHILE [#100 LE 2.] DO1\\nG1 X#100 Y0. Z[#100*#100] F100.\\n#100=[#100+1.]\\nEND1\\nM30"
+    >>> sim = simulate(program)
     >>> [(m.x, m.z) for m in sim.moves]
     [(0.0, 0.0), (1.0, 1.0), (2.0, 4.0)]
     """
@@ -723,7 +731,8 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         b = blocks[pc]
         executed += 1
         if executed > max_blocks:
-            raise ControlAlarm("runaway", f"more than {max_blocks} blocks executed; a loop that never ends?", b.line, b.text)
+            raise ControlAlarm("runaway", f"more than {max_blocks} blocks executed; a loop that never ends?",
+                               b.line, b.text)
         try:
             nxt = _step(m, blocks, pc, b, labels)
         except _Syntax as e:

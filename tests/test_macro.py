@@ -390,7 +390,8 @@ def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
 
 def test_ball_end_gouge_is_refused_with_a_suggestion():
     s = surface("paper-example-4")
-    with pytest.raises(ToolpathError, match=r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"):
+    expected = r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"
+    with pytest.raises(ToolpathError, match=expected):
         macro_program(s, MachineSettings(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
 
 

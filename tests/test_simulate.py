@@ -207,7 +207,8 @@ def test_simulator_agrees_with_rs274(rs274, tmp_path_factory, exprs):
     if real.returncode != 0 or "error" in real.stdout.lower():
         pytest.skip(f"rs274 refused a generated expression: {real.stdout[-200:]}")  # pragma: no cover
     ours = simulate(body + "M2\n", "linuxcnc", 15).feed_points()
-    fanuc = simulate(body.replace(" = ", "=").replace(" Y0 Z0 F100", " Y0. Z0. F100.") + "M30\n", "fanuc", 15).feed_points()
+    fanuc_text = body.replace(" = ", "=").replace(" Y0 Z0 F100", " Y0. Z0. F100.") + "M30\n"
+    fanuc = simulate(fanuc_text, "fanuc", 15).feed_points()
     ref = feeds(real.stdout)
     assert ref.shape == ours.shape
     # rs274 prints four decimals
@@ -216,9 +217,15 @@ def test_simulator_agrees_with_rs274(rs274, tmp_path_factory, exprs):
 
 
 def test_fix_and_fup_agree_with_rs274_for_linuxcnc(rs274, tmp_path):
-    body = "".join(f"G1 X{f}[{v}] Y0 Z0 F100\n" for f in ("FIX", "FUP", "ROUND") for v in ("-1.5", "1.5", "-2.2", "2.7"))
+    values = ("-1.5", "1.5", "-2.2", "2.7")
+    body = "".join(f"G1 X{f}[{v}] Y0 Z0 F100\n" for f in ("FIX", "FUP", "ROUND") for v in values)
     path = tmp_path / "fix.ngc"
     path.write_text(body + "M2\n")
     ref = feeds(rs274.run(path).stdout)
     ours = simulate(body + "M2\n", "linuxcnc", 15).feed_points()
     np.testing.assert_allclose(ours, ref, atol=1e-9)
+
+
+def test_unsupported_o_words_are_refused_not_skipped():
+    with pytest.raises(ControlAlarm, match="outside what the simulator runs"):
+        simulate("o100 sub\no100 endsub\n", "linuxcnc", 15)

@@ -43,7 +43,8 @@ def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help="control language (default fanuc)")
     p.add_argument("--precision", type=int, choices=PRECISIONS,
-                   help="significant digits of the control's arithmetic (default 8 for fanuc and heidenhain, 15 for linuxcnc)")
+                   help="significant digits of the control's arithmetic "
+                        "(default 8 for fanuc and heidenhain, 15 for linuxcnc)")
     p.add_argument("--form", choices=FORMS,
                    help="horner (shortest) or lagrange (tensor-product basis, most accurate); "
                         "default lagrange at 8 digits, horner at 15")

@@ -78,9 +78,9 @@ def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", u
         pp, rr = (float(np.asarray(p).ravel()[k]) / unit, float(np.asarray(r).ravel()[k]) / unit)
         raise ToolpathError(
             f"{source}: the surface is concave with a radius of curvature of {rc:.3g} mm near "
-            f"({pp:.3f}, {rr:.3f}) mm, below the offset radius {radius / unit:g} mm (ball radius plus stock): an offset along the normal "
-            f"would gouge there; use a ball of diameter at most {2 * rc:.3g} mm, or the point-list "
-            f"toolpath (lagsym toolpath, drop-cutter)")
+            f"({pp:.3f}, {rr:.3f}) mm, below the offset radius {radius / unit:g} mm (ball radius plus stock): "
+            f"an offset along the normal would gouge there; use a ball of diameter at most {2 * rc:.3g} mm, "
+            f"or the point-list toolpath (lagsym toolpath, drop-cutter)")
 
 
 def ballend_plan(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec, tool: Tool,

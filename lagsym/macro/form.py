@@ -206,7 +206,8 @@ def row_statements(form: RowForm, r: Var, prefix: str = "g", slopes: bool = Fals
             dv = differentiation_matrix(form.r_nodes)
             for i, row in enumerate(form.heights):
                 slope = [sum(dv[k][q] * row[q] for q in range(len(row))) for k in range(len(row))]
-                out += _dot(var(f"{prefix}v{i}"), [(var(f"l{k}"), const(abs(h)), h < 0) for k, h in enumerate(slope) if h])
+                terms = [(var(f"l{k}"), const(abs(h)), h < 0) for k, h in enumerate(slope) if h]
+                out += _dot(var(f"{prefix}v{i}"), terms)
             du = differentiation_matrix(form.p_nodes)
             for i, drow in enumerate(du):
                 out += _dot(var(f"{prefix}u{i}"),

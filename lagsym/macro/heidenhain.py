@@ -58,7 +58,8 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
         return _signed(fixed(v, dp))
 
     out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}",
-                      f"; lagsym surface macro, {plan.form.shape[0]}x{plan.form.shape[1]} normalized {plan.form.kind} form",
+                      f"; lagsym surface macro, {plan.form.shape[0]}x{plan.form.shape[1]}, "
+                      f"normalized {plan.form.kind} form",
                       f"; {plan.raster.size} points, rows along {plan.raster.direction}, {precision}-digit arithmetic",
                       f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
                       f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M3"]
@@ -105,7 +106,8 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
             elif isinstance(s, Clamp):
                 n = label()
                 lim = operand(s.limit)
-                out.extend([f"FN 12: IF +{q(s.target)} LT {lim} GOTO LBL {n}", f"FN 0: {q(s.target)} = {lim}", f"LBL {n}"])
+                out.extend([f"FN 12: IF +{q(s.target)} LT {lim} GOTO LBL {n}",
+                            f"FN 0: {q(s.target)} = {lim}", f"LBL {n}"])
             elif isinstance(s, Loop):
                 n = label()
                 c = q(s.counter)

@@ -27,7 +27,8 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
 
     dp = settings.digits
     out = ["%", f"(lagsym surface macro, program {settings.program_number})",
-           f"(surface {plan.form.shape[0]}x{plan.form.shape[1]}, normalized {plan.form.kind} form, {precision}-digit arithmetic)",
+           f"(surface {plan.form.shape[0]}x{plan.form.shape[1]}, normalized {plan.form.kind} form, "
+           f"{precision}-digit arithmetic)",
            f"({plan.raster.size} points, rows along {plan.raster.direction})",
            f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90 G64 P0.001",
            settings.work_offset,
@@ -50,7 +51,8 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
             elif isinstance(s, Clamp):
                 n = next(labels)
                 lim = literal(s.limit.value, precision)
-                out.extend([f"{pad}o{n} if [{name(s.target)} GT {lim}]", f"{pad}  {name(s.target)} = {lim}", f"{pad}o{n} endif"])
+                out.extend([f"{pad}o{n} if [{name(s.target)} GT {lim}]",
+                            f"{pad}  {name(s.target)} = {lim}", f"{pad}o{n} endif"])
             elif isinstance(s, Loop):
                 n = next(labels)
                 c = name(s.counter)

@@ -72,7 +72,8 @@ def _axis(letter: str, lo: Fraction, hi: Fraction, step: Fraction) -> Axis:
         raise ToolpathError(f"{letter} step {float(step)!r} must be positive")
     count = max(math.ceil(length / step), 1)
     if count > 10**6:
-        raise ToolpathError(f"{letter} step {float(step)!r} gives {count} positions over {float(length)!r}; use a larger step")
+        raise ToolpathError(f"{letter} step {float(step)!r} gives {count} positions over {float(length)!r}; "
+                            "use a larger step")
     return Axis(letter=letter, start=lo, end=hi, step=step, count=count)
 
 

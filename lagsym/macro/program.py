@@ -37,7 +37,7 @@ from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool, choice
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
-from .plan import MacroRaster, exact, macro_raster
+from .plan import MacroRaster, macro_raster
 
 __all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", "MacroPlan", "MacroProgram",
            "macro_plan", "macro_program", "predicted_error", "exact_height", "loop_plan"]
@@ -256,9 +256,9 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
     if err > tolerance_mm:
         raise ProgramError(
             f"{surface.grid.source}: a {surface.grid.shape[0]}x{surface.grid.shape[1]} surface evaluated with "
-            f"{precision} significant digits in the {form} form is predicted to be off by {err:.3g} mm, more than the tolerance "
-            f"{tolerance_mm:g} mm; use a control with 15-digit arithmetic (--precision 15), fewer control points, "
-            f"or the point-list toolpath")
+            f"{precision} significant digits in the {form} form is predicted to be off by {err:.3g} mm, "
+            f"more than the tolerance {tolerance_mm:g} mm; use a control with 15-digit arithmetic "
+            f"(--precision 15), the lagrange form, fewer control points, or the point-list toolpath")
     module = importlib.import_module(f"{__package__}.{dialect}")
     text = module.render(plan, settings, precision=precision, variable_base=variable_base)
     return MacroProgram(text=text, dialect=dialect, precision=precision, predicted_error=err, plan=plan)

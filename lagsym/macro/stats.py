@@ -64,8 +64,8 @@ class ProgramStats:
         ratio = self.point_list_bytes / self.macro_bytes
         return (f"raster points:      {self.points}\n"
                 f"macro program:      {self.macro_bytes} bytes, {self.macro_seconds:.1f} s at 9600 baud 7E2\n"
-                f"point-list program: {self.point_list_bytes} bytes, {_duration(self.point_list_seconds)} at 9600 baud 7E2 "
-                f"(estimate)\n"
+                f"point-list program: {self.point_list_bytes} bytes, "
+                f"{_duration(self.point_list_seconds)} at 9600 baud 7E2 (estimate)\n"
                 f"the point list is {ratio:.1f} times larger")
 
 
