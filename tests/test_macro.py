@@ -10,6 +10,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import given, settings as hsettings, strategies as st
 
 from conftest import EXAMPLES
 from lagsym.errors import ProgramError, ToolpathError
@@ -100,6 +101,36 @@ def test_fanuc_and_linuxcnc_programs_agree_with_rs274_and_each_other(rs274, tmp_
         fanuc = simulate(progs["fanuc"].text, "fanuc", 15).feed_points()
         np.testing.assert_allclose(ours, real, atol=6e-5, rtol=0)
         np.testing.assert_allclose(fanuc, ours, atol=1e-9, rtol=0)
+
+
+@st.composite
+def grids(draw):
+    n, m = draw(st.integers(2, 6)), draw(st.integers(2, 6))
+    gaps = st.integers(1, 40).map(lambda v: Fraction(v, 4))
+    xs = np.cumsum([Fraction(draw(st.integers(-20, 20)))] + draw(st.lists(gaps, min_size=n - 1, max_size=n - 1)))
+    ys = np.cumsum([Fraction(draw(st.integers(-20, 20)))] + draw(st.lists(gaps, min_size=m - 1, max_size=m - 1)))
+    z = [[Fraction(draw(st.integers(-2000, 2000)), 100) for _ in range(m)] for _ in range(n)]
+    return lagrange_surface(grid_from_table(list(xs), list(ys), z))
+
+
+@hsettings(max_examples=12, deadline=None)
+@given(s=grids(), scale=st.sampled_from([0.5, 1.0, 2.5]), direction=st.sampled_from(["x", "y"]),
+       dialect=st.sampled_from(["linuxcnc", "fanuc"]))
+def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, tmp_path_factory, s, scale,
+                                                                         direction, dialect):
+    x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
+    raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
+    settings = MachineSettings(dialect=dialect, scale=scale, origin_mm=(3.0, -4.0, 1.5))
+    program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
+    if dialect == "linuxcnc":
+        path = tmp_path_factory.mktemp("any") / "any.ngc"
+        path.write_text(program.text)
+        result = rs274.run(path)
+        assert result.returncode == 0, result.stdout[-300:]
+        got = feeds(result.stdout)
+    else:
+        got = simulate(program.text, "fanuc", 15).feed_points()
+    np.testing.assert_allclose(got[1:], planned_points(s, settings, raster, FLAT), atol=1e-3, rtol=0)
 
 
 # ---------------------------------------------------------------- accuracy on the control
