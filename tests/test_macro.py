@@ -167,9 +167,16 @@ def test_the_expanded_horner_form_fails_where_the_basis_form_holds():
 
 
 def test_a_program_that_misses_the_tolerance_is_refused_with_the_prediction():
-    s = rough_grid(12, seed=12)
+    s = rough_grid(9, seed=9)
     with pytest.raises(ProgramError, match=r"predicted to be off by [0-9.e-]+ mm, more than the tolerance 0.001 mm"):
         macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner")
+
+
+def test_a_constant_the_control_cannot_read_is_refused():
+    s = rough_grid(12, seed=12)
+    with pytest.raises(ProgramError, match=r"has 9 digits, more than the 8 the control reads"):
+        macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner",
+                      tolerance_mm=100.0)
 
 
 # ---------------------------------------------------------------- size
@@ -351,7 +358,7 @@ def test_cli_simulate_reports_an_alarm(run_cli, tmp_path):
 
 def test_cli_macro_refuses_with_exit_2(run_cli, tmp_path):
     rng = random.Random(3)
-    pts = [[i * 5, k * 5, rng.randint(0, 5000) / 100] for i in range(12) for k in range(12)]
+    pts = [[i * 5, k * 5, rng.randint(0, 5000) / 100] for i in range(9) for k in range(9)]
     f = tmp_path / "big.json"
     f.write_text(json.dumps({"points": pts}))
     status, out, err = run_cli("macro", f, "--dialect", "fanuc", "--form", "horner", "--tool-diameter", 0,

@@ -15,6 +15,8 @@ from decimal import ROUND_HALF_EVEN, Context, Decimal, localcontext
 from fractions import Fraction
 from typing import Union
 
+from ..errors import ProgramError
+
 __all__ = ["Var", "Const", "Op", "Sqrt", "div", "sqrt", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
            "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables", "written"]
 
@@ -145,6 +147,9 @@ def written(value: Fraction, digits: int) -> Decimal:
         ctx.prec = 80
         d = Decimal(value.numerator) / Decimal(value.denominator)
         integer_digits = max(d.adjusted() + 1, 0)
+        if integer_digits > digits:
+            raise ProgramError(f"the constant {d:.0f} has {integer_digits} digits, more than the {digits} the "
+                               f"control reads; use 15-digit arithmetic (--precision 15) or fewer control points")
         decimals = max(digits - integer_digits, 0)
         return d.quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_EVEN)
 
