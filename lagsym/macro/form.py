@@ -124,8 +124,10 @@ def _horner(target: Var, coeffs, x: Var) -> list[Assign]:
     coeffs = list(coeffs)
     while len(coeffs) > 1 and isinstance(coeffs[-1], Const) and coeffs[-1].value == 0:
         coeffs.pop()  # an exact zero leading coefficient costs a statement and changes nothing
-    out = [Assign(target, coeffs[-1])]
-    for c in reversed(coeffs[:-1]):
+    if len(coeffs) == 1:
+        return [Assign(target, coeffs[0])]
+    out = [Assign(target, add(mul(coeffs[-1], x), coeffs[-2]))]
+    for c in reversed(coeffs[:-2]):
         out.append(Assign(target, add(mul(target, x), c)))
     return out
 
