@@ -25,8 +25,8 @@ a micrometre.  The *Lagrange* form evaluates the tensor-product basis itself,
     L_i(U) = W_i * prod_{j != i} (U - U_j),
 
 whose constants are the scaled heights ``H`` and the weights ``W``; its error
-is bounded by the Lebesgue constants, some 70 times below Horner's at 7x7 with
-8 digits, for about a third more program text.
+is bounded by the Lebesgue constants, some 6 times below Horner's at 7x7 with
+8 digits (100 times at 10x10), for a little more program text.
 """
 
 from __future__ import annotations
