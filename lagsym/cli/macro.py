@@ -24,10 +24,11 @@ The arithmetic of the control (--precision: 8 significant digits for a Fanuc
 predicted to be off by more than --tolerance is refused.
 
 examples:
-  lagsym macro examples/paper-example-4.json --scale 20 --tool-diameter 6 --stepover 0.5 --step 0.2 \\
+  lagsym macro examples/paper-example-4.json --scale 20 --tool-diameter 4 --stepover 0.5 --step 0.2 \\
       --dialect fanuc --program 1000 -o O1000.nc --stats
-  lagsym macro examples/paper-example-1.json --dialect linuxcnc --tool-diameter 0 -o surface.ngc
-  lagsym macro examples/paper-example-2.json --dialect heidenhain --variable-base 20 -o 1000.h"""
+  lagsym macro examples/paper-example-1.json --dialect linuxcnc --tool-diameter 0 --scale 10 -o surface.ngc
+  lagsym macro examples/paper-example-2.json --dialect heidenhain --scale 10 --tool-diameter 2 \\
+      --variable-base 20 -o 1000.h"""
 
 
 def _triple(text: str) -> tuple[float, float, float]:
