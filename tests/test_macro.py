@@ -394,6 +394,24 @@ def test_ball_end_macro_through_the_simulator(dialect, form):
     np.testing.assert_allclose(got, planned_points(s, settings, raster, BALL), atol=1e-3, rtol=0)
 
 
+@pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
+def test_ball_end_7x7_program_raises_no_alarm(dialect):
+    """The largest program lagsym writes at 8 digits keeps every control limit (brackets, blocks, digits, variables)."""
+    nodes = [Fraction(10 * i) for i in range(7)]
+    z = [[Fraction(round(300 * np.sin(i / 2) + 200 * np.cos(k / 3)), 100) for k in range(7)] for i in range(7)]
+    s = lagrange_surface(grid_from_table(nodes, nodes, z))
+    settings = MachineSettings(dialect=dialect)
+    raster = RasterSpec("y", 5.0, 3.0)
+    program = macro_program(s, settings, raster, Tool("ball", 6.0))
+    got = simulate(program.text, dialect, 8).feed_points()[1:]
+    np.testing.assert_allclose(got, planned_points(s, settings, raster, Tool("ball", 6.0)), atol=1e-3, rtol=0)
+
+
+def test_cli_simulate_missing_file(run_cli, tmp_path):
+    status, out, err = run_cli("simulate", tmp_path / "nope.nc")
+    assert status == 2 and out == "" and err.strip().endswith("nope.nc: no such file")
+
+
 def test_ball_end_tip_is_one_radius_off_the_surface():
     s = surface("paper-example-4")
     settings = MachineSettings(scale=20.0)

@@ -40,6 +40,8 @@ def run(args, out, err) -> int:
     path = Path(args.program)
     try:
         raw = path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{args.program}: no such file") from None
     except OSError as e:
         raise InputError(f"{args.program}: {e.strerror or e}") from None
     try:
