@@ -6,11 +6,13 @@ the control from a well-conditioned form of the exact polynomial, so its size
 does not depend on the step.  One module per dialect (:mod:`.fanuc`,
 :mod:`.linuxcnc`, :mod:`.heidenhain`) renders the shared loop plan
 (:mod:`.program`); :mod:`.form` holds the normalized Horner form, :mod:`.plan`
-the raster and the points a program should produce, :mod:`.stats` the size
-comparison with a point list.
+the raster and the points a program should produce, :mod:`.ballend` the
+normal offset and gouge check of a ball-end cutter, :mod:`.stats` the size
+comparison with a point list.  :mod:`lagsym.simulate` dry-runs the result.
 """
 
-from .form import RowForm, row_form
+from .ballend import check_gouge, tip_points
+from .form import FORMS, RowForm, row_form
 from .plan import MacroRaster, macro_raster, planned_points, raster_positions
 from .program import (
     DEFAULT_PRECISION,
@@ -26,6 +28,7 @@ from .stats import ProgramStats, point_list_size, program_stats, transfer_second
 
 __all__ = [
     "DEFAULT_PRECISION",
+    "FORMS",
     "MACRO_DIALECTS",
     "PRECISIONS",
     "MacroPlan",
@@ -33,6 +36,7 @@ __all__ = [
     "MacroRaster",
     "ProgramStats",
     "RowForm",
+    "check_gouge",
     "macro_plan",
     "macro_program",
     "macro_raster",
@@ -42,5 +46,6 @@ __all__ = [
     "program_stats",
     "raster_positions",
     "row_form",
+    "tip_points",
     "transfer_seconds",
 ]

@@ -36,7 +36,7 @@ from fractions import Fraction
 
 from ..grid import grid_from_table
 from ..lagrange import LagrangeSurface, lagrange_surface
-from ..machine import MachineSettings
+from ..machine import MachineSettings, choice
 from .model import Assign, Const, Var, add, const, mul, sub, var
 from .plan import exact
 
@@ -111,8 +111,7 @@ def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str
     c = lagrange_surface(grid_from_table(un, vn, zn)).coefficients
     z0 = oz + exact(settings.stock_to_leave_mm) * uf
     zt = tuple(tuple(row) for row in zn)
-    if kind not in FORMS:
-        raise ValueError(f"form {kind!r} is not one of {', '.join(FORMS)}")
+    choice(kind, FORMS, "form")
     if direction == "x":
         return RowForm("x", c, xc, xk, yc, yk, z0, kind, un, vn, zt)
     ct = tuple(tuple(c[a][b] for a in range(len(c))) for b in range(len(c[0])))
