@@ -36,6 +36,12 @@ from test_simulate import feeds
 FLAT = Tool("flat", 0.0)
 
 
+def machine(**settings) -> MachineSettings:
+    """Machine settings with a safe height above every test surface."""
+    settings.setdefault("safe_z_mm", 1000.0)
+    return MachineSettings(**settings)
+
+
 def surface(name: str):
     return lagrange_surface(read_points(EXAMPLES / f"{name}.json"))
 
@@ -58,10 +64,10 @@ CASES = [
 
 # ---------------------------------------------------------------- the proof
 
-@pytest.mark.parametrize("name, machine, raster", CASES, ids=[c[0] for c in CASES])
-def test_linuxcnc_macro_through_rs274_equals_the_pc_raster(rs274, tmp_path, name, machine, raster):
+@pytest.mark.parametrize("name, options, raster", CASES, ids=[c[0] for c in CASES])
+def test_linuxcnc_macro_through_rs274_equals_the_pc_raster(rs274, tmp_path, name, options, raster):
     s = surface(name)
-    settings = MachineSettings(dialect="linuxcnc", **machine)
+    settings = machine(dialect="linuxcnc", **options)
     program = macro_program(s, settings, raster, FLAT)
     path = tmp_path / "macro.ngc"
     path.write_text(program.text)
@@ -75,10 +81,10 @@ def test_linuxcnc_macro_through_rs274_equals_the_pc_raster(rs274, tmp_path, name
 
 
 @pytest.mark.parametrize("dialect", ["fanuc", "heidenhain", "linuxcnc"])
-@pytest.mark.parametrize("name, machine, raster", CASES, ids=[c[0] for c in CASES])
-def test_every_dialect_through_the_simulator_equals_the_pc_raster(dialect, name, machine, raster):
+@pytest.mark.parametrize("name, options, raster", CASES, ids=[c[0] for c in CASES])
+def test_every_dialect_through_the_simulator_equals_the_pc_raster(dialect, name, options, raster):
     s = surface(name)
-    settings = MachineSettings(dialect=dialect, **machine)
+    settings = machine(dialect=dialect, **options)
     program = macro_program(s, settings, raster, FLAT)
     sim = simulate(program.text, dialect, program.precision)
     want = planned_points(s, settings, raster, FLAT)
@@ -92,7 +98,7 @@ def test_fanuc_and_linuxcnc_programs_agree_with_rs274_and_each_other(rs274, tmp_
     for n, direction in ((3, "x"), (5, "y"), (6, "x")):
         s = rough_grid(n, seed=n, zmax=20)
         raster = RasterSpec(direction, 6.0, 2.5)
-        progs = {d: macro_program(s, MachineSettings(dialect=d), raster, FLAT, precision=15)
+        progs = {d: macro_program(s, machine(dialect=d), raster, FLAT, precision=15)
                  for d in ("fanuc", "linuxcnc")}
         path = tmp_path / f"m{n}.ngc"
         path.write_text(progs["linuxcnc"].text)
@@ -120,7 +126,7 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
                                                                          direction, dialect):
     x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
     raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
-    settings = MachineSettings(dialect=dialect, scale=scale, origin_mm=(3.0, -4.0, 1.5))
+    settings = machine(dialect=dialect, scale=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=1e6)
     program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
     if dialect == "linuxcnc":
         path = tmp_path_factory.mktemp("any") / "any.ngc"
@@ -137,19 +143,19 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
 
 @pytest.mark.parametrize("n", [3, 4, 5, 6, 7])
 def test_eight_digits_stay_within_a_micrometre_up_to_7x7(n):
-    plan = macro_plan(rough_grid(n, seed=n), MachineSettings(), RasterSpec("x", 1.0, 1.0), FLAT, form="lagrange")
+    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="lagrange")
     assert predicted_error(plan, 8, rows=7, points=11) <= 1e-3
 
 
 @pytest.mark.parametrize("n", [8, 10, 12])
 def test_fifteen_digits_stay_within_a_micrometre_up_to_12x12(n):
-    plan = macro_plan(rough_grid(n, seed=n), MachineSettings(), RasterSpec("x", 1.0, 1.0), FLAT, form="horner")
+    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="horner")
     assert predicted_error(plan, 15, rows=5, points=9) <= 1e-3
 
 
 def test_simulated_error_at_eight_digits_matches_the_prediction():
     s = rough_grid(7, seed=7)
-    settings = MachineSettings(dialect="fanuc")
+    settings = machine(dialect="fanuc")
     raster = RasterSpec("x", 6.0, 3.0)
     program = macro_program(s, settings, raster, FLAT)
     got = simulate(program.text, "fanuc", 8).feed_points()[1:]
@@ -161,21 +167,21 @@ def test_simulated_error_at_eight_digits_matches_the_prediction():
 def test_the_expanded_horner_form_fails_where_the_basis_form_holds():
     s = rough_grid(8, seed=8)
     raster = RasterSpec("x", 1.0, 1.0)
-    horner = predicted_error(macro_plan(s, MachineSettings(), raster, FLAT, "horner"), 8, 7, 11)
-    basis = predicted_error(macro_plan(s, MachineSettings(), raster, FLAT, "lagrange"), 8, 7, 11)
+    horner = predicted_error(macro_plan(s, machine(), raster, FLAT, "horner"), 8, 7, 11)
+    basis = predicted_error(macro_plan(s, machine(), raster, FLAT, "lagrange"), 8, 7, 11)
     assert horner > 1e-3 > basis
 
 
 def test_a_program_that_misses_the_tolerance_is_refused_with_the_prediction():
     s = rough_grid(9, seed=9)
     with pytest.raises(ProgramError, match=r"predicted to be off by [0-9.e-]+ mm, more than the tolerance 0.001 mm"):
-        macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner")
+        macro_program(s, machine(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner")
 
 
 def test_a_constant_the_control_cannot_read_is_refused():
     s = rough_grid(12, seed=12)
     with pytest.raises(ProgramError, match=r"has 9 digits, more than the 8 the control reads"):
-        macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner",
+        macro_program(s, machine(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner",
                       tolerance_mm=100.0)
 
 
@@ -185,7 +191,7 @@ def test_a_constant_the_control_cannot_read_is_refused():
 @pytest.mark.parametrize("n", [3, 5, 7])
 def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
     s = rough_grid(n, seed=n, zmax=10)
-    sizes = [macro_program(s, MachineSettings(dialect=dialect), RasterSpec("x", step, step / 2), FLAT).size
+    sizes = [macro_program(s, machine(dialect=dialect), RasterSpec("x", step, step / 2), FLAT).size
              for step in (5.0, 0.5, 0.01)]
     assert max(sizes) < 4096
     assert max(sizes) - min(sizes) <= 40  # only the loop counts and steps change
@@ -193,7 +199,7 @@ def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
 
 def test_stats_compare_with_the_point_list():
     s = surface("paper-example-4")
-    settings = MachineSettings(dialect="fanuc", scale=20.0)
+    settings = machine(dialect="fanuc", scale=20.0)
     raster = RasterSpec("x", 0.5, 0.2)
     program = macro_program(s, settings, raster, FLAT)
     pts = planned_points(s, settings, raster, FLAT)
@@ -218,7 +224,7 @@ def test_point_list_size_counts_what_fixed_would_write():
 
 def test_raster_is_counted_and_clamped_to_the_box():
     s = surface("paper-example-1")  # x 1..5, y 2..4
-    plan = macro_raster(s, MachineSettings(scale=10.0), RasterSpec("x", 7.0, 3.0))
+    plan = macro_raster(s, machine(scale=10.0), RasterSpec("x", 7.0, 3.0))
     assert (plan.points.count, plan.rows.count) == (14, 3)  # 40 mm / 3 -> 14 steps, 20 mm / 7 -> 3
     assert plan.points.clamped and plan.rows.clamped
     x, y = raster_positions(plan)
@@ -228,7 +234,7 @@ def test_raster_is_counted_and_clamped_to_the_box():
 
 def test_no_drift_over_many_points(rs274, tmp_path):
     s = surface("paper-example-1")
-    settings = MachineSettings(dialect="linuxcnc", scale=10.0)
+    settings = machine(dialect="linuxcnc", scale=10.0)
     raster = RasterSpec("x", 10.0, 0.1)  # 400 points a row
     path = tmp_path / "fine.ngc"
     path.write_text(macro_program(s, settings, raster, FLAT).text)
@@ -240,7 +246,7 @@ def test_no_drift_over_many_points(rs274, tmp_path):
 
 def test_row_form_is_exact():
     s = surface("paper-example-3")
-    settings = MachineSettings(scale=3.0, origin_mm=(1.0, 2.0, 3.0))
+    settings = machine(scale=3.0, origin_mm=(1.0, 2.0, 3.0))
     for direction in ("x", "y"):
         f = row_form(s, settings, direction)
         for xi, yk, z in s.grid.points()[::3]:
@@ -253,7 +259,7 @@ def test_row_form_is_exact():
 
 def test_macro_needs_fixed_steps():
     with pytest.raises(ToolpathError, match="fixed side step"):
-        macro_raster(surface("paper-example-1"), MachineSettings(), RasterSpec("x", None, 0.2, scallop_mm=0.01))
+        macro_raster(surface("paper-example-1"), machine(), RasterSpec("x", None, 0.2, scallop_mm=0.01))
 
 
 # ---------------------------------------------------------------- what each control requires
@@ -269,7 +275,7 @@ def _depth(line: str) -> int:
 
 @pytest.mark.parametrize("form", ["horner", "lagrange"])
 def test_fanuc_program_follows_macro_b_rules(form):
-    program = macro_program(rough_grid(7, seed=1), MachineSettings(dialect="fanuc", program_number=42),
+    program = macro_program(rough_grid(7, seed=1), machine(dialect="fanuc", program_number=42),
                             RasterSpec("y", 1.0, 0.5), FLAT, form=form, tolerance_mm=1.0)
     lines = program.text.split("\n")
     assert lines[0] == "%" and lines[1].startswith("O0042 ") and lines[-2] == "%"
@@ -289,16 +295,16 @@ def test_fanuc_program_follows_macro_b_rules(form):
 
 def test_fanuc_variable_base():
     s = surface("paper-example-4")
-    text = macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec(), FLAT, variable_base=500).text
+    text = macro_program(s, machine(dialect="fanuc"), RasterSpec(), FLAT, variable_base=500).text
     numbers = {int(v) for v in re.findall(r"#(\d+)", text)}
     assert min(numbers) == 500 and max(numbers) < 600
     assert simulate(text, "fanuc", 8, max_blocks=50_000_000).moves
     with pytest.raises(ProgramError, match="outside the ranges"):
-        macro_program(s, MachineSettings(dialect="fanuc"), RasterSpec(), FLAT, variable_base=190)
+        macro_program(s, machine(dialect="fanuc"), RasterSpec(), FLAT, variable_base=190)
 
 
 def test_heidenhain_program_shape():
-    text = macro_program(surface("paper-example-2"), MachineSettings(dialect="heidenhain", program_number=7),
+    text = macro_program(surface("paper-example-2"), machine(dialect="heidenhain", program_number=7),
                          RasterSpec("x", 1.0, 1.0), FLAT).text
     lines = text.splitlines()
     assert lines[0] == "0 BEGIN PGM 7 MM" and lines[-1].endswith("END PGM 7 MM")
@@ -307,8 +313,13 @@ def test_heidenhain_program_shape():
     assert max(int(q) for q in re.findall(r"Q(\d+)", text)) <= 99
 
 
+def test_safe_z_below_the_path_is_refused():
+    with pytest.raises(ToolpathError, match=r"safe Z 50 mm is not above the highest point of the path, 71.38\d mm"):
+        macro_program(surface("paper-example-4"), MachineSettings(scale=20.0), RasterSpec("x", 5.0, 5.0), FLAT)
+
+
 def test_program_is_immutable_and_uses_line_ending():
-    program = macro_program(surface("paper-example-1"), MachineSettings(dialect="fanuc", line_ending="crlf"),
+    program = macro_program(surface("paper-example-1"), machine(dialect="fanuc", line_ending="crlf"),
                             RasterSpec(), FLAT)
     with pytest.raises(dataclasses.FrozenInstanceError):
         program.text = ""
@@ -317,7 +328,7 @@ def test_program_is_immutable_and_uses_line_ending():
 
 def test_inch_programs_are_in_inches():
     s = surface("paper-example-1")
-    settings = MachineSettings(dialect="linuxcnc", units="inch", scale=25.4)
+    settings = machine(dialect="linuxcnc", units="inch", scale=25.4)
     raster = RasterSpec("x", 12.7, 6.35)
     program = macro_program(s, settings, raster, FLAT)
     assert "G20" in program.text
@@ -329,7 +340,7 @@ def test_inch_programs_are_in_inches():
 
 def test_unknown_dialect_names_the_choices():
     with pytest.raises(ToolpathError, match="fanuc, linuxcnc, heidenhain"):
-        macro_program(surface("paper-example-1"), MachineSettings(dialect="grbl"), RasterSpec(), FLAT)
+        macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
 
 
 # ---------------------------------------------------------------- command line
@@ -337,6 +348,7 @@ def test_unknown_dialect_names_the_choices():
 def test_cli_macro_then_simulate(run_cli, tmp_path):
     prog, moves = tmp_path / "O1000.nc", tmp_path / "moves.csv"
     status, out, err = run_cli("macro", EXAMPLES / "paper-example-4.json", "--scale", 20, "--tool-diameter", 0,
+                               "--safe-z", 100,
                                "--stepover", 2, "--step", 1, "--dialect", "fanuc", "--program", 1000,
                                "-o", prog, "--stats")
     assert status == 0, err
@@ -361,7 +373,7 @@ def test_cli_macro_refuses_with_exit_2(run_cli, tmp_path):
     pts = [[i * 5, k * 5, rng.randint(0, 5000) / 100] for i in range(9) for k in range(9)]
     f = tmp_path / "big.json"
     f.write_text(json.dumps({"points": pts}))
-    status, out, err = run_cli("macro", f, "--dialect", "fanuc", "--form", "horner", "--tool-diameter", 0,
+    status, out, err = run_cli("macro", f, "--dialect", "fanuc", "--form", "horner", "--tool-diameter", 0, "--safe-z", 900,
                                "--stepover", 5, "--step", 5)
     assert status == 2 and "predicted to be off by" in err
 
@@ -374,7 +386,7 @@ BALL = Tool("ball", 4.0)
 @pytest.mark.parametrize("direction", ["x", "y"])
 def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, direction):
     s = surface("paper-example-4")
-    settings = MachineSettings(dialect="linuxcnc", scale=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
+    settings = machine(dialect="linuxcnc", scale=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
     raster = RasterSpec(direction, 5.0, 2.0)
     path = tmp_path / "ball.ngc"
     path.write_text(macro_program(s, settings, raster, BALL).text)
@@ -387,7 +399,7 @@ def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, dire
 @pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
 def test_ball_end_macro_through_the_simulator(dialect, form):
     s = surface("paper-example-3")
-    settings = MachineSettings(dialect=dialect, scale=25.0)
+    settings = machine(dialect=dialect, scale=25.0)
     raster = RasterSpec("y", 12.0, 5.0)
     program = macro_program(s, settings, raster, BALL, form=form)
     got = simulate(program.text, dialect, 8).feed_points()[1:]
@@ -400,7 +412,7 @@ def test_ball_end_7x7_program_raises_no_alarm(dialect):
     nodes = [Fraction(10 * i) for i in range(7)]
     z = [[Fraction(round(300 * np.sin(i / 2) + 200 * np.cos(k / 3)), 100) for k in range(7)] for i in range(7)]
     s = lagrange_surface(grid_from_table(nodes, nodes, z))
-    settings = MachineSettings(dialect=dialect)
+    settings = machine(dialect=dialect)
     raster = RasterSpec("y", 5.0, 3.0)
     program = macro_program(s, settings, raster, Tool("ball", 6.0))
     got = simulate(program.text, dialect, 8).feed_points()[1:]
@@ -414,7 +426,7 @@ def test_cli_simulate_missing_file(run_cli, tmp_path):
 
 def test_ball_end_tip_is_one_radius_off_the_surface():
     s = surface("paper-example-4")
-    settings = MachineSettings(scale=20.0)
+    settings = machine(scale=20.0)
     tips = planned_points(s, settings, RasterSpec("x", 10.0, 4.0), BALL)
     centres = tips + [0.0, 0.0, 2.0]
     xs = np.linspace(20.0, 100.0, 401)
@@ -433,7 +445,7 @@ def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
     from lagsym.lagrange import X, Y
 
     s = surface("paper-example-3")
-    plan = macro_plan(s, MachineSettings(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
+    plan = macro_plan(s, machine(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
     ctx = decimal_context(30)
     env = run(plan.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
     env["p"] = ctx.create_decimal("1.75")
@@ -448,11 +460,11 @@ def test_ball_end_gouge_is_refused_with_a_suggestion():
     s = surface("paper-example-4")
     expected = r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"
     with pytest.raises(ToolpathError, match=expected):
-        macro_program(s, MachineSettings(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
+        macro_program(s, machine(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
 
 
 def test_flat_tool_and_zero_diameter_program_the_surface():
     s = surface("paper-example-1")
-    a = macro_program(s, MachineSettings(), RasterSpec(), Tool("flat", 10.0)).text
-    b = macro_program(s, MachineSettings(), RasterSpec(), Tool("ball", 0.0)).text
+    a = macro_program(s, machine(), RasterSpec(), Tool("flat", 10.0)).text
+    b = macro_program(s, machine(), RasterSpec(), Tool("ball", 0.0)).text
     assert a == b and "SQRT" not in a

@@ -25,8 +25,9 @@ predicted to be off by more than --tolerance is refused.
 
 examples:
   lagsym macro examples/paper-example-4.json --scale 20 --tool-diameter 4 --stepover 0.5 --step 0.2 \\
-      --dialect fanuc --program 1000 -o O1000.nc --stats
-  lagsym macro examples/paper-example-1.json --dialect linuxcnc --tool-diameter 0 --scale 10 -o surface.ngc
+      --safe-z 100 --dialect fanuc --program 1000 -o O1000.nc --stats
+  lagsym macro examples/paper-example-1.json --dialect linuxcnc --tool-diameter 0 --scale 10 \\
+      --origin 0,0,-400 -o surface.ngc
   lagsym macro examples/paper-example-2.json --dialect heidenhain --scale 10 --tool-diameter 2 \\
       --variable-base 20 -o 1000.h"""
 
@@ -66,7 +67,8 @@ def add_arguments(p) -> None:
     p.add_argument("--feed", type=float, default=600.0, metavar="MM_MIN", help="cutting feed (default 600)")
     p.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM_MIN", help="plunge feed (default 200)")
     p.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
-    p.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="clearance height (default 50)")
+    p.add_argument("--safe-z", type=float, default=50.0, metavar="MM",
+                   help="clearance height for rapid moves, above the whole path (default 50)")
     p.add_argument("--stock", type=float, default=0.0, metavar="MM", help="stock to leave (default 0)")
     p.add_argument("--program", type=int, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
     p.add_argument("--work-offset", default="G54", help="work offset (default G54)")

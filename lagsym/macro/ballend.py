@@ -10,7 +10,8 @@ derivatives, the programmed tip is
 The control computes ``Zp`` and ``Zr`` from the same well-conditioned form as
 ``Z``.  Where the surface is concave with a radius of curvature below the
 ball's, the offset point is not the nearest and the ball cuts into the part;
-:func:`check_gouge` finds that off-line, along the whole raster, and refuses.
+:func:`check_gouge` finds that off-line, over the raster (every position, or
+1001 x 1001 of them evenly spread for a finer one), and refuses.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from .form import RowForm, point_statements, row_form, row_statements
 from .model import Assign, add, const, div, mul, sqrt, sub, var
-from .plan import exact, macro_raster, raster_positions
+from .plan import exact, macro_raster, sample_positions
 
 __all__ = ["ballend_plan", "offset_points", "tip_points", "check_gouge", "derivatives"]
 
@@ -93,8 +94,8 @@ def ballend_plan(surface: LagrangeSurface, settings: MachineSettings, raster: Ra
     uf = settings.unit_factor
     radius = tool.radius_mm * uf
     offset = (tool.radius_mm + settings.stock_to_leave_mm) * uf
-    pr, rr = raster_positions(plan)
-    pr, rr = (pr, rr) if plan.direction == "x" else (rr, pr)
+    xs, ys = sample_positions(plan, 1001)
+    pr, rr = (xs, ys) if plan.direction == "x" else (ys, xs)
     check_gouge(rf, pr, rr, offset, surface.grid.source, uf)
     p, r, z = var("p"), var("r"), var("z")
     zp, zr, q = var("zp"), var("zr"), var("q")

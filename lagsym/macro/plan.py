@@ -23,7 +23,7 @@ from ..errors import ToolpathError
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 
-__all__ = ["Axis", "MacroRaster", "macro_raster", "raster_positions", "planned_points", "exact"]
+__all__ = ["Axis", "MacroRaster", "macro_raster", "raster_positions", "sample_positions", "planned_points", "exact"]
 
 
 def exact(value) -> Fraction:
@@ -128,6 +128,20 @@ def raster_positions(plan: MacroRaster) -> tuple[np.ndarray, np.ndarray]:
     r = np.repeat(rows, len(pts))
     p = np.concatenate([pts if j % 2 == 0 else pts[::-1] for j in range(len(rows))])
     return (p, r) if plan.direction == "x" else (r, p)
+
+
+def sample_positions(plan: MacroRaster, limit: int = 401) -> tuple[np.ndarray, np.ndarray]:
+    """(X, Y) of raster positions on up to ``limit`` rows by ``limit`` points, evenly spread, edges included.
+
+    For checks over the whole raster (clearance, gouging) that must not grow
+    with a fine step.
+    """
+    def pick(axis: Axis) -> np.ndarray:
+        ks = np.unique(np.linspace(0, axis.count, min(axis.count + 1, limit)).round().astype(int))
+        return np.minimum(float(axis.start) + ks * float(axis.step), float(axis.end))
+
+    r, p = np.meshgrid(pick(plan.rows), pick(plan.points), indexing="ij")
+    return (p.ravel(), r.ravel()) if plan.direction == "x" else (r.ravel(), p.ravel())
 
 
 def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,

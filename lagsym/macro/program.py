@@ -32,12 +32,12 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..errors import ProgramError
+from ..errors import ProgramError, ToolpathError
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool, choice
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
-from .plan import MacroRaster, macro_raster
+from .plan import MacroRaster, macro_raster, sample_positions
 
 __all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", "MacroPlan", "MacroProgram",
            "macro_plan", "macro_program", "predicted_error", "exact_height", "loop_plan"]
@@ -200,6 +200,28 @@ def _decimal(v: Fraction, ctx) -> Decimal:
     return ctx.divide(Decimal(v.numerator), Decimal(v.denominator))
 
 
+def _check_clearance(surface, settings, raster, tool, plan: MacroPlan) -> None:
+    """The rapid moves at the safe height must clear the highest point the tool tip reaches.
+
+    Checked over the raster positions (up to 401 x 401 of them, evenly spread),
+    with 1 % of the height range as margin for what lies between them.
+    """
+    x, y = sample_positions(plan.raster)
+    uf = settings.unit_factor
+    if plan.ball_radius:
+        from .ballend import tip_points
+
+        z = tip_points(surface, settings, tool, x, y)[:, 2]
+    else:
+        s = float(settings.scale) * uf
+        ox, oy, oz = (v * uf for v in settings.origin_mm)
+        z = surface.evaluate((x - ox) / s, (y - oy) / s) * s + oz + settings.stock_to_leave_mm * uf
+    top = (float(z.max()) + 0.01 * float(np.ptp(z))) / uf
+    if settings.safe_z_mm <= top:
+        raise ToolpathError(f"safe Z {settings.safe_z_mm:g} mm is not above the highest point of the path, "
+                            f"{float(z.max()) / uf:.3f} mm: the rapid moves would hit the part; raise --safe-z")
+
+
 @dataclass(frozen=True)
 class MacroProgram:
     """A finished macro program.
@@ -267,6 +289,7 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
         raise ProgramError(f"precision {precision} is not one of {', '.join(map(str, PRECISIONS))} significant digits")
     form = DEFAULT_FORM[precision] if form is None else choice(form, FORMS, "form")
     plan = macro_plan(surface, settings, raster, tool, form)
+    _check_clearance(surface, settings, raster, tool, plan)
     err = predicted_error(plan, precision) / settings.unit_factor
     if err > tolerance_mm:
         raise ProgramError(
