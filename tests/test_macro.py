@@ -211,6 +211,20 @@ def test_stats_compare_with_the_point_list():
     assert "9600 baud 7E2" in stats.text()
 
 
+def test_stats_from_a_sample_are_close_to_the_full_count():
+    from lagsym.macro.plan import points_at, sample_positions
+
+    s = surface("paper-example-4")
+    settings = machine(dialect="fanuc", scale=20.0)
+    raster = RasterSpec("x", 0.5, 0.2)
+    program = macro_program(s, settings, raster, FLAT)
+    full = program_stats(program, planned_points(s, settings, raster, FLAT), settings)
+    sample = points_at(s, settings, FLAT, *sample_positions(program.plan.raster, 101))
+    estimate = program_stats(program, sample, settings, count=full.points)
+    assert estimate.points == full.points
+    assert estimate.point_list_bytes == pytest.approx(full.point_list_bytes, rel=0.01)
+
+
 def test_point_list_size_counts_what_fixed_would_write():
     from lagsym.post.numbers import fixed
 

@@ -5,9 +5,12 @@ from __future__ import annotations
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
-from ..macro.form import FORMS
 from ..macro import MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, program_stats
+from ..macro.form import FORMS
+from ..macro.plan import points_at, sample_positions
 from ._common import emit
+
+STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
 NAME = "macro"
 ORDER = 70
@@ -98,7 +101,12 @@ def run(args, out, err) -> int:
                             tolerance_mm=args.tolerance, variable_base=args.variable_base, form=args.form)
     emit(program.text, args.output, out)
     if args.stats:
-        stats = program_stats(program, planned_points(surface, settings, raster, tool), settings)
+        plan = program.plan.raster
+        if plan.size <= STATS_POINTS:
+            stats = program_stats(program, planned_points(surface, settings, raster, tool), settings)
+        else:  # a sample, scaled: a list of millions of points is not worth building to count it
+            sample = points_at(surface, settings, tool, *sample_positions(plan, 1001))
+            stats = program_stats(program, sample, settings, count=plan.size)
         report = (stats.text() + f"\npredicted arithmetic error at {program.precision} digits: "
                   f"{program.predicted_error:.2g} mm\n")
         (out if args.output and args.output != "-" else err).write(report)

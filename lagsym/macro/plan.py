@@ -23,7 +23,8 @@ from ..errors import ToolpathError
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 
-__all__ = ["Axis", "MacroRaster", "macro_raster", "raster_positions", "sample_positions", "planned_points", "exact"]
+__all__ = ["Axis", "MacroRaster", "macro_raster", "raster_positions", "sample_positions", "planned_points",
+           "points_at", "exact"]
 
 
 def exact(value) -> Fraction:
@@ -144,23 +145,33 @@ def sample_positions(plan: MacroRaster, limit: int = 401) -> tuple[np.ndarray, n
     return (p.ravel(), r.ravel()) if plan.direction == "x" else (r.ravel(), p.ravel())
 
 
+def points_at(surface: LagrangeSurface, settings: MachineSettings, tool: Tool | None, x, y) -> np.ndarray:
+    """The programmed points (N, 3) for raster positions (x, y), in program units.
+
+    Z is the surface height at each position (stable evaluation, within 1e-12
+    of the exact value), scaled, plus the origin and the stock to leave.  For a
+    ball-end tool with a diameter the point is the tool tip of a ball whose
+    centre sits one radius (plus stock) off the surface along its normal (see
+    :mod:`lagsym.macro.ballend`).
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if tool is not None and tool.shape == "ball" and tool.diameter_mm > 0:
+        from .ballend import tip_points
+
+        return tip_points(surface, settings, tool, x, y)
+    s = float(settings.scale) * settings.unit_factor
+    ox, oy, oz = (v * settings.unit_factor for v in settings.origin_mm)
+    z = surface.evaluate((x - ox) / s, (y - oy) / s) * s + oz + settings.stock_to_leave_mm * settings.unit_factor
+    return np.column_stack([x, y, z])
+
+
 def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
                    tool: Tool | None = None) -> np.ndarray:
     """The points a macro program should move through, computed on the PC: an (N, 3) array in program units.
 
-    Z is the surface height at each raster position (stable evaluation, within
-    1e-12 of the exact value), scaled, plus the origin and the stock to leave.
-    For a ball-end tool with a diameter the point is the tool tip of a ball
-    whose centre sits one radius off the surface along its normal (see
-    :func:`lagsym.macro.ballend.tip_points`).
+    Every raster position in the order the program visits them, through
+    :func:`points_at`.  The program's first feed move (the plunge) ends at the
+    first of these points.
     """
     plan = macro_raster(surface, settings, raster)
-    X, Y = raster_positions(plan)
-    if tool is not None and tool.shape == "ball" and tool.diameter_mm > 0:
-        from .ballend import tip_points
-
-        return tip_points(surface, settings, tool, X, Y)
-    s = float(settings.scale) * settings.unit_factor
-    ox, oy, oz = (v * settings.unit_factor for v in settings.origin_mm)
-    z = surface.evaluate((X - ox) / s, (Y - oy) / s) * s + oz + settings.stock_to_leave_mm * settings.unit_factor
-    return np.column_stack([X, Y, z])
+    return points_at(surface, settings, tool, *raster_positions(plan))

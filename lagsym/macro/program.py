@@ -37,7 +37,7 @@ from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool, choice
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
-from .plan import MacroRaster, macro_raster, sample_positions
+from .plan import MacroRaster, macro_raster, points_at, sample_positions
 
 __all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", "MacroPlan", "MacroProgram",
            "macro_plan", "macro_program", "predicted_error", "exact_height", "loop_plan"]
@@ -206,16 +206,8 @@ def _check_clearance(surface, settings, raster, tool, plan: MacroPlan) -> None:
     Checked over the raster positions (up to 401 x 401 of them, evenly spread),
     with 1 % of the height range as margin for what lies between them.
     """
-    x, y = sample_positions(plan.raster)
     uf = settings.unit_factor
-    if plan.ball_radius:
-        from .ballend import tip_points
-
-        z = tip_points(surface, settings, tool, x, y)[:, 2]
-    else:
-        s = float(settings.scale) * uf
-        ox, oy, oz = (v * uf for v in settings.origin_mm)
-        z = surface.evaluate((x - ox) / s, (y - oy) / s) * s + oz + settings.stock_to_leave_mm * uf
+    z = points_at(surface, settings, tool, *sample_positions(plan.raster))[:, 2]
     top = (float(z.max()) + 0.01 * float(np.ptp(z))) / uf
     if settings.safe_z_mm <= top:
         raise ToolpathError(f"safe Z {settings.safe_z_mm:g} mm is not above the highest point of the path, "

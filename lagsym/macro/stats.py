@@ -88,12 +88,19 @@ def frame_bytes(text: str, eol: str) -> int:
     return sum(len(line) + len(eol) for line in keep if line)
 
 
-def program_stats(program, points: np.ndarray, settings) -> ProgramStats:
+def program_stats(program, points: np.ndarray, settings, count: int | None = None) -> ProgramStats:
     """Compare ``program`` (a MacroProgram) with the point list over ``points`` (the planned (N, 3) points).
 
     The point list keeps the macro's preamble and postamble (:func:`frame_bytes`)
-    and has one block per point (:func:`point_list_size`).
+    and has one block per point (:func:`point_list_size`).  With ``count``,
+    ``points`` is a sample of a raster of ``count`` points and the blocks are
+    scaled from the sample's mean.
     """
-    plist = point_list_size(points, settings.digits, settings.eol, overhead=frame_bytes(program.text, settings.eol))
-    return ProgramStats(points=len(points), macro_bytes=program.size, point_list_bytes=plist,
+    frame = frame_bytes(program.text, settings.eol)
+    blocks = point_list_size(points, settings.digits, settings.eol)
+    n = len(points) if count is None else int(count)
+    if count is not None:
+        blocks = round(blocks * n / len(points))
+    plist = frame + blocks
+    return ProgramStats(points=n, macro_bytes=program.size, point_list_bytes=plist,
                         macro_seconds=transfer_seconds(program.size), point_list_seconds=transfer_seconds(plist))
