@@ -1,0 +1,113 @@
+"""``lagsym macro FILE``: a parametric program that computes the surface on the control (variable programming)."""
+
+from __future__ import annotations
+
+from ..io import read_points
+from ..lagrange import lagrange_surface
+from ..machine import MachineSettings, RasterSpec, Tool
+from ..macro import MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, program_stats
+from ..macro.form import FORMS
+from ..macro.plan import points_at, sample_positions
+from ._common import emit
+
+STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
+
+NAME = "macro"
+ORDER = 70
+HELP = "write a macro program that evaluates the surface on the control (Fanuc, LinuxCNC, Heidenhain)"
+DESCRIPTION = """Write a parametric (macro) program for the surface through the control points in
+FILE.  The program loops over integer-counted rows and points of a zig-zag
+raster over the control points' box (scaled by --scale, moved by --origin) and
+computes each height on the control from the normalized Horner form of the
+exact polynomial, so its size does not depend on the step.  The last row and
+the last point of a row are clamped to the box edge.
+
+The arithmetic of the control (--precision: 8 significant digits for a Fanuc
+16/18-class control, 15 for IEEE double) is checked before writing: a program
+predicted to be off by more than --tolerance is refused.
+
+examples:
+  lagsym macro examples/paper-example-4.json --scale 20 --tool-diameter 4 --stepover 0.5 --step 0.2 \\
+      --safe-z 100 --dialect fanuc --program 1000 -o O1000.nc --stats
+  lagsym macro examples/paper-example-1.json --dialect linuxcnc --tool-diameter 0 --scale 10 \\
+      --origin 0,0,-400 -o surface.ngc
+  lagsym macro examples/paper-example-2.json --dialect heidenhain --scale 10 --tool-diameter 2 \\
+      --variable-base 20 -o 1000.h"""
+
+
+def _triple(text: str) -> tuple[float, float, float]:
+    parts = [p for p in text.replace(",", " ").split()]
+    if len(parts) != 3:
+        import argparse
+
+        raise argparse.ArgumentTypeError(f"{text!r} is not X,Y,Z")
+    return tuple(float(p) for p in parts)
+
+
+def add_arguments(p) -> None:
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help="control language (default fanuc)")
+    p.add_argument("--precision", type=int, choices=PRECISIONS,
+                   help="significant digits of the control's arithmetic "
+                        "(default 8 for fanuc and heidenhain, 15 for linuxcnc)")
+    p.add_argument("--form", choices=FORMS,
+                   help="horner (shortest) or lagrange (tensor-product basis, most accurate); "
+                        "default lagrange at 8 digits, horner at 15")
+    p.add_argument("--tolerance", type=float, default=0.001, metavar="MM",
+                   help="largest arithmetic error accepted on the control, mm (default 0.001)")
+    p.add_argument("--variable-base", type=int, metavar="N",
+                   help="first variable number: Fanuc #100 (default) or #500, Heidenhain Q1 (default)")
+    p.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    p.add_argument("--origin", type=_triple, default=(0.0, 0.0, 0.0), metavar="X,Y,Z", help="work offset added, mm")
+    p.add_argument("--units", choices=("mm", "inch"), default="mm", help="program units (default mm)")
+    p.add_argument("--direction", choices=("x", "y"), default="x", help="rows run along x (default) or y")
+    p.add_argument("--stepover", type=float, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
+    p.add_argument("--step", type=float, default=0.2, metavar="MM", help="forward step along a row, mm (default 0.2)")
+    p.add_argument("--tool-shape", choices=("ball", "flat"), default="ball", help="cutter shape (default ball)")
+    p.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
+                   help="cutter diameter, mm; 0 programs the surface itself (default 6)")
+    p.add_argument("--tool-number", type=int, default=1, metavar="T")
+    p.add_argument("--feed", type=float, default=600.0, metavar="MM_MIN", help="cutting feed (default 600)")
+    p.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM_MIN", help="plunge feed (default 200)")
+    p.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    p.add_argument("--safe-z", type=float, default=50.0, metavar="MM",
+                   help="clearance height for rapid moves, above the whole path (default 50)")
+    p.add_argument("--stock", type=float, default=0.0, metavar="MM", help="stock to leave (default 0)")
+    p.add_argument("--program", type=int, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
+    p.add_argument("--work-offset", default="G54", help="work offset (default G54)")
+    p.add_argument("--line-ending", choices=("lf", "crlf", "cr"), default="lf")
+    p.add_argument("--decimals", type=int, metavar="N", help="decimals in positions (default 3 mm, 4 inch)")
+    p.add_argument("--stats", action="store_true",
+                   help="compare the program's size with the equivalent point list, and their 9600-baud transfer times")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+
+
+def settings_from(args) -> tuple[MachineSettings, RasterSpec, Tool]:
+    """The machine, raster and tool the arguments describe."""
+    settings = MachineSettings(
+        dialect=args.dialect, scale=args.scale, origin_mm=args.origin, units=args.units,
+        feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
+        safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock, program_number=args.program,
+        work_offset=args.work_offset, line_ending=args.line_ending, decimals=args.decimals,
+        tool_number=args.tool_number)
+    raster = RasterSpec(direction=args.direction, stepover_mm=args.stepover, step_mm=args.step)
+    return settings, raster, Tool(shape=args.tool_shape, diameter_mm=args.tool_diameter)
+
+
+def run(args, out, err) -> int:
+    surface = lagrange_surface(read_points(args.file))
+    settings, raster, tool = settings_from(args)
+    program = macro_program(surface, settings, raster, tool, precision=args.precision,
+                            tolerance_mm=args.tolerance, variable_base=args.variable_base, form=args.form)
+    emit(program.text, args.output, out)
+    if args.stats:
+        plan = program.plan.raster
+        if plan.size <= STATS_POINTS:
+            stats = program_stats(program, planned_points(surface, settings, raster, tool), settings)
+        else:  # a sample, scaled: a list of millions of points is not worth building to count it
+            sample = points_at(surface, settings, tool, *sample_positions(plan, 1001))
+            stats = program_stats(program, sample, settings, count=plan.size)
+        report = (stats.text() + f"\npredicted arithmetic error at {program.precision} digits: "
+                  f"{program.predicted_error:.2g} mm\n")
+        (out if args.output and args.output != "-" else err).write(report)
+    return 0

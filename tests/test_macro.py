@@ -1,0 +1,484 @@
+"""Macro programs: the raster they cut equals the one computed on the PC, through rs274 and the simulator."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import random
+import re
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given, settings as hsettings, strategies as st
+
+from conftest import EXAMPLES
+from lagsym.errors import ProgramError, ToolpathError
+from lagsym.grid import grid_from_table
+from lagsym.io import read_points
+from lagsym.lagrange import lagrange_surface
+from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.macro import (
+    macro_plan,
+    macro_program,
+    macro_raster,
+    planned_points,
+    point_list_size,
+    predicted_error,
+    program_stats,
+    raster_positions,
+    row_form,
+    transfer_seconds,
+)
+from lagsym.simulate import simulate
+from test_simulate import feeds
+
+FLAT = Tool("flat", 0.0)
+
+
+def machine(**settings) -> MachineSettings:
+    """Machine settings with a safe height above every test surface."""
+    settings.setdefault("safe_z_mm", 1000.0)
+    return MachineSettings(**settings)
+
+
+def surface(name: str):
+    return lagrange_surface(read_points(EXAMPLES / f"{name}.json"))
+
+
+def rough_grid(n: int, seed: int = 0, span: int = 60, zmax: int = 50):
+    """An n x n grid of random heights 0..zmax mm over a span x span mm box: the hard case for a control."""
+    rng = random.Random(seed)
+    nodes = [Fraction(span * i, n - 1) for i in range(n)]
+    z = [[Fraction(rng.randint(0, 100 * zmax), 100) for _ in range(n)] for _ in range(n)]
+    return lagrange_surface(grid_from_table(nodes, nodes, z, source=f"rough{n}x{n}"))
+
+
+CASES = [
+    ("paper-example-1", dict(scale=5.0), RasterSpec("x", 1.5, 0.7)),
+    ("paper-example-2", dict(scale=2.0, origin_mm=(-10.0, 5.0, -3.0)), RasterSpec("y", 2.5, 1.1)),
+    ("paper-example-3", dict(scale=7.5), RasterSpec("x", 3.0, 1.3)),
+    ("paper-example-4", dict(scale=20.0, origin_mm=(1.5, -2.25, 10.0)), RasterSpec("y", 5.0, 2.0)),
+]
+
+
+# ---------------------------------------------------------------- the proof
+
+@pytest.mark.parametrize("name, options, raster", CASES, ids=[c[0] for c in CASES])
+def test_linuxcnc_macro_through_rs274_equals_the_pc_raster(rs274, tmp_path, name, options, raster):
+    s = surface(name)
+    settings = machine(dialect="linuxcnc", **options)
+    program = macro_program(s, settings, raster, FLAT)
+    path = tmp_path / "macro.ngc"
+    path.write_text(program.text)
+    result = rs274.run(path)
+    assert result.returncode == 0, result.stdout[-500:] + result.stderr[-500:]
+    got = feeds(result.stdout)
+    want = planned_points(s, settings, raster, FLAT)
+    assert got.shape == (len(want) + 1, 3)
+    np.testing.assert_allclose(got[0], want[0], atol=1e-3)  # the plunge
+    np.testing.assert_allclose(got[1:], want, atol=1e-3, rtol=0)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "heidenhain", "linuxcnc"])
+@pytest.mark.parametrize("name, options, raster", CASES, ids=[c[0] for c in CASES])
+def test_every_dialect_through_the_simulator_equals_the_pc_raster(dialect, name, options, raster):
+    s = surface(name)
+    settings = machine(dialect=dialect, **options)
+    program = macro_program(s, settings, raster, FLAT)
+    sim = simulate(program.text, dialect, program.precision)
+    want = planned_points(s, settings, raster, FLAT)
+    got = sim.feed_points()
+    assert got.shape == (len(want) + 1, 3)
+    np.testing.assert_allclose(got[1:], want, atol=1e-3, rtol=0)
+
+
+def test_fanuc_and_linuxcnc_programs_agree_with_rs274_and_each_other(rs274, tmp_path):
+    """A family of equivalent programs: rs274 runs the LinuxCNC one, the simulator runs both."""
+    for n, direction in ((3, "x"), (5, "y"), (6, "x")):
+        s = rough_grid(n, seed=n, zmax=20)
+        raster = RasterSpec(direction, 6.0, 2.5)
+        progs = {d: macro_program(s, machine(dialect=d), raster, FLAT, precision=15)
+                 for d in ("fanuc", "linuxcnc")}
+        path = tmp_path / f"m{n}.ngc"
+        path.write_text(progs["linuxcnc"].text)
+        real = feeds(rs274.run(path).stdout)
+        ours = simulate(progs["linuxcnc"].text, "linuxcnc", 15).feed_points()
+        fanuc = simulate(progs["fanuc"].text, "fanuc", 15).feed_points()
+        np.testing.assert_allclose(ours, real, atol=6e-5, rtol=0)
+        np.testing.assert_allclose(fanuc, ours, atol=1e-9, rtol=0)
+
+
+@st.composite
+def grids(draw):
+    n, m = draw(st.integers(2, 6)), draw(st.integers(2, 6))
+    gaps = st.integers(1, 40).map(lambda v: Fraction(v, 4))
+    xs = np.cumsum([Fraction(draw(st.integers(-20, 20)))] + draw(st.lists(gaps, min_size=n - 1, max_size=n - 1)))
+    ys = np.cumsum([Fraction(draw(st.integers(-20, 20)))] + draw(st.lists(gaps, min_size=m - 1, max_size=m - 1)))
+    z = [[Fraction(draw(st.integers(-2000, 2000)), 100) for _ in range(m)] for _ in range(n)]
+    return lagrange_surface(grid_from_table(list(xs), list(ys), z))
+
+
+@hsettings(max_examples=12, deadline=None)
+@given(s=grids(), scale=st.sampled_from([0.5, 1.0, 2.5]), direction=st.sampled_from(["x", "y"]),
+       dialect=st.sampled_from(["linuxcnc", "fanuc"]))
+def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, tmp_path_factory, s, scale,
+                                                                         direction, dialect):
+    x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
+    raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
+    settings = machine(dialect=dialect, scale=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=1e6)
+    program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
+    if dialect == "linuxcnc":
+        path = tmp_path_factory.mktemp("any") / "any.ngc"
+        path.write_text(program.text)
+        result = rs274.run(path)
+        assert result.returncode == 0, result.stdout[-300:]
+        got = feeds(result.stdout)
+    else:
+        got = simulate(program.text, "fanuc", 15).feed_points()
+    np.testing.assert_allclose(got[1:], planned_points(s, settings, raster, FLAT), atol=1e-3, rtol=0)
+
+
+# ---------------------------------------------------------------- accuracy on the control
+
+@pytest.mark.parametrize("n", [3, 4, 5, 6, 7])
+def test_eight_digits_stay_within_a_micrometre_up_to_7x7(n):
+    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="lagrange")
+    assert predicted_error(plan, 8, rows=7, points=11) <= 1e-3
+
+
+@pytest.mark.parametrize("n", [8, 10, 12])
+def test_fifteen_digits_stay_within_a_micrometre_up_to_12x12(n):
+    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="horner")
+    assert predicted_error(plan, 15, rows=5, points=9) <= 1e-3
+
+
+def test_simulated_error_at_eight_digits_matches_the_prediction():
+    s = rough_grid(7, seed=7)
+    settings = machine(dialect="fanuc")
+    raster = RasterSpec("x", 6.0, 3.0)
+    program = macro_program(s, settings, raster, FLAT)
+    got = simulate(program.text, "fanuc", 8).feed_points()[1:]
+    err = np.abs(got - planned_points(s, settings, raster, FLAT)).max()
+    assert err <= 1e-3
+    assert err <= 3 * program.predicted_error + 2e-6
+
+
+def test_the_expanded_horner_form_fails_where_the_basis_form_holds():
+    s = rough_grid(8, seed=8)
+    raster = RasterSpec("x", 1.0, 1.0)
+    horner = predicted_error(macro_plan(s, machine(), raster, FLAT, "horner"), 8, 7, 11)
+    basis = predicted_error(macro_plan(s, machine(), raster, FLAT, "lagrange"), 8, 7, 11)
+    assert horner > 1e-3 > basis
+
+
+def test_a_program_that_misses_the_tolerance_is_refused_with_the_prediction():
+    s = rough_grid(9, seed=9)
+    with pytest.raises(ProgramError, match=r"predicted to be off by [0-9.e-]+ mm, more than the tolerance 0.001 mm"):
+        macro_program(s, machine(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner")
+
+
+def test_a_constant_the_control_cannot_read_is_refused():
+    s = rough_grid(12, seed=12)
+    with pytest.raises(ProgramError, match=r"has 9 digits, more than the 8 the control reads"):
+        macro_program(s, machine(dialect="fanuc"), RasterSpec("x", 5.0, 5.0), FLAT, form="horner",
+                      tolerance_mm=100.0)
+
+
+# ---------------------------------------------------------------- size
+
+@pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
+@pytest.mark.parametrize("n", [3, 5, 7])
+def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
+    s = rough_grid(n, seed=n, zmax=10)
+    sizes = [macro_program(s, machine(dialect=dialect), RasterSpec("x", step, step / 2), FLAT).size
+             for step in (5.0, 0.5, 0.01)]
+    assert max(sizes) < 4096
+    assert max(sizes) - min(sizes) <= 40  # only the loop counts and steps change
+
+
+def test_stats_compare_with_the_point_list():
+    s = surface("paper-example-4")
+    settings = machine(dialect="fanuc", scale=20.0)
+    raster = RasterSpec("x", 0.5, 0.2)
+    program = macro_program(s, settings, raster, FLAT)
+    pts = planned_points(s, settings, raster, FLAT)
+    stats = program_stats(program, pts, settings)
+    assert stats.points == len(pts) == 161 * 401
+    assert stats.macro_bytes == program.size < 4096
+    assert stats.point_list_bytes > 1_000_000
+    assert stats.point_list_seconds == pytest.approx(stats.point_list_bytes * 11 / 9600)
+    assert "9600 baud 7E2" in stats.text()
+
+
+def test_stats_from_a_sample_are_close_to_the_full_count():
+    from lagsym.macro.plan import points_at, sample_positions
+
+    s = surface("paper-example-4")
+    settings = machine(dialect="fanuc", scale=20.0)
+    raster = RasterSpec("x", 0.5, 0.2)
+    program = macro_program(s, settings, raster, FLAT)
+    full = program_stats(program, planned_points(s, settings, raster, FLAT), settings)
+    sample = points_at(s, settings, FLAT, *sample_positions(program.plan.raster, 101))
+    estimate = program_stats(program, sample, settings, count=full.points)
+    assert estimate.points == full.points
+    assert estimate.point_list_bytes == pytest.approx(full.point_list_bytes, rel=0.01)
+
+
+def test_point_list_size_counts_what_fixed_would_write():
+    from lagsym.post.numbers import fixed
+
+    pts = np.array([[0.0, -1.2345, 100.0], [12.5, 0.0004, -0.0004], [-3.0, 99.9996, 7.0]])
+    text = "".join(f"G1 X{fixed(float(x), 3)} Y{fixed(float(y), 3)} Z{fixed(float(z), 3)}\n" for x, y, z in pts)
+    assert point_list_size(pts, 3) == len(text)
+    assert transfer_seconds(960) == pytest.approx(1.1)
+
+
+# ---------------------------------------------------------------- the raster
+
+def test_raster_is_counted_and_clamped_to_the_box():
+    s = surface("paper-example-1")  # x 1..5, y 2..4
+    plan = macro_raster(s, machine(scale=10.0), RasterSpec("x", 7.0, 3.0))
+    assert (plan.points.count, plan.rows.count) == (14, 3)  # 40 mm / 3 -> 14 steps, 20 mm / 7 -> 3
+    assert plan.points.clamped and plan.rows.clamped
+    x, y = raster_positions(plan)
+    assert x[14] == 50.0 and x[13] == 49.0 and x[15] == 50.0  # clamped, then the reversed row starts there
+    assert sorted(set(y)) == [20.0, 27.0, 34.0, 40.0]
+
+
+def test_no_drift_over_many_points(rs274, tmp_path):
+    s = surface("paper-example-1")
+    settings = machine(dialect="linuxcnc", scale=10.0)
+    raster = RasterSpec("x", 10.0, 0.1)  # 400 points a row
+    path = tmp_path / "fine.ngc"
+    path.write_text(macro_program(s, settings, raster, FLAT).text)
+    got = feeds(rs274.run(path).stdout)[1:]
+    want = planned_points(s, settings, raster, FLAT)
+    np.testing.assert_allclose(got, want, atol=1e-3, rtol=0)
+    assert got[400, 0] == 50.0  # the 401st point of the first row is the box edge
+
+
+def test_row_form_is_exact():
+    s = surface("paper-example-3")
+    settings = machine(scale=3.0, origin_mm=(1.0, 2.0, 3.0))
+    for direction in ("x", "y"):
+        f = row_form(s, settings, direction)
+        for xi, yk, z in s.grid.points()[::3]:
+            X, Y = xi * 3 + 1, yk * 3 + 2
+            p, r = (X, Y) if direction == "x" else (Y, X)
+            u, v = (p - f.pc) * f.pk, (r - f.rc) * f.rk
+            value = sum(c * u**a * v**b for a, row in enumerate(f.coefficients) for b, c in enumerate(row))
+            assert value + f.z0 == z * 3 + 3
+
+
+def test_macro_needs_fixed_steps():
+    with pytest.raises(ToolpathError, match="fixed side step"):
+        macro_raster(surface("paper-example-1"), machine(), RasterSpec("x", None, 0.2, scallop_mm=0.01))
+
+
+# ---------------------------------------------------------------- what each control requires
+
+def _depth(line: str) -> int:
+    d = best = 0
+    for ch in line:
+        d += ch == "["
+        d -= ch == "]"
+        best = max(best, d)
+    return best
+
+
+@pytest.mark.parametrize("form", ["horner", "lagrange"])
+def test_fanuc_program_follows_macro_b_rules(form):
+    program = macro_program(rough_grid(7, seed=1), machine(dialect="fanuc", program_number=42),
+                            RasterSpec("y", 1.0, 0.5), FLAT, form=form, tolerance_mm=1.0)
+    lines = program.text.split("\n")
+    assert lines[0] == "%" and lines[1].startswith("O0042 ") and lines[-2] == "%"
+    body = [re.sub(r"\([^)]*\)", "", line) for line in lines]
+    assert all(_depth(line) <= 5 for line in body)
+    assert not any(re.search(r"\d[eE][-+]?\d", line) for line in body)
+    for line in body:  # every constant in an expression or on an axis word has a decimal point
+        if "#" in line or line.startswith(("G0", "G1 X")):
+            for num in re.findall(r"(?<![#\w.])(\d+\.?\d*)", line.split(" DO")[0]):
+                if not re.match(r"G\d", line) or line.find(num) > 2:
+                    assert "." in num, (num, line)
+    numbers = {int(v) for v in re.findall(r"#(\d+)", program.text)}
+    assert min(numbers) >= 100 and max(numbers) <= 199
+    assert max(int(d) for d in re.findall(r"DO(\d)", program.text)) == 2
+    assert all(len(line) <= 128 for line in lines)
+
+
+def test_fanuc_variable_base():
+    s = surface("paper-example-4")
+    text = macro_program(s, machine(dialect="fanuc"), RasterSpec(), FLAT, variable_base=500).text
+    numbers = {int(v) for v in re.findall(r"#(\d+)", text)}
+    assert min(numbers) == 500 and max(numbers) < 600
+    assert simulate(text, "fanuc", 8, max_blocks=50_000_000).moves
+    with pytest.raises(ProgramError, match="outside the ranges"):
+        macro_program(s, machine(dialect="fanuc"), RasterSpec(), FLAT, variable_base=190)
+
+
+def test_heidenhain_program_shape():
+    text = macro_program(surface("paper-example-2"), machine(dialect="heidenhain", program_number=7),
+                         RasterSpec("x", 1.0, 1.0), FLAT).text
+    lines = text.splitlines()
+    assert lines[0] == "0 BEGIN PGM 7 MM" and lines[-1].endswith("END PGM 7 MM")
+    assert [int(line.split()[0]) for line in lines] == list(range(len(lines)))
+    assert all(re.match(r"\d+ (FN \d+: |LBL |L |;|TOOL CALL|BEGIN|END)", line) for line in lines)
+    assert max(int(q) for q in re.findall(r"Q(\d+)", text)) <= 99
+
+
+def test_safe_z_below_the_path_is_refused():
+    with pytest.raises(ToolpathError, match=r"safe Z 50 mm is not above the highest point of the path, 71.38\d mm"):
+        macro_program(surface("paper-example-4"), MachineSettings(scale=20.0), RasterSpec("x", 5.0, 5.0), FLAT)
+
+
+def test_program_is_immutable_and_uses_line_ending():
+    program = macro_program(surface("paper-example-1"), machine(dialect="fanuc", line_ending="crlf"),
+                            RasterSpec(), FLAT)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        program.text = ""
+    assert program.text.count("\r\n") == program.text.count("\n")
+
+
+def test_inch_programs_are_in_inches():
+    s = surface("paper-example-1")
+    settings = machine(dialect="linuxcnc", units="inch", scale=25.4)
+    raster = RasterSpec("x", 12.7, 6.35)
+    program = macro_program(s, settings, raster, FLAT)
+    assert "G20" in program.text
+    got = simulate(program.text, "linuxcnc", 15).feed_points()[1:]
+    want = planned_points(s, settings, raster, FLAT)
+    np.testing.assert_allclose(got, want, atol=1e-4)
+    assert want[0].tolist() == pytest.approx([1.0, 2.0, 7.0])  # surface units are inches at scale 25.4
+
+
+def test_unknown_dialect_names_the_choices():
+    with pytest.raises(ToolpathError, match="fanuc, linuxcnc, heidenhain"):
+        macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
+
+
+# ---------------------------------------------------------------- command line
+
+def test_cli_macro_then_simulate(run_cli, tmp_path):
+    prog, moves = tmp_path / "O1000.nc", tmp_path / "moves.csv"
+    status, out, err = run_cli("macro", EXAMPLES / "paper-example-4.json", "--scale", 20, "--tool-diameter", 0,
+                               "--safe-z", 100,
+                               "--stepover", 2, "--step", 1, "--dialect", "fanuc", "--program", 1000,
+                               "-o", prog, "--stats")
+    assert status == 0, err
+    assert "macro program:" in out and "point-list program:" in out and "9600 baud" in out
+    assert prog.read_text().startswith("%\nO1000 ")
+    status, out, err = run_cli("simulate", prog, "--precision", 8, "-o", moves)
+    assert status == 0, err
+    rows = moves.read_text().splitlines()
+    assert rows[0] == "line,motion,x,y,z,feed" and "no alarm" in err
+    assert sum(1 for r in rows if ",G1," in r) == 41 * 81 + 1
+
+
+def test_cli_simulate_reports_an_alarm(run_cli, tmp_path):
+    prog = tmp_path / "bad.nc"
+    prog.write_text("%\nO1\nWHILE [1. LT 2.] DO1\nG1 X1. Y1. Z1. F1.\n%\n")
+    status, out, err = run_cli("simulate", prog)
+    assert status == 2 and "alarm 124" in err
+
+
+def test_cli_macro_refuses_with_exit_2(run_cli, tmp_path):
+    rng = random.Random(3)
+    pts = [[i * 5, k * 5, rng.randint(0, 5000) / 100] for i in range(9) for k in range(9)]
+    f = tmp_path / "big.json"
+    f.write_text(json.dumps({"points": pts}))
+    status, out, err = run_cli("macro", f, "--dialect", "fanuc", "--form", "horner", "--tool-diameter", 0, "--safe-z", 900,
+                               "--stepover", 5, "--step", 5)
+    assert status == 2 and "predicted to be off by" in err
+
+
+# ---------------------------------------------------------------- ball-end cutter
+
+BALL = Tool("ball", 4.0)
+
+
+@pytest.mark.parametrize("direction", ["x", "y"])
+def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, direction):
+    s = surface("paper-example-4")
+    settings = machine(dialect="linuxcnc", scale=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
+    raster = RasterSpec(direction, 5.0, 2.0)
+    path = tmp_path / "ball.ngc"
+    path.write_text(macro_program(s, settings, raster, BALL).text)
+    got = feeds(rs274.run(path).stdout)[1:]
+    want = planned_points(s, settings, raster, BALL)
+    np.testing.assert_allclose(got, want, atol=1e-3, rtol=0)
+
+
+@pytest.mark.parametrize("form", ["horner", "lagrange"])
+@pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
+def test_ball_end_macro_through_the_simulator(dialect, form):
+    s = surface("paper-example-3")
+    settings = machine(dialect=dialect, scale=25.0)
+    raster = RasterSpec("y", 12.0, 5.0)
+    program = macro_program(s, settings, raster, BALL, form=form)
+    got = simulate(program.text, dialect, 8).feed_points()[1:]
+    np.testing.assert_allclose(got, planned_points(s, settings, raster, BALL), atol=1e-3, rtol=0)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
+def test_ball_end_7x7_program_raises_no_alarm(dialect):
+    """The largest program lagsym writes at 8 digits keeps every control limit (brackets, blocks, digits, variables)."""
+    nodes = [Fraction(10 * i) for i in range(7)]
+    z = [[Fraction(round(300 * np.sin(i / 2) + 200 * np.cos(k / 3)), 100) for k in range(7)] for i in range(7)]
+    s = lagrange_surface(grid_from_table(nodes, nodes, z))
+    settings = machine(dialect=dialect)
+    raster = RasterSpec("y", 5.0, 3.0)
+    program = macro_program(s, settings, raster, Tool("ball", 6.0))
+    got = simulate(program.text, dialect, 8).feed_points()[1:]
+    np.testing.assert_allclose(got, planned_points(s, settings, raster, Tool("ball", 6.0)), atol=1e-3, rtol=0)
+
+
+def test_cli_simulate_missing_file(run_cli, tmp_path):
+    status, out, err = run_cli("simulate", tmp_path / "nope.nc")
+    assert status == 2 and out == "" and err.strip().endswith("nope.nc: no such file")
+
+
+def test_ball_end_tip_is_one_radius_off_the_surface():
+    s = surface("paper-example-4")
+    settings = machine(scale=20.0)
+    tips = planned_points(s, settings, RasterSpec("x", 10.0, 4.0), BALL)
+    centres = tips + [0.0, 0.0, 2.0]
+    xs = np.linspace(20.0, 100.0, 401)
+    X, Y = np.meshgrid(xs, xs)
+    cloud = np.column_stack([X.ravel(), Y.ravel(), 20.0 * s.evaluate(X.ravel() / 20.0, Y.ravel() / 20.0)])
+    # away from the box edges, where the sampled surface ends
+    inner = [c for c in centres if 25 < c[0] < 95 and 25 < c[1] < 95]
+    near = [np.min(np.linalg.norm(cloud - c, axis=1)) for c in inner[::4]]
+    assert len(near) > 20
+    assert min(near) == pytest.approx(2.0, abs=0.01)  # never closer than the radius: no gouge
+    assert max(near) == pytest.approx(2.0, abs=0.01)  # and touching
+
+
+def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
+    from lagsym.macro.model import decimal_context, run
+    from lagsym.lagrange import X, Y
+
+    s = surface("paper-example-3")
+    plan = macro_plan(s, machine(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
+    ctx = decimal_context(30)
+    env = run(plan.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
+    env["p"] = ctx.create_decimal("1.75")
+    run(plan.point_code, env, ctx)
+    fx = s.derivative(1, 0).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
+    fy = s.derivative(0, 1).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
+    assert float(env["zp"]) == pytest.approx(float(fx), rel=1e-20, abs=1e-20)
+    assert float(env["zr"]) == pytest.approx(float(fy), rel=1e-20, abs=1e-20)
+
+
+def test_ball_end_gouge_is_refused_with_a_suggestion():
+    s = surface("paper-example-4")
+    expected = r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"
+    with pytest.raises(ToolpathError, match=expected):
+        macro_program(s, machine(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
+
+
+def test_flat_tool_and_zero_diameter_program_the_surface():
+    s = surface("paper-example-1")
+    a = macro_program(s, machine(), RasterSpec(), Tool("flat", 10.0)).text
+    b = macro_program(s, machine(), RasterSpec(), Tool("ball", 0.0)).text
+    assert a == b and "SQRT" not in a
