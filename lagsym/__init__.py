@@ -23,7 +23,9 @@ from .formula import Formula, parse_formula
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
 from .io import read_any_points, read_curve_points, read_points
 from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
+from .macro import MacroProgram, macro_program, planned_points, predicted_error, program_stats
 from .sampling import Sample, SampleGrid, sample, sample_grid
+from .simulate import ControlAlarm, Simulation, simulate
 from .surfaces import bezier_surface, bspline_surface, hermite_surface, make_surface
 
 __version__ = "0.1.0"
@@ -47,6 +49,14 @@ __all__ = [
     "sample_grid",
     "surface_evaluator",
     "write_sample",
+    "ControlAlarm",
+    "MacroProgram",
+    "Simulation",
+    "macro_program",
+    "planned_points",
+    "predicted_error",
+    "program_stats",
+    "simulate",
     "ControlGrid",
     "CurvePoints",
     "ExitStatus",

@@ -95,6 +95,8 @@ def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str
              kind: str = "horner") -> RowForm:
     """The normalized Horner form of ``surface`` in program units, for rows along ``direction``.
 
+    Examples
+    --------
     >>> from lagsym.grid import grid_from_table
     >>> from lagsym.lagrange import lagrange_surface
     >>> f = row_form(lagrange_surface(grid_from_table([0, 2], [0, 1], [[0, 1], [2, 3]])), MachineSettings())
@@ -174,6 +176,8 @@ def _dot(target: Var, terms, chunk: int = 4) -> list[Assign]:
 def differentiation_matrix(nodes) -> list[list[Fraction]]:
     """``D[i][j] = L_j'(t_i)``: derivative values at the nodes from values at the nodes, exact.
 
+    Examples
+    --------
     >>> differentiation_matrix([-1, 0, 1])[1]
     [Fraction(-1, 2), Fraction(0, 1), Fraction(1, 2)]
     """

@@ -138,6 +138,8 @@ def written(value: Fraction, digits: int) -> Decimal:
     so a small constant keeps fewer significant digits: 1/3 is 0.33333333,
     1/3000 is 0.00033333.
 
+    Examples
+    --------
     >>> written(Fraction(1, 3), 8), written(Fraction(1, 3000), 8), written(Fraction(-400, 3), 8)
     (Decimal('0.33333333'), Decimal('0.00033333'), Decimal('-133.33333'))
     """

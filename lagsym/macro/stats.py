@@ -23,6 +23,8 @@ BITS_PER_CHAR_7E2 = 11  # start bit, 7 data bits, even parity, 2 stop bits
 def transfer_seconds(size_bytes: int, baud: int = 9600, bits_per_char: int = BITS_PER_CHAR_7E2) -> float:
     """Seconds to send ``size_bytes`` characters at ``baud`` (7E2: 11 bits a character).
 
+    Examples
+    --------
     >>> round(transfer_seconds(9600), 1)
     11.0
     """
@@ -41,6 +43,8 @@ def _width(values: np.ndarray, decimals: int) -> int:
 def point_list_size(points: np.ndarray, decimals: int = 3, eol: str = "\n", overhead: int = 0) -> int:
     """Bytes of a plain point list: ``G1 X.. Y.. Z..`` and a line ending per point, plus ``overhead``.
 
+    Examples
+    --------
     >>> point_list_size(np.array([[1.0, 2.0, -0.5]]), 3)
     25
     """
