@@ -1,0 +1,533 @@
+"""Raster toolpaths with gouge-free cutter locations.
+
+The pipeline follows OpenCAMLib's four steps, each its own function:
+
+1. **path pattern** (:func:`raster_pattern`): a zig-zag of rows along x or y
+   over the control points' box, side step and forward step in millimetres;
+2. **cutter locations** (:func:`drop_cutter`): at each ``(x, y)`` the tool is
+   lowered until it touches the exact surface anywhere under it;
+3. **filtering** (:func:`filter_rows`): with a chordal tolerance, points whose
+   removal keeps the moves within the tolerance of the true cutter path go;
+4. the program text, in :mod:`lagsym.post`.
+
+Terms are used as in CAM: the *cutter location* (CL) is the programmed point,
+here the tool tip; the *cutter contact* (CC) point is where the tool touches
+the surface.
+
+Drop-cutter
+-----------
+For a ball of radius ``R`` centred over ``c = (cx, cy)`` the tip height is
+
+    CL(c) = max over p in D(c, R) ∩ B of  F(p) + sqrt(R**2 - |p - c|**2) - R,
+
+and for a flat end ``max F(p)`` over the same set; ``D`` is the disc under the
+tool and ``B`` the box spanned by the control points.  Only the surface inside
+the box counts: the polynomial is never evaluated outside it (beyond the box
+lies no part, not a cliff and not an extrapolated surface), so near an edge the
+tool rests on what lies inside.  The maximum is found by a dense lattice of
+candidate contact points in the disc, then a pattern search from the best few
+candidates that shrinks to ``1e-7`` of the tool radius (an error of order
+``1e-14`` radius in height at a smooth maximum).  Every value found is
+the height of a real contact, so it can only err low; :data:`CL_MARGIN` (a
+relative ``1e-9``) is added to absorb that rounding.  No normal offset is
+involved, so concave regions tighter than the tool are handled: the tool rests
+on the two walls instead of cutting into them.
+
+Chordal error
+-------------
+Between two cutter locations the control moves in a straight line, which cuts
+below the true cutter path over convex regions.  Each row is therefore sampled
+more finely than it is emitted; the largest sag of every move below the finely
+sampled cutter path is measured and both ends of the move are lifted by it.
+Emitted points thus lie on or above the exact drop-cutter value and at most the
+chordal error (the tolerance, when one is given) above it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.polynomial import polynomial as P
+
+from .errors import ToolpathError
+from .machine import MachineSettings, RasterSpec, Tool
+
+__all__ = [
+    "Toolpath",
+    "SurfaceEvaluator",
+    "raster_pattern",
+    "drop_cutter",
+    "filter_rows",
+    "scallop_stepover",
+    "plan_toolpath",
+    "CL_MARGIN",
+]
+
+CL_MARGIN = 1e-9
+"""Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
+
+_CHUNK = 1 << 15
+
+
+def _readonly(a) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+class SurfaceEvaluator:
+    """Value of a Lagrange surface at scattered points, fast, from its exact coefficients.
+
+    The exact power-basis coefficients are first re-expressed, exactly, in the
+    normalised variables ``u, v`` that map the box onto ``[-1, 1]**2``; only
+    then are they rounded to floats.  Evaluation in ``u, v`` is well conditioned
+    for the degrees lagsym handles, unlike the raw power basis over a box far
+    from the origin.
+    """
+
+    def __init__(self, surface):
+        from fractions import Fraction
+
+        x0, x1, y0, y1 = surface.grid.bounds
+        mx, hx = (x0 + x1) / 2, (x1 - x0) / 2
+        my, hy = (y0 + y1) / 2, (y1 - y0) / 2
+        c = surface.coefficients
+        n, m = len(c), len(c[0])
+
+        def shift(mid, half, deg):
+            s = [[Fraction(0)] * deg for _ in range(deg)]
+            for a in range(deg):
+                for k in range(a + 1):
+                    s[a][k] = math.comb(a, k) * mid ** (a - k) * half ** k
+            return s
+
+        sx, sy = shift(mx, hx, n), shift(my, hy, m)
+        # d[k][l] = sum_ab sx[a][k] c[a][b] sy[b][l], exactly.
+        t = [[sum(sx[a][k] * c[a][b] for a in range(n)) for b in range(m)] for k in range(n)]
+        d = [[sum(t[k][b] * sy[b][l] for b in range(m)) for l in range(m)] for k in range(n)]
+        self.coef = np.array([[float(v) for v in row] for row in d])
+        self.coef.setflags(write=False)
+        self.mid = (float(mx), float(my))
+        self.half = (float(hx), float(hy))
+        self.bounds = tuple(float(v) for v in surface.grid.bounds)
+
+    def __call__(self, x, y) -> np.ndarray:
+        """``F(x, y)``; ``x`` and ``y`` broadcast together."""
+        u = (np.asarray(x, dtype=float) - self.mid[0]) / self.half[0]
+        v = (np.asarray(y, dtype=float) - self.mid[1]) / self.half[1]
+        return P.polyval2d(u, v, self.coef)
+
+    def curvature_bound(self, samples: int = 41) -> float:
+        """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on a sample grid (per surface unit)."""
+        u = np.linspace(-1.0, 1.0, samples)
+        uu, vv = np.meshgrid(u, u, indexing="ij")
+        hx, hy = self.half
+        out = 0.0
+        for dx, dy, s in ((2, 0, hx * hx), (0, 2, hy * hy), (1, 1, hx * hy)):
+            c = P.polyder(P.polyder(self.coef, dx, axis=0), dy, axis=1) if (dx or dy) else self.coef
+            if c.size:
+                out = max(out, float(np.abs(P.polyval2d(uu, vv, c)).max()) / s)
+        return out
+
+
+def _lattice(radius: float, spacing: float) -> np.ndarray:
+    """Offsets of a square lattice inside the disc, plus points on its rim (for a flat end)."""
+    k = max(int(math.ceil(radius / spacing)), 1)
+    t = np.linspace(-radius, radius, 2 * k + 1)
+    gx, gy = np.meshgrid(t, t, indexing="ij")
+    inside = gx**2 + gy**2 <= radius**2 * (1 + 1e-12)
+    rim_n = max(8 * k, 16)
+    a = np.linspace(0.0, 2 * math.pi, rim_n, endpoint=False)
+    pts = np.concatenate([np.stack([gx[inside], gy[inside]], axis=1), radius * np.stack([np.cos(a), np.sin(a)], axis=1)])
+    return pts
+
+
+def _project(px, py, cx, cy, radius, box):
+    """Move candidate contact points into the box, then into the disc (the box is convex and holds the centre)."""
+    x0, x1, y0, y1 = box
+    px = np.clip(px, x0, x1)
+    py = np.clip(py, y0, y1)
+    dx, dy = px - cx, py - cy
+    d2 = dx * dx + dy * dy
+    over = d2 > radius * radius
+    if np.any(over):
+        f = np.where(over, radius / np.sqrt(np.where(over, d2, 1.0)), 1.0)
+        px, py = cx + dx * f, cy + dy * f
+        dx, dy = px - cx, py - cy
+        d2 = dx * dx + dy * dy
+    return px, py, d2
+
+
+def _height(ev, px, py, d2, radius, shape):
+    z = ev(px, py)
+    if shape == "ball":
+        z = z + np.sqrt(np.maximum(radius * radius - d2, 0.0)) - radius
+    return z
+
+
+def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 2,
+                evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+    """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+        The exact surface; only its part inside the control points' box counts.
+    x, y : array_like
+        Tool axis positions in surface units, inside the box.
+    radius : float
+        Tool radius in surface units (0: a point, the surface itself).
+    shape : {"ball", "flat"}
+        Cutter shape.
+    lattice : int
+        Candidate contact points per tool radius in the first, dense search.
+    starts : int
+        How many of the best candidates the local search refines.
+
+    Returns
+    -------
+    numpy.ndarray
+        Tip heights, shape of ``x`` broadcast with ``y``; never below the exact
+        drop-cutter value, above it by at most :data:`CL_MARGIN` relative.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 0), (0, 2, 0), (2, 0, 0), (2, 2, 0)]))
+    >>> round(float(drop_cutter(s, 1.0, 1.0, 0.5)), 6)
+    0.0
+    """
+    ev = evaluator or SurfaceEvaluator(surface)
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    shape_out = x.shape
+    cx, cy = x.ravel(), y.ravel()
+    box = ev.bounds
+    x0, x1, y0, y1 = box
+    eps_box = 1e-9 * max(x1 - x0, y1 - y0)
+    if np.any((cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)):
+        bad = int(np.flatnonzero((cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box))[0])
+        raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+    cx, cy = np.clip(cx, x0, x1), np.clip(cy, y0, y1)
+    radius = float(radius)
+    if radius < 0:
+        raise ToolpathError(f"tool radius {radius!r} must not be negative")
+    if radius == 0:
+        return ev(cx, cy).reshape(shape_out)
+    if shape not in ("ball", "flat"):
+        raise ToolpathError(f"tool shape {shape!r} is not one of ball, flat")
+    deg = max(len(ev.coef), len(ev.coef[0]), 2)
+    feature = min(x1 - x0, y1 - y0) / (2 * deg)
+    spacing = min(radius / lattice, feature / 2)
+    spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
+    offsets = _lattice(radius, spacing)
+    span = float(np.ptp(ev.coef)) + radius + 1.0
+    out = np.empty(cx.size)
+    for s in range(0, cx.size, _CHUNK):
+        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets, spacing,
+                                        starts, box)
+    return (out + CL_MARGIN * span).reshape(shape_out)
+
+
+_DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)], dtype=float)
+
+
+def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
+    n, k = cx.size, len(offsets)
+    best_val = np.full(n, -np.inf)
+    # Dense candidates, a block of offsets at a time to bound memory.
+    block = max(1, (1 << 22) // max(n, 1))
+    cand_val = np.empty((n, k))
+    cand_px = np.empty((n, k))
+    cand_py = np.empty((n, k))
+    for s in range(0, k, block):
+        ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
+        px, py, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
+        cand_val[:, s:s + block] = _height(ev, px, py, d2, radius, shape)
+        cand_px[:, s:s + block], cand_py[:, s:s + block] = px, py
+    order = np.argsort(-cand_val, axis=1)[:, :starts]
+    rows = np.arange(n)[:, None]
+    px = cand_px[rows, order].ravel()
+    py = cand_py[rows, order].ravel()
+    val = cand_val[rows, order].ravel()
+    ccx, ccy = np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1])
+    h = np.full(px.size, spacing)
+    stop = radius * 1e-7
+    for _ in range(80):
+        active = h > stop
+        if not active.any():
+            break
+        ia = np.flatnonzero(active)
+        qx = px[ia, None] + h[ia, None] * _DIRS[:, 0]
+        qy = py[ia, None] + h[ia, None] * _DIRS[:, 1]
+        qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
+        qv = _height(ev, qx, qy, d2, radius, shape)
+        j = np.argmax(qv, axis=1)
+        bv = qv[np.arange(ia.size), j]
+        up = bv > val[ia]
+        iu = ia[up]
+        px[iu], py[iu], val[iu] = qx[up, j[up]], qy[up, j[up]], bv[up]
+        h[ia[~up]] *= 0.5
+    best_val = np.maximum(best_val, val.reshape(n, -1).max(axis=1))
+    return np.maximum(best_val, cand_val.max(axis=1))
+
+
+def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
+    """Side step of a ball-end cutter that leaves cusps ``scallop_mm`` high on a flat floor.
+
+    ``2 * sqrt(2 R h - h**2)``, from the circle of the ball over the cusp.
+
+    >>> round(scallop_stepover(3.0, 0.01), 4)
+    0.4895
+    """
+    r, h = float(radius_mm), float(scallop_mm)
+    if r <= 0:
+        raise ToolpathError("a scallop height needs a ball-end cutter with a diameter above 0")
+    if h >= r:
+        raise ToolpathError(f"scallop height {h:g} mm must be less than the tool radius {r:g} mm")
+    return 2.0 * math.sqrt(2.0 * r * h - h * h)
+
+
+def _levels(lo: float, hi: float, step: float) -> np.ndarray:
+    count = max(int(math.ceil((hi - lo) / step - 1e-9)), 1)
+    return np.linspace(lo, hi, count + 1)
+
+
+def raster_pattern(bounds, direction: str, stepover: float, step: float):
+    """A zig-zag over ``bounds`` = ``(x0, x1, y0, y1)``: row levels and along-row positions.
+
+    Rows run along ``direction``; both are evenly spaced, never wider than the
+    steps given, and include the box edges.  Odd rows run backwards.
+
+    Returns
+    -------
+    levels : ndarray
+        Cross coordinate of each row.
+    along : ndarray
+        Positions along a row (forwards).
+    """
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    if direction == "x":
+        return _levels(y0, y1, stepover), _levels(x0, x1, step)
+    return _levels(x0, x1, stepover), _levels(y0, y1, step)
+
+
+def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float) -> np.ndarray:
+    """Indices of the points of one row to keep so that straight moves stay within ``tolerance`` of ``z``.
+
+    Greedy, as OpenCAMLib's line filter: from each kept point the move reaches
+    as far as every skipped point lies within ``tolerance`` (vertically) of it.
+    The first and last points are always kept.
+    """
+    n = len(along)
+    keep = [0]
+    i = 0
+    while i < n - 1:
+        lo, hi = i + 1, min(n - 1, i + 2)
+        # Grow the reach by doubling, then bisect back to the last good end.
+        while hi < n - 1 and _within(along, z, i, hi, tolerance):
+            lo, hi = hi, min(n - 1, i + 2 * (hi - i))
+        if _within(along, z, i, hi, tolerance):
+            lo = hi
+        else:
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if _within(along, z, i, mid, tolerance):
+                    lo = mid
+                else:
+                    hi = mid
+        keep.append(lo)
+        i = lo
+    return np.array(keep, dtype=int)
+
+
+def _within(t, z, i, j, tol):
+    if j - i < 2:
+        return True
+    s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
+    chord = z[i] + s * (z[j] - z[i])
+    return bool(np.all(np.abs(z[i + 1:j] - chord) <= tol))
+
+
+def _sag(t, z, keep):
+    """Largest height of the fine cutter path above each kept move (0 where the move lies above it)."""
+    sag = np.zeros(len(keep) - 1)
+    for m, (i, j) in enumerate(zip(keep[:-1], keep[1:])):
+        if j - i >= 2:
+            s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
+            chord = z[i] + s * (z[j] - z[i])
+            sag[m] = max(0.0, float(np.max(z[i + 1:j] - chord)))
+    return sag
+
+
+@dataclass(frozen=True)
+class Toolpath:
+    """A planned zig-zag: cutter locations (tool tip) in machine millimetres, in cutting order.
+
+    Attributes
+    ----------
+    points_mm : ndarray, shape (N, 3)
+        Programmed tip positions X, Y, Z in mm, work offset and stock included;
+        read-only.
+    rows : ndarray, shape (N,)
+        Row number of each point; read-only.
+    exact_mm : ndarray, shape (N,)
+        The drop-cutter height at each point before the lift for chordal
+        error; ``points_mm[:, 2] - exact_mm`` is that lift (0 or more).
+    tool : Tool
+    raster : RasterSpec
+    stepover_mm, step_mm : float
+        The side step and sampling step actually used.
+    """
+
+    points_mm: np.ndarray
+    rows: np.ndarray
+    exact_mm: np.ndarray
+    tool: Tool
+    raster: RasterSpec
+    stepover_mm: float
+    step_mm: float
+    bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+
+    def __post_init__(self):
+        for name in ("points_mm", "rows", "exact_mm"):
+            a = np.array(getattr(self, name))
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+
+    def __len__(self) -> int:
+        return len(self.points_mm)
+
+    @property
+    def lift_mm(self) -> np.ndarray:
+        """How far each point was raised above its drop-cutter value to keep the moves above the cutter path."""
+        return self.points_mm[:, 2] - self.exact_mm
+
+
+def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
+                  evaluator: SurfaceEvaluator | None = None) -> Toolpath:
+    """Plan a zig-zag raster of gouge-free cutter locations over the surface.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+        The exact surface; lengths in its units become mm by ``settings.scale``.
+    tool : Tool
+        Cutter shape and diameter (mm).
+    raster : RasterSpec
+        Direction and steps (mm), or scallop height and chordal tolerance.
+    settings : MachineSettings
+        Scale, work offset and stock to leave.
+
+    Returns
+    -------
+    Toolpath
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 1, 1), (1, 0, 1), (1, 1, 1)]))
+    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(scale=1.0))
+    >>> tp.points_mm.tolist()
+    [[0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.5, 1.0], [0.5, 0.5, 1.0], [0.0, 0.5, 1.0], [0.0, 1.0, 1.0], [0.5, 1.0, 1.0], [1.0, 1.0, 1.0]]
+    """
+    ev = evaluator or SurfaceEvaluator(surface)
+    scale = settings.scale
+    r_mm = tool.radius_mm
+    stock = settings.stock_to_leave_mm
+    if raster.stepover_mm is not None:
+        stepover = raster.stepover_mm
+    else:
+        if tool.shape != "ball":
+            raise ToolpathError("a scallop height (--scallop) needs a ball-end cutter; give --stepover for a flat end")
+        stepover = scallop_stepover(r_mm, raster.scallop_mm)
+    tol = raster.tolerance_mm
+    if raster.step_mm is not None:
+        step = raster.step_mm
+        fine = step / 4.0 if tol is None else min(step, _tolerance_step(ev, tol, scale))
+    else:
+        fine = _tolerance_step(ev, tol, scale)
+        step = fine
+    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / scale, fine / scale)
+    emit_every = None
+    if tol is None:
+        # Fixed forward step: a fine sample halfway along each move measures its sag.
+        emit_every = 2
+        n = len(_levels(along[0], along[-1], step / scale)) - 1
+        along = np.linspace(along[0], along[-1], n * emit_every + 1)
+    # Drop the tool over every fine sample of every row, and over the links between rows.
+    r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / scale
+    a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
+    xs, ys = (a_grid, l_grid) if raster.direction == "x" else (l_grid, a_grid)
+    z_rows = drop_cutter(surface, xs, ys, r, tool.shape, evaluator=ev)
+    lift_tip = r - r_mm / scale if tool.shape == "ball" else stock / scale
+    z_rows = (z_rows + lift_tip) * scale  # tool tip, mm
+    pts, rows, exact = [], [], []
+    ox, oy, oz = settings.origin_mm
+    link_n = 4
+    for i in range(len(levels)):
+        fwd = i % 2 == 0
+        t = along if fwd else along[::-1]
+        zr = z_rows[i] if fwd else z_rows[i][::-1]
+        if emit_every is not None:
+            keep = np.arange(0, len(t), emit_every)
+        else:
+            keep = filter_rows(t * scale, zr, tol)
+        seg = [(t, zr, keep)]
+        if i + 1 < len(levels):
+            end = t[-1]
+            lv = np.linspace(levels[i], levels[i + 1], link_n + 1)
+            lx, ly = (np.full_like(lv, end), lv) if raster.direction == "x" else (lv, np.full_like(lv, end))
+            zl = drop_cutter(surface, lx, ly, r, tool.shape, evaluator=ev)
+            zl = (zl + lift_tip) * scale
+            seg.append((lv, zl, np.array([0, link_n])))
+        lift_row = None
+        for j, (tt, zz, kk) in enumerate(seg):
+            sag = _sag(tt * scale, zz, kk)
+            lift = np.zeros(len(kk))
+            lift[:-1] = np.maximum(lift[:-1], sag)
+            lift[1:] = np.maximum(lift[1:], sag)
+            if j == 0:
+                lift_row = lift
+                row_t, row_z, row_k = tt, zz, kk
+            else:
+                # The link starts at the row's last point and ends at the next row's first point.
+                lift_row[-1] = max(lift_row[-1], lift[0])
+                link_lift_end = lift[-1]
+        a = row_t[row_k]
+        zc = row_z[row_k]
+        if raster.direction == "x":
+            x, y = a, np.full_like(a, levels[i])
+        else:
+            x, y = np.full_like(a, levels[i]), a
+        if i > 0 and pts:
+            lift_row[0] = max(lift_row[0], pending)
+        pending = link_lift_end if i + 1 < len(levels) else 0.0
+        pts.append(np.stack([x * scale + ox, y * scale + oy, zc + lift_row + oz], axis=1))
+        exact.append(zc + oz)
+        rows.append(np.full(len(a), i))
+    b = ev.bounds
+    return Toolpath(
+        points_mm=np.concatenate(pts),
+        rows=np.concatenate(rows),
+        exact_mm=np.concatenate(exact),
+        tool=tool,
+        raster=raster,
+        stepover_mm=float((levels[1] - levels[0]) * scale) if len(levels) > 1 else float(stepover),
+        step_mm=float(step),
+        bounds_mm=(b[0] * scale + ox, b[1] * scale + ox, b[2] * scale + oy, b[3] * scale + oy),
+    )
+
+
+def _tolerance_step(ev: SurfaceEvaluator, tol: float, scale: float) -> float:
+    """A sampling step whose own chordal error on the surface is a quarter of ``tol`` (mm)."""
+    kappa = ev.curvature_bound() / scale  # 1/mm
+    x0, x1, y0, y1 = ev.bounds
+    longest = max(x1 - x0, y1 - y0) * scale
+    if kappa <= 0:
+        return longest / 4
+    return float(min(math.sqrt(2.0 * tol / kappa), longest / 4))
