@@ -26,10 +26,11 @@ the box counts: the polynomial is never evaluated outside it (beyond the box
 lies no part, not a cliff and not an extrapolated surface), so near an edge the
 tool rests on what lies inside.  The maximum is found by a dense lattice of
 candidate contact points in the disc, then a pattern search from the best few
-candidates that shrinks to ``1e-7`` of the tool radius (an error of order
-``1e-14`` radius in height at a smooth maximum).  Every value found is
+candidates that shrinks to ``1e-9`` of the tool radius (where the maximum lies on
+the rim or on a box edge the height converges only as fast as the step).  Every value found is
 the height of a real contact, so it can only err low; :data:`CL_MARGIN` (a
-relative ``1e-9``) is added to absorb that rounding.  No normal offset is
+relative ``1e-7``, far below any program's resolution) is added to absorb
+that error.  No normal offset is
 involved, so concave regions tighter than the tool are handled: the tool rests
 on the two walls instead of cutting into them.
 
@@ -65,7 +66,7 @@ __all__ = [
     "CL_MARGIN",
 ]
 
-CL_MARGIN = 1e-9
+CL_MARGIN = 1e-7
 """Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
 
 _CHUNK = 1 << 15
@@ -160,6 +161,28 @@ def _project(px, py, cx, cy, radius, box):
     return px, py, d2
 
 
+def _edge_points(cx, cy, radius, box):
+    """Box corners, and for each box edge the foot of the perpendicular from the centre and the rim crossings."""
+    x0, x1, y0, y1 = box
+    n = cx.size
+    xs, ys = [], []
+    for a in (x0, x1):
+        for b in (y0, y1):
+            xs.append(np.full(n, a))
+            ys.append(np.full(n, b))
+    for a in (x0, x1):  # vertical edges
+        w = np.sqrt(np.maximum(radius**2 - (cx - a) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(np.full(n, a))
+            ys.append(cy + off * w)
+    for b in (y0, y1):  # horizontal edges
+        w = np.sqrt(np.maximum(radius**2 - (cy - b) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(cx + off * w)
+            ys.append(np.full(n, b))
+    return np.stack(xs, axis=1), np.stack(ys, axis=1)
+
+
 def _height(ev, px, py, d2, radius, shape):
     z = ev(px, py)
     if shape == "ball":
@@ -168,7 +191,7 @@ def _height(ev, px, py, d2, radius, shape):
 
 
 def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 2,
-                evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+                margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
     Parameters
@@ -185,6 +208,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
         Candidate contact points per tool radius in the first, dense search.
     starts : int
         How many of the best candidates the local search refines.
+    margin : bool
+        Add :data:`CL_MARGIN`; without it the value is the best contact found,
+        a lower bound of the exact one.
 
     Returns
     -------
@@ -229,10 +255,11 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     for s in range(0, cx.size, _CHUNK):
         out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets, spacing,
                                         starts, box)
-    return (out + CL_MARGIN * span).reshape(shape_out)
+    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
-_DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)], dtype=float)
+_DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1)], dtype=float)
+_SIGNS = np.array([1.0, -1.0])[None, :, None]
 
 
 def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
@@ -248,6 +275,12 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
         px, py, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
         cand_val[:, s:s + block] = _height(ev, px, py, d2, radius, shape)
         cand_px[:, s:s + block], cand_py[:, s:s + block] = px, py
+    # The corners of the region under the tool: box corners, and where the rim crosses a box edge.
+    ex, ey = _edge_points(cx, cy, radius, box)
+    px, py, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
+    cand_val = np.concatenate([cand_val, _height(ev, px, py, d2, radius, shape)], axis=1)
+    cand_px = np.concatenate([cand_px, px], axis=1)
+    cand_py = np.concatenate([cand_py, py], axis=1)
     order = np.argsort(-cand_val, axis=1)[:, :starts]
     rows = np.arange(n)[:, None]
     px = cand_px[rows, order].ravel()
@@ -255,22 +288,35 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
     val = cand_val[rows, order].ravel()
     ccx, ccy = np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1])
     h = np.full(px.size, spacing)
-    stop = radius * 1e-7
-    for _ in range(80):
+    stop = radius * 1e-9
+    for _ in range(120):
         active = h > stop
         if not active.any():
             break
         ia = np.flatnonzero(active)
-        qx = px[ia, None] + h[ia, None] * _DIRS[:, 0]
-        qy = py[ia, None] + h[ia, None] * _DIRS[:, 1]
+        # Axis steps follow the box edges; radial and tangential steps follow the rim of the disc.
+        ox, oy = px[ia] - ccx[ia], py[ia] - ccy[ia]
+        norm = np.hypot(ox, oy)
+        norm = np.where(norm > 0, norm, 1.0)
+        er = np.stack([ox / norm, oy / norm], axis=1)
+        et = np.stack([-er[:, 1], er[:, 0]], axis=1)
+        dirs = np.concatenate([np.broadcast_to(_DIRS[None, :, :], (ia.size, 4, 2)),
+                               er[:, None, :] * _SIGNS, et[:, None, :] * _SIGNS], axis=1)
+        qx = px[ia, None] + h[ia, None] * dirs[:, :, 0]
+        qy = py[ia, None] + h[ia, None] * dirs[:, :, 1]
         qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
         qv = _height(ev, qx, qy, d2, radius, shape)
         j = np.argmax(qv, axis=1)
         bv = qv[np.arange(ia.size), j]
         up = bv > val[ia]
         iu = ia[up]
-        px[iu], py[iu], val[iu] = qx[up, j[up]], qy[up, j[up]], bv[up]
+        nx, ny = qx[up, j[up]], qy[up, j[up]]
+        # A step the projection shortened to a creep along a constraint counts as a failure too:
+        # shrinking lets the steps along the rim or edge stop overshooting the maximum.
+        creep = np.hypot(nx - px[iu], ny - py[iu]) < 0.25 * h[iu]
+        px[iu], py[iu], val[iu] = nx, ny, bv[up]
         h[ia[~up]] *= 0.5
+        h[iu[creep]] *= 0.5
     best_val = np.maximum(best_val, val.reshape(n, -1).max(axis=1))
     return np.maximum(best_val, cand_val.max(axis=1))
 
@@ -459,62 +505,68 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         emit_every = 2
         n = len(_levels(along[0], along[-1], step / scale)) - 1
         along = np.linspace(along[0], along[-1], n * emit_every + 1)
-    # Drop the tool over every fine sample of every row, and over the links between rows.
+    # Drop the tool over every fine sample of every row and of the links between rows.
     r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / scale
+    lift_tip = r - r_mm / scale if tool.shape == "ball" else stock / scale
     a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
     xs, ys = (a_grid, l_grid) if raster.direction == "x" else (l_grid, a_grid)
-    z_rows = drop_cutter(surface, xs, ys, r, tool.shape, evaluator=ev)
-    lift_tip = r - r_mm / scale if tool.shape == "ball" else stock / scale
-    z_rows = (z_rows + lift_tip) * scale  # tool tip, mm
-    pts, rows, exact = [], [], []
-    ox, oy, oz = settings.origin_mm
-    link_n = 4
+    z_rows = (drop_cutter(surface, xs, ys, r, tool.shape, evaluator=ev) + lift_tip) * scale  # tool tip, mm
+    gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
+    link_n = max(2, 2 * int(math.ceil(gap * scale / fine / 2)))
+    u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
+    ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
+    link_a = np.repeat(ends, len(u))
+    link_l = (levels[:-1, None] + u[None, :] * gap).ravel()
+    lx, ly = (link_a, link_l) if raster.direction == "x" else (link_l, link_a)
+    z_links = ((drop_cutter(surface, lx, ly, r, tool.shape, evaluator=ev) + lift_tip) * scale
+               if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
+    # One fine polyline through all rows and links, then the points to emit on it.
+    fa, fl, fz, frow, keep = [], [], [], [], []
+    count = 0
     for i in range(len(levels)):
         fwd = i % 2 == 0
         t = along if fwd else along[::-1]
-        zr = z_rows[i] if fwd else z_rows[i][::-1]
-        if emit_every is not None:
-            keep = np.arange(0, len(t), emit_every)
-        else:
-            keep = filter_rows(t * scale, zr, tol)
-        seg = [(t, zr, keep)]
+        piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
         if i + 1 < len(levels):
-            end = t[-1]
-            lv = np.linspace(levels[i], levels[i + 1], link_n + 1)
-            lx, ly = (np.full_like(lv, end), lv) if raster.direction == "x" else (lv, np.full_like(lv, end))
-            zl = drop_cutter(surface, lx, ly, r, tool.shape, evaluator=ev)
-            zl = (zl + lift_tip) * scale
-            seg.append((lv, zl, np.array([0, link_n])))
-        lift_row = None
-        for j, (tt, zz, kk) in enumerate(seg):
-            sag = _sag(tt * scale, zz, kk)
-            lift = np.zeros(len(kk))
-            lift[:-1] = np.maximum(lift[:-1], sag)
-            lift[1:] = np.maximum(lift[1:], sag)
-            if j == 0:
-                lift_row = lift
-                row_t, row_z, row_k = tt, zz, kk
-            else:
-                # The link starts at the row's last point and ends at the next row's first point.
-                lift_row[-1] = max(lift_row[-1], lift[0])
-                link_lift_end = lift[-1]
-        a = row_t[row_k]
-        zc = row_z[row_k]
-        if raster.direction == "x":
-            x, y = a, np.full_like(a, levels[i])
+            piece.append((np.full_like(u, t[-1]), levels[i] + u * gap, z_links[i]))
+        for pa, pl, pz in piece:
+            fa.append(pa)
+            fl.append(pl)
+            fz.append(pz)
+            frow.append(np.full(len(pa), i))
+        # The row runs over fine indices [count, count + len(t)), the link after it up to the next row's start.
+        row_end = count + len(t) - 1
+        nxt = row_end + len(u) + 1 if i + 1 < len(levels) else None
+        for lo, hi, is_row in ((count, row_end, True), (row_end, nxt, False)):
+            if hi is not None:
+                keep.append((lo, hi, is_row))
+        count = row_end + len(u) + 1 if i + 1 < len(levels) else row_end + 1
+    fa, fl, fz, frow = (np.concatenate(v) for v in (fa, fl, fz, frow))
+    fx, fy = (fa, fl) if raster.direction == "x" else (fl, fa)
+    fx, fy = fx * scale, fy * scale
+    s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))])
+    kept = [0]
+    for lo, hi, is_row in keep:
+        if tol is not None:
+            k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], fz[lo:hi + 1], tol) + lo
+        elif is_row:
+            k = np.arange(lo, hi + 1, emit_every)
         else:
-            x, y = np.full_like(a, levels[i]), a
-        if i > 0 and pts:
-            lift_row[0] = max(lift_row[0], pending)
-        pending = link_lift_end if i + 1 < len(levels) else 0.0
-        pts.append(np.stack([x * scale + ox, y * scale + oy, zc + lift_row + oz], axis=1))
-        exact.append(zc + oz)
-        rows.append(np.full(len(a), i))
+            k = np.array([lo, hi])
+        kept.extend(int(v) for v in k[1:])
+    kept = np.array(kept, dtype=int)
+    sag = _sag(s_mm, fz, kept)
+    lift = np.zeros(len(kept))
+    if len(sag):
+        lift[:-1] = sag
+        lift[1:] = np.maximum(lift[1:], sag)
+    ox, oy, oz = settings.origin_mm
+    points = np.stack([fx[kept] + ox, fy[kept] + oy, fz[kept] + lift + oz], axis=1)
     b = ev.bounds
     return Toolpath(
-        points_mm=np.concatenate(pts),
-        rows=np.concatenate(rows),
-        exact_mm=np.concatenate(exact),
+        points_mm=points,
+        rows=frow[kept],
+        exact_mm=fz[kept] + oz,
         tool=tool,
         raster=raster,
         stepover_mm=float((levels[1] - levels[0]) * scale) if len(levels) > 1 else float(stepover),
