@@ -47,6 +47,10 @@ class Moves:
         Feed rate in force for each move (NaN before any ``F``).
     line : ndarray of int, shape (N,)
         1-based line number of each move in the text.
+    z_known : ndarray of bool, shape (N,)
+        False until the program has given a Z: before that the height of the
+        tool is the machine's, not the program's (the 0 in ``points_mm`` is
+        only a placeholder, as in LinuxCNC's interpreter).
     """
 
     points_mm: np.ndarray
@@ -54,9 +58,12 @@ class Moves:
     rapid: np.ndarray
     feed_mm_min: np.ndarray
     line: np.ndarray
+    z_known: np.ndarray | None = None
 
     def __post_init__(self):
-        for name in ("points_mm", "start_mm", "rapid", "feed_mm_min", "line"):
+        if self.z_known is None:
+            object.__setattr__(self, "z_known", np.ones(len(self.points_mm), dtype=bool))
+        for name in ("points_mm", "start_mm", "rapid", "feed_mm_min", "line", "z_known"):
             a = np.array(getattr(self, name))
             a.setflags(write=False)
             object.__setattr__(self, name, a)
@@ -97,7 +104,8 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     absolute = True
     motion = None
     feed = float("nan")
-    pts, rapid, feeds, lines = [], [], [], []
+    pts, rapid, feeds, lines, zk = [], [], [], [], []
+    z_seen = False
     percent = 0
     for no, raw in enumerate(text.splitlines(), start=1):
         s = raw.strip()
@@ -160,6 +168,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
             continue
         if motion is None:
             raise ProgramError(f"{source}, line {no}: a coordinate before any G00 or G01")
+        z_seen = z_seen or "Z" in target
         for k, letter in enumerate("XYZ"):
             if letter in target:
                 v = target[letter] * factor
@@ -168,10 +177,12 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
         rapid.append(motion == 0)
         feeds.append(feed * factor)
         lines.append(no)
+        zk.append(z_seen)
     return Moves(
         points_mm=np.array(pts, dtype=float).reshape(-1, 3),
         start_mm=np.array(start, dtype=float),
         rapid=np.array(rapid, dtype=bool),
         feed_mm_min=np.array(feeds, dtype=float),
         line=np.array(lines, dtype=int),
+        z_known=np.array(zk, dtype=bool),
     )

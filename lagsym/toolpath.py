@@ -39,7 +39,10 @@ Chordal error
 Between two cutter locations the control moves in a straight line, which cuts
 below the true cutter path over convex regions.  Each row is therefore sampled
 more finely than it is emitted; the largest sag of every move below the finely
-sampled cutter path is measured and both ends of the move are lifted by it.
+sampled cutter path, plus a quarter of the path's downward second difference
+at each sample (the bend between samples they do not show, such as the
+square-root onset where a ball starts to roll over a box edge), is measured
+and both ends of the move are lifted by it.
 Emitted points thus lie on or above the exact drop-cutter value and at most the
 chordal error (the tolerance, when one is given) above it.
 """
@@ -361,27 +364,31 @@ def raster_pattern(bounds, direction: str, stepover: float, step: float):
     return _levels(x0, x1, stepover), _levels(y0, y1, step)
 
 
-def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float) -> np.ndarray:
+def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.ndarray | None = None) -> np.ndarray:
     """Indices of the points of one row to keep so that straight moves stay within ``tolerance`` of ``z``.
 
     Greedy, as OpenCAMLib's line filter: from each kept point the move reaches
     as far as every skipped point lies within ``tolerance`` (vertically) of it.
-    The first and last points are always kept.
+    The first and last points are always kept.  ``extra`` (per point) is added
+    to a skipped point's distance below the chord: the part of the true path's
+    bend between samples that they do not show.
     """
     n = len(along)
+    if extra is None:
+        extra = np.zeros(n)
     keep = [0]
     i = 0
     while i < n - 1:
         lo, hi = i + 1, min(n - 1, i + 2)
         # Grow the reach by doubling, then bisect back to the last good end.
-        while hi < n - 1 and _within(along, z, i, hi, tolerance):
+        while hi < n - 1 and _within(along, z, i, hi, tolerance, extra):
             lo, hi = hi, min(n - 1, i + 2 * (hi - i))
-        if _within(along, z, i, hi, tolerance):
+        if _within(along, z, i, hi, tolerance, extra):
             lo = hi
         else:
             while hi - lo > 1:
                 mid = (lo + hi) // 2
-                if _within(along, z, i, mid, tolerance):
+                if _within(along, z, i, mid, tolerance, extra):
                     lo = mid
                 else:
                     hi = mid
@@ -390,22 +397,35 @@ def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float) -> np.ndarra
     return np.array(keep, dtype=int)
 
 
-def _within(t, z, i, j, tol):
+def _within(t, z, i, j, tol, extra):
     if j - i < 2:
         return True
     s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
-    chord = z[i] + s * (z[j] - z[i])
-    return bool(np.all(np.abs(z[i + 1:j] - chord) <= tol))
+    dev = z[i + 1:j] - (z[i] + s * (z[j] - z[i]))
+    return bool(np.all((-dev <= tol) & (dev + extra[i + 1:j] <= tol)))
 
 
-def _sag(t, z, keep):
+def _bend(z: np.ndarray) -> np.ndarray:
+    """A quarter of each sample's downward second difference: how far the path between samples may bend below them.
+
+    For a parabola this is half the sag of a move over two samples that the
+    middle sample shows; for the square-root onset where a ball starts to
+    roll over a box edge it covers the part of the sag the samples miss.
+    """
+    out = np.zeros(len(z))
+    if len(z) > 2:
+        out[1:-1] = np.maximum(0.0, -(z[:-2] - 2.0 * z[1:-1] + z[2:])) / 4.0
+    return out
+
+
+def _sag(t, z, keep, extra):
     """Largest height of the fine cutter path above each kept move (0 where the move lies above it)."""
     sag = np.zeros(len(keep) - 1)
     for m, (i, j) in enumerate(zip(keep[:-1], keep[1:])):
         if j - i >= 2:
             s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
             chord = z[i] + s * (z[j] - z[i])
-            sag[m] = max(0.0, float(np.max(z[i + 1:j] - chord)))
+            sag[m] = max(0.0, float(np.max(z[i + 1:j] - chord + extra[i + 1:j])))
     return sag
 
 
@@ -545,17 +565,18 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     fx, fy = (fa, fl) if raster.direction == "x" else (fl, fa)
     fx, fy = fx * scale, fy * scale
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))])
+    bend = np.concatenate([_bend(fz[lo:hi + 1])[:-1] for lo, hi, _ in keep] + [[0.0]])
     kept = [0]
     for lo, hi, is_row in keep:
         if tol is not None:
-            k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], fz[lo:hi + 1], tol) + lo
+            k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], fz[lo:hi + 1], tol, bend[lo:hi + 1]) + lo
         elif is_row:
             k = np.arange(lo, hi + 1, emit_every)
         else:
             k = np.array([lo, hi])
         kept.extend(int(v) for v in k[1:])
     kept = np.array(kept, dtype=int)
-    sag = _sag(s_mm, fz, kept)
+    sag = _sag(s_mm, fz, kept, bend)
     lift = np.zeros(len(kept))
     if len(sag):
         lift[:-1] = sag
