@@ -263,6 +263,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
 
 _DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1)], dtype=float)
 _SIGNS = np.array([1.0, -1.0])[None, :, None]
+_HALF = math.sqrt(0.5)
 
 
 def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
@@ -300,8 +301,10 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
         # Axis steps follow the box edges; radial and tangential steps follow the rim of the disc.
         ox, oy = px[ia] - ccx[ia], py[ia] - ccy[ia]
         norm = np.hypot(ox, oy)
-        norm = np.where(norm > 0, norm, 1.0)
-        er = np.stack([ox / norm, oy / norm], axis=1)
+        at_centre = norm <= stop
+        norm = np.where(at_centre, 1.0, norm)
+        # At the centre there is no radius to follow: step along the diagonals instead.
+        er = np.stack([np.where(at_centre, _HALF, ox / norm), np.where(at_centre, _HALF, oy / norm)], axis=1)
         et = np.stack([-er[:, 1], er[:, 0]], axis=1)
         dirs = np.concatenate([np.broadcast_to(_DIRS[None, :, :], (ia.size, 4, 2)),
                                er[:, None, :] * _SIGNS, et[:, None, :] * _SIGNS], axis=1)

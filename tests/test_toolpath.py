@@ -141,7 +141,7 @@ def test_cutter_location_never_below_the_exact_value(surf, radius, shape, seed):
     ref = reference(surf, x, y, radius, shape)
     span = 1.0 + radius + max(abs(float(v)) for row in surf.grid.z for v in row)
     assert np.all(z >= ref)
-    assert np.all(z <= ref + 10 * CL_MARGIN * span)
+    assert np.all(z <= ref + 100 * CL_MARGIN * span)
     for k in range(2):
         assert z[k] >= brute(surf, x[k], y[k], radius, shape, n=161) - 1e-12 * span
 
