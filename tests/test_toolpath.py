@@ -129,7 +129,6 @@ def surfaces(draw):
     return lagrange_surface(grid_from_table(xs, ys, [[Fraction(v, 2) for v in row] for row in zs]))
 
 
-@settings(max_examples=25)
 @given(surfaces(), st.floats(0.05, 2.5), st.sampled_from(["ball", "flat"]), st.integers(0, 2**31))
 def test_cutter_location_never_below_the_exact_value(surf, radius, shape, seed):
     x0, x1, y0, y1 = (float(v) for v in surf.grid.bounds)
