@@ -193,7 +193,7 @@ def _height(ev, px, py, d2, radius, shape):
     return z
 
 
-def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 2,
+def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 3,
                 margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
@@ -257,7 +257,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     out = np.empty(cx.size)
     for s in range(0, cx.size, _CHUNK):
         out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets, spacing,
-                                        starts, box)
+                                        starts, box, 0.01 * CL_MARGIN * span)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
@@ -266,7 +266,7 @@ _SIGNS = np.array([1.0, -1.0])[None, :, None]
 _HALF = math.sqrt(0.5)
 
 
-def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
+def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box, settle):
     n, k = cx.size, len(offsets)
     best_val = np.full(n, -np.inf)
     # Dense candidates, a block of offsets at a time to bound memory.
@@ -285,7 +285,7 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
     cand_val = np.concatenate([cand_val, _height(ev, px, py, d2, radius, shape)], axis=1)
     cand_px = np.concatenate([cand_px, px], axis=1)
     cand_py = np.concatenate([cand_py, py], axis=1)
-    order = np.argsort(-cand_val, axis=1)[:, :starts]
+    order = _spread_starts(cand_val, cand_px, cand_py, starts, 2.5 * spacing)
     rows = np.arange(n)[:, None]
     px = cand_px[rows, order].ravel()
     py = cand_py[rows, order].ravel()
@@ -323,8 +323,32 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box):
         px[iu], py[iu], val[iu] = nx, ny, bv[up]
         h[ia[~up]] *= 0.5
         h[iu[creep]] *= 0.5
+        # Where no neighbour differs by more than a hundredth of the margin, the value has settled.
+        settled = ~up & (np.max(np.abs(np.where(np.isfinite(qv), qv, val[ia, None]) - val[ia, None]), axis=1) < settle)
+        h[ia[settled]] = 0.0
     best_val = np.maximum(best_val, val.reshape(n, -1).max(axis=1))
     return np.maximum(best_val, cand_val.max(axis=1))
+
+
+def _spread_starts(val, px, py, starts, apart):
+    """For each row, the best candidate and then the best ones at least ``apart`` from those already chosen.
+
+    Two nearly equal peaks under the tool are then both refined, instead of
+    two neighbours on the slope of one of them.
+    """
+    n, k = val.shape
+    top = np.argsort(-val, axis=1)[:, :min(k, 8 * starts)]
+    rows = np.arange(n)[:, None]
+    tx, ty = px[rows, top], py[rows, top]
+    chosen = [top[:, 0]]
+    far = np.ones(top.shape, dtype=bool)
+    for _ in range(1, starts):
+        last = chosen[-1]
+        lx, ly = px[np.arange(n), last], py[np.arange(n), last]
+        far &= np.hypot(tx - lx[:, None], ty - ly[:, None]) >= apart
+        j = np.argmax(far, axis=1)  # the first (best) far candidate, or 0 if none is far
+        chosen.append(np.where(far[np.arange(n), j], top[np.arange(n), j], top[:, min(len(chosen), top.shape[1] - 1)]))
+    return np.stack(chosen, axis=1)
 
 
 def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
