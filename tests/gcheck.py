@@ -41,7 +41,18 @@ def interpret(rs274, text: str, suffix: str = ".ngc"):
 
 
 def resolution_mm(settings) -> float:
-    """Largest difference between a planned point and what rs274 prints: half the last program digit plus
-    half of rs274's fourth decimal (in the program's units)."""
+    """Largest difference between a planned point and what rs274 prints: one unit of the program's last
+    decimal (Z is rounded up) plus half of rs274's fourth decimal (in the program's units)."""
     unit = 1.0 if settings.units == "mm" else 25.4
-    return (0.5 * 10.0 ** -settings.digits + 0.5e-4) * unit * (1 + 1e-9) + 1e-12
+    return (10.0 ** -settings.digits + 0.5e-4) * unit * (1 + 1e-9) + 1e-12
+
+
+def check_feeds(feeds, planned, settings) -> None:
+    """rs274's feed moves are the planned points: X, Y to the nearest, Z at or above (never below) the plan."""
+    unit = 1.0 if settings.units == "mm" else 25.4
+    half = (0.5 * 10.0 ** -settings.digits + 0.5e-4) * unit + 1e-9
+    assert feeds.shape == planned.shape, (feeds.shape, planned.shape)
+    assert np.abs(feeds[:, :2] - planned[:, :2]).max() <= half
+    dz = feeds[:, 2] - planned[:, 2]
+    assert dz.min() >= -0.5e-4 * unit - 1e-9, "a written Z lies below its cutter location"
+    assert dz.max() <= resolution_mm(settings)

@@ -5,7 +5,8 @@ A dialect module (:mod:`lagsym.post.fanuc`, :mod:`lagsym.post.linuxcnc`,
 moves are written here, once, fast: coordinates are rounded to the program's
 decimals as integers and only the words that change are written (X, Y, Z and F
 are modal on every control lagsym writes for).  Every number has a decimal
-point and fixed decimals, never an exponent.  Words that are counts, not
+point and fixed decimals, never an exponent; Z is rounded up, so rounding
+never puts the tool below a cutter location.  Words that are counts, not
 lengths (``S``, ``T``, ``H``, ``M``, ``O``), are integers: a Fanuc alarms on a
 decimal point there.
 """
@@ -92,6 +93,20 @@ def _words(letter: str, ints: np.ndarray, digits: int, changed: np.ndarray) -> l
     return out
 
 
+def _quantize(points_mm, settings: MachineSettings) -> np.ndarray:
+    """Points in units of the program's last decimal: X and Y to the nearest, Z rounded up.
+
+    Rounding Z up means a written point never lies below its cutter location,
+    so the rounding cannot gouge; it raises a point by less than one unit of
+    the last decimal.
+    """
+    v = np.asarray(points_mm, dtype=float) * (settings.unit_factor * 10 ** settings.digits)
+    out = np.empty(v.shape, dtype=np.int64)
+    out[:, :2] = np.rint(v[:, :2])
+    out[:, 2] = np.ceil(v[:, 2] - 1e-6)  # 1e-6 of a unit: a value that is a whole unit up to float error stays
+    return out
+
+
 def format_moves(points_mm: np.ndarray, settings: MachineSettings, previous=None, first_feed: float | None = None,
                  motion: str = "G01") -> list[str]:
     """Blocks of linear feed moves through ``points_mm``, modal words left out.
@@ -109,13 +124,13 @@ def format_moves(points_mm: np.ndarray, settings: MachineSettings, previous=None
 
     Examples
     --------
-    >>> format_moves(np.array([[1.0, 2.0, -0.0008], [1.5, 2.0, 0.0]]), MachineSettings(), first_feed=600)
-    ['G01 X1.000 Y2.000 Z-0.001 F600.0', 'X1.500 Z0.000']
+    >>> format_moves(np.array([[1.0, 2.0, -0.0008], [1.5, 2.0, 0.0012]]), MachineSettings(), first_feed=600)
+    ['G01 X1.000 Y2.000 Z0.000 F600.0', 'X1.500 Z0.002']
     """
     d = settings.digits
-    ints = np.rint(np.asarray(points_mm, dtype=float) * settings.unit_factor * 10 ** d).astype(np.int64)
+    ints = _quantize(points_mm, settings)
     prev = (np.full(3, np.iinfo(np.int64).min) if previous is None
-            else np.rint(np.asarray(previous, dtype=float) * settings.unit_factor * 10 ** d).astype(np.int64))
+            else _quantize(np.asarray(previous, dtype=float)[None, :], settings)[0])
     before = np.vstack([prev[None, :], ints[:-1]])
     changed = ints != before
     changed[0] = changed[0] | (previous is None)
