@@ -72,7 +72,7 @@ __all__ = [
 CL_MARGIN = 1e-7
 """Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
 
-_CHUNK = 1 << 15
+_CHUNK = 1 << 12  # positions per pass: about 30 MB of candidates
 
 
 def _readonly(a) -> np.ndarray:
@@ -473,7 +473,11 @@ class Toolpath:
     tool : Tool
     raster : RasterSpec
     stepover_mm, step_mm : float
-        The side step and sampling step actually used.
+        The side step and forward step actually used (with a chordal
+        tolerance, ``step_mm`` is the sampling step the filter started from).
+    bounds_mm : tuple of float
+        The control points' box on the machine, ``(x0, x1, y0, y1)``: the
+        envelope of the tool positions.
     """
 
     points_mm: np.ndarray
