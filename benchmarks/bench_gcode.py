@@ -76,7 +76,8 @@ def main(argv=None) -> int:
     print(f"{n} moves")
     print(f"{'task':<44}{'time s':>9}{'vs lagsym':>11}")
     print(f"{'write: lagsym write_program (modal words)':<44}{t_lag:>9.2f}{1.0:>10.2f}x   {len(text) / 1e6:.1f} MB")
-    print(f"{'write: f-string, every word':<44}{t_naive:>9.2f}{t_naive / t_lag:>10.2f}x   {len(naive_text) / 1e6:.1f} MB")
+    print(f"{'write: f-string, every word':<44}{t_naive:>9.2f}{t_naive / t_lag:>10.2f}x"
+          f"   {len(naive_text) / 1e6:.1f} MB")
     print(f"{'write: fixed() per number (extrapolated)':<44}{t_fixed:>9.2f}{t_fixed / t_lag:>10.2f}x")
     print(f"{'read: lagsym parse_moves (checked)':<44}{t_read:>9.2f}{1.0:>10.2f}x")
     print(f"{'read: split and float(), no checks':<44}{t_nread:>9.2f}{t_nread / t_read:>10.2f}x")

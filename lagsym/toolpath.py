@@ -144,8 +144,8 @@ def _lattice(radius: float, spacing: float) -> np.ndarray:
     inside = gx**2 + gy**2 <= radius**2 * (1 + 1e-12)
     rim_n = max(8 * k, 16)
     a = np.linspace(0.0, 2 * math.pi, rim_n, endpoint=False)
-    pts = np.concatenate([np.stack([gx[inside], gy[inside]], axis=1), radius * np.stack([np.cos(a), np.sin(a)], axis=1)])
-    return pts
+    rim = radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+    return np.concatenate([np.stack([gx[inside], gy[inside]], axis=1), rim])
 
 
 def _project(px, py, cx, cy, radius, box):
@@ -236,8 +236,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     box = ev.bounds
     x0, x1, y0, y1 = box
     eps_box = 1e-9 * max(x1 - x0, y1 - y0)
-    if np.any((cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)):
-        bad = int(np.flatnonzero((cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box))[0])
+    outside = (cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)
+    if np.any(outside):
+        bad = int(np.flatnonzero(outside)[0])
         raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
                             f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
     cx, cy = np.clip(cx, x0, x1), np.clip(cy, y0, y1)
@@ -529,8 +530,10 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     >>> from lagsym.lagrange import lagrange_surface
     >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 1, 1), (1, 0, 1), (1, 1, 1)]))
     >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(scale=1.0))
-    >>> tp.points_mm.tolist()
-    [[0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.5, 1.0], [0.5, 0.5, 1.0], [0.0, 0.5, 1.0], [0.0, 1.0, 1.0], [0.5, 1.0, 1.0], [1.0, 1.0, 1.0]]
+    >>> tp.points_mm[:, :2].tolist()  # zig-zag: along x, up the edge, back
+    [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5], [0.0, 1.0], [0.5, 1.0], [1.0, 1.0]]
+    >>> bool((tp.points_mm[:, 2] == 1.0).all()), tp.rows.tolist()
+    (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
     """
     ev = evaluator or SurfaceEvaluator(surface)
     scale = settings.scale

@@ -60,7 +60,10 @@ def test_a_lowered_point_is_found(ex2_program):
 
 
 def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
-    """The textbook offset (tip = surface point + R n - R z) against drop-cutter, on a valley of radius 10 mm, R = 15."""
+    """The textbook offset (tip = surface point + R n - R z) against drop-cutter.
+
+    The valley's curvature radius is 10 mm at the floor, the ball's radius 15 mm.
+    """
     surf = valley()
     scale, r = 10.0, 15.0
     x = np.linspace(0.0, 4.0, 161)

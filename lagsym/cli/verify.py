@@ -35,7 +35,8 @@ def add_arguments(p) -> None:
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset the program was made with, mm")
     p.add_argument("--cell", type=float, metavar="MM", help="height-map cell size (default: box side / 400)")
     p.add_argument("--gouge-limit", type=float, metavar="MM",
-                   help="depth from which a cut counts as a gouge (default: program rounding plus simulation resolution)")
+                   help="depth from which a cut counts as a gouge "
+                        "(default: program rounding plus simulation resolution)")
 
 
 def run(args, out, err) -> int:

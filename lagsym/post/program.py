@@ -173,8 +173,8 @@ def writer(dialect: str) -> Callable[[PointProgram], list[str]]:
 def point_program(toolpath, settings: MachineSettings, title: str = "") -> PointProgram:
     """The program model of a :class:`~lagsym.toolpath.Toolpath` for one machine."""
     t = toolpath.tool
-    return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title,
-                        tool_comment=f"T{settings.tool_number} {t.shape.upper()} END D{fixed(t.diameter_mm, 3, trim=True)} MM")
+    tool = f"T{settings.tool_number} {t.shape.upper()} END D{fixed(t.diameter_mm, 3, trim=True)} MM"
+    return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
 
 
 def write_program(program: PointProgram) -> str:
