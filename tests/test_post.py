@@ -126,3 +126,11 @@ def test_every_emitted_program_passes_rs274(rs274, surf, dialect, units, diamete
     text = write_program(point_program(tp, s, title="hypothesis"))
     feeds, _ = interpret(rs274, text)
     check_feeds(feeds, tp.points_mm, s)
+
+
+def test_the_interpreter_check_catches_a_bad_program(rs274):
+    """The check is only worth something if rs274 refuses what a control would: a stray word, a missing end."""
+    with pytest.raises(AssertionError, match="refused"):
+        interpret(rs274, "G21 G90\nG1 X1. F100.\nG1 X2. Q5.\nM2\n")
+    with pytest.raises(AssertionError, match="no percent sign or program end"):
+        interpret(rs274, "G21 G90\nG1 X1. F100.\n")
