@@ -23,7 +23,7 @@ import numpy as np
 
 from .errors import ProgramError
 
-__all__ = ["Moves", "parse_moves"]
+__all__ = ["Moves", "parse_moves", "move_points"]
 
 _WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 _COMMENT = re.compile(r"\([^)]*\)")
@@ -186,3 +186,29 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
         line=np.array(lines, dtype=int),
         z_known=np.array(zk, dtype=bool),
     )
+
+
+def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.ndarray]:
+    """The tool-tip polyline of a program and which of its segments are rapids, for plotting.
+
+    Returns
+    -------
+    points : ndarray, shape (N, 3)
+        Tip positions in mm, from the first one the program states fully (its
+        first move with a Z) to the end.
+    rapid : ndarray of bool, shape (N - 1,)
+        ``rapid[k]`` is True when the move from ``points[k]`` to
+        ``points[k + 1]`` is a ``G00``.
+
+    Examples
+    --------
+    >>> pts, rapid = move_points("G00 X1. Y2.\nZ5.\nG01 Z0. F100.\nX3.\n")
+    >>> pts.tolist(), rapid.tolist()
+    ([[1.0, 2.0, 5.0], [1.0, 2.0, 0.0], [3.0, 2.0, 0.0]], [False, False])
+    """
+    m = parse_moves(text, source)
+    known = np.flatnonzero(m.z_known)
+    if not len(known):
+        return np.zeros((0, 3)), np.zeros(0, dtype=bool)
+    first = int(known[0])
+    return np.array(m.points_mm[first:]), np.array(m.rapid[first + 1:])
