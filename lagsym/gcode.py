@@ -202,7 +202,7 @@ def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.nd
 
     Examples
     --------
-    >>> pts, rapid = move_points("G00 X1. Y2.\nZ5.\nG01 Z0. F100.\nX3.\n")
+    >>> pts, rapid = move_points("G00 X1. Y2.\\nZ5.\\nG01 Z0. F100.\\nX3.\\n")
     >>> pts.tolist(), rapid.tolist()
     ([[1.0, 2.0, 5.0], [1.0, 2.0, 0.0], [3.0, 2.0, 0.0]], [False, False])
     """
