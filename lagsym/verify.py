@@ -36,6 +36,8 @@ from .machine import Tool
 
 __all__ = ["CutReport", "simulate_cut"]
 
+_MOVES_PER_PASS = 20_000
+
 
 @dataclass(frozen=True)
 class CutReport:
@@ -167,13 +169,15 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
     known = np.asarray(moves.z_known, dtype=bool)
     path = moves.path_mm
     use = known & np.concatenate([[False], known[:-1]]) if len(moves) else known
-    if use.any():
-        pts = _samples(path[:-1][use], path[1:][use], ds, dz_mm)
+    a_all, b_all = path[:-1][use], path[1:][use]
+    # A few thousand moves at a time, so a long program never needs all its samples in memory at once.
+    for s in range(0, len(a_all), _MOVES_PER_PASS):
+        pts = _samples(a_all[s:s + _MOVES_PER_PASS], b_all[s:s + _MOVES_PER_PASS], ds, dz_mm)
         near = (pts[:, 0] >= x0 - r - hx) & (pts[:, 0] <= x1 + r + hx) & (pts[:, 1] >= y0 - r - hy) & (
             pts[:, 1] <= y1 + r + hy)
         pts = pts[near]
-        positions = len(pts)
-        if positions:
+        positions += len(pts)
+        if len(pts):
             _press(cut, pts, xs, ys, r, ball)
     reached = np.isfinite(cut)
     diff = np.where(reached, cut - surf, np.nan)
