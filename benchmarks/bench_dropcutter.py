@@ -1,0 +1,100 @@
+"""Drop-cutter against the exact surface (lagsym) versus OpenCAMLib on STL triangulations of it.
+
+Both place the same ball-end cutter over the same (x, y) positions of a raster
+on the paper's Example 4, scaled to millimetres.  The "exact" value is
+lagsym's drop-cutter with a much finer search (``lattice=24, starts=8``).
+OpenCAMLib sees the surface as triangles, so its cutter locations carry the
+mesh's chordal error, and they can lie below the exact value (a gouge).
+
+    python3 benchmarks/bench_dropcutter.py [--points 4000] [--mesh 50 100 200]
+
+Needs ``opencamlib`` (``pip install opencamlib``; wheels for Python 3.11).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from lagsym.io import read_points  # noqa: E402
+from lagsym.lagrange import lagrange_surface  # noqa: E402
+from lagsym.toolpath import drop_cutter  # noqa: E402
+
+EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "paper-example-4.json"
+
+
+def stl_surface(ocl, surface, n: int, scale: float):
+    """An n x n grid of the exact surface, two triangles a cell, in mm."""
+    x0, x1, y0, y1 = (float(v) for v in surface.grid.bounds)
+    xs, ys = np.linspace(x0, x1, n + 1), np.linspace(y0, y1, n + 1)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    gz = surface.evaluate(gx, gy)
+    pts = [[ocl.Point(gx[i, j] * scale, gy[i, j] * scale, gz[i, j] * scale) for j in range(n + 1)]
+           for i in range(n + 1)]
+    stl = ocl.STLSurf()
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = pts[i][j], pts[i + 1][j], pts[i + 1][j + 1], pts[i][j + 1]
+            stl.addTriangle(ocl.Triangle(a, b, c))
+            stl.addTriangle(ocl.Triangle(a, c, d))
+    return stl
+
+
+def ocl_drop(ocl, stl, diameter: float, x, y, floor: float):
+    cutter = ocl.BallCutter(diameter, 4 * diameter)
+    bdc = ocl.BatchDropCutter()
+    bdc.setSTL(stl)
+    bdc.setCutter(cutter)
+    for a, b in zip(x, y):
+        bdc.appendPoint(ocl.CLPoint(float(a), float(b), floor))
+    bdc.run()
+    return np.array([p.z for p in bdc.getCLPoints()])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--points", type=int, default=4000, help="cutter locations (default 4000)")
+    ap.add_argument("--mesh", type=int, nargs="+", default=[50, 100, 200], help="cells per side of the STL meshes")
+    ap.add_argument("--scale", type=float, default=20.0)
+    ap.add_argument("--diameter", type=float, default=6.0)
+    args = ap.parse_args(argv)
+    import opencamlib as ocl
+
+    surface = lagrange_surface(read_points(EXAMPLE))
+    x0, x1, y0, y1 = (float(v) for v in surface.grid.bounds)
+    rows = max(int(np.sqrt(args.points / 2.5)), 2)
+    cols = max(args.points // rows, 2)
+    gx, gy = np.meshgrid(np.linspace(x0, x1, cols), np.linspace(y0, y1, rows))
+    x, y = gx.ravel(), gy.ravel()
+    r = args.diameter / 2 / args.scale
+
+    t = time.perf_counter()
+    z = drop_cutter(surface, x, y, r) * args.scale
+    t_lagsym = time.perf_counter() - t
+    exact = drop_cutter(surface, x, y, r, lattice=24, starts=8, margin=False) * args.scale
+
+    print(f"Example 4 at scale {args.scale:g}: {len(x)} cutter locations, ball D{args.diameter:g} mm, "
+          f"{ocl.max_threads()} OpenCAMLib threads")
+    print(f"{'method':<28}{'time s':>9}{'vs lagsym':>11}{'max |err| mm':>15}{'below exact mm':>16}")
+    print(f"{'lagsym exact drop-cutter':<28}{t_lagsym:>9.3f}{1.0:>10.2f}x{np.abs(z - exact).max():>15.2e}"
+          f"{max(0.0, float((exact - z).max())):>16.2e}")
+    floor = float(np.min(surface.grid.z_array)) * args.scale - 100.0
+    for n in args.mesh:
+        stl = stl_surface(ocl, surface, n, args.scale)
+        t = time.perf_counter()
+        zo = ocl_drop(ocl, stl, args.diameter, x * args.scale, y * args.scale, floor)
+        t_ocl = time.perf_counter() - t
+        err = zo - exact
+        print(f"{f'OpenCAMLib STL {n}x{n}x2':<28}{t_ocl:>9.3f}{t_ocl / t_lagsym:>10.2f}x{np.abs(err).max():>15.2e}"
+              f"{max(0.0, float(-err.min())):>16.2e}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,100 @@
+"""``lagsym toolpath FILE``: a zig-zag raster of gouge-free cutter locations, written as a point-list program."""
+
+from __future__ import annotations
+
+from ..errors import InputError
+from ..io import read_points, write_text
+from ..lagrange import lagrange_surface
+from ..machine import DIRECTIONS, LINE_ENDINGS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
+from ..post.program import point_program, write_program
+
+NAME = "toolpath"
+ORDER = 60
+HELP = "plan a raster toolpath over the exact surface and write it as G-code"
+DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
+FILE and write it as a point-list G-code program.  Cutter locations come from
+drop-cutter against the exact surface, so the tool never cuts below it, also
+where the surface is more concave than the tool.  The programmed point is the
+tool tip; the tool stays down between rows.
+
+examples:
+  lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
+      --stepover 0.5 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
+  lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 \\
+      --dialect linuxcnc -o part.ngc"""
+
+POINT_DIALECTS = ("fanuc", "linuxcnc", "grbl")
+
+
+def add_arguments(p) -> None:
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+    p.add_argument("--dialect", choices=POINT_DIALECTS, default="fanuc",
+                   help="fanuc (default; also Haas and ISO-reading Bridgeport controls), linuxcnc or grbl")
+    g = p.add_argument_group("raster")
+    g.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
+    g.add_argument("--stepover", type=float, metavar="MM", help="side step between rows (default 0.5)")
+    g.add_argument("--step", type=float, metavar="MM", help="forward step along a row (default 0.2)")
+    g.add_argument("--scallop", type=float, metavar="MM",
+                   help="side step from this cusp height of a ball-end cutter, instead of --stepover")
+    g.add_argument("--tolerance", type=float, metavar="MM",
+                   help="forward steps from this chordal error, instead of a fixed --step")
+    t = p.add_argument_group("cutter")
+    t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
+    t.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
+                   help="cutter diameter (default 6; 0 gives the uncompensated path on the surface)")
+    t.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool and length offset number (default 1)")
+    m = p.add_argument_group("machine")
+    m.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
+    m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
+    m.add_argument("--feed", type=float, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
+    m.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
+    m.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    m.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="retract height (default 50)")
+    m.add_argument("--stock-to-leave", type=float, default=0.0, metavar="MM", help="material left on the surface")
+    m.add_argument("--program", type=int, default=1000, metavar="N", help="program number O N (default 1000)")
+    m.add_argument("--line-ending", choices=tuple(LINE_ENDINGS), default="lf", help="lf (default), crlf or cr")
+    m.add_argument("--decimals", type=int, metavar="N", help="decimals in coordinates (default 3 for mm, 4 for inch)")
+    m.add_argument("--title", help="comment at the top of the program (default: the points file's name)")
+
+
+def origin(text: str) -> tuple[float, float, float]:
+    """``X,Y,Z`` in millimetres."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(v == v and abs(v) != float("inf") for v in values):
+        raise InputError(f"--origin {text!r} must be three numbers X,Y,Z in mm")
+    return values
+
+
+def settings_from(args, dialect: str) -> MachineSettings:
+    """The machine settings the arguments describe."""
+    return MachineSettings(
+        dialect=dialect, scale=args.scale, origin_mm=origin(args.origin), units=args.units,
+        feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
+        safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock_to_leave, program_number=args.program,
+        line_ending=args.line_ending, decimals=args.decimals, tool_number=args.tool_number)
+
+
+def run(args, out, err) -> int:
+    from ..toolpath import plan_toolpath
+
+    grid = read_points(args.file)
+    settings = settings_from(args, args.dialect)
+    tool = Tool(args.tool_shape, args.tool_diameter)
+    stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
+    step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
+    raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance)
+    tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings)
+    title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
+    text = write_program(point_program(tp, settings, title=title))
+    if args.output and args.output != "-":
+        write_text(args.output, text, newline="")
+        err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} rows, "
+                  f"side step {tp.stepover_mm:.4f} mm, largest lift for chordal error {tp.lift_mm.max():.4f} mm\n")
+    else:
+        out.write(text)
+    return 0

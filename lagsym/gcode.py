@@ -1,0 +1,214 @@
+"""A reader of point-list G-code: the moves of a program as an array in millimetres.
+
+It understands what point-list programs use, as LinuxCNC's interpreter reads
+it: modal ``G00``/``G01`` with ``X Y Z F`` words, ``G20``/``G21`` units,
+``G90``/``G91`` absolute and incremental positions, ``(...)`` and ``;``
+comments, ``%`` framing lines, ``O`` program numbers and ``N`` block numbers.
+Set-up words that do not move the tool (``G17 G40 G43 G49 G54..G59 G80 G94``,
+``S T M H D``) are passed over.  Anything that would move the tool in another
+way (arcs, canned cycles, ``G28``, ``G92``) is refused with the line it is on,
+so a reader of the result never silently sees a different path.
+
+The tool starts at ``(0, 0, 0)``, as in LinuxCNC's interpreter; a number
+without a decimal point is read as a whole number of units (LinuxCNC's
+reading, not a Fanuc's least-input-increment one).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ProgramError
+
+__all__ = ["Moves", "parse_moves", "move_points"]
+
+_WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
+_COMMENT = re.compile(r"\([^)]*\)")
+_IGNORED_G = {17, 40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 94, 97}
+_IGNORED_LETTERS = set("NSTMHDP")
+
+
+@dataclass(frozen=True)
+class Moves:
+    """The straight moves of a program, in order.
+
+    Attributes
+    ----------
+    points_mm : ndarray, shape (N, 3)
+        End point of each move (mm); read-only.
+    start_mm : ndarray, shape (3,)
+        Where the tool was before the first move.
+    rapid : ndarray of bool, shape (N,)
+        True for ``G00`` moves, False for ``G01`` feed moves.
+    feed_mm_min : ndarray, shape (N,)
+        Feed rate in force for each move (NaN before any ``F``).
+    line : ndarray of int, shape (N,)
+        1-based line number of each move in the text.
+    z_known : ndarray of bool, shape (N,)
+        False until the program has given a Z: before that the height of the
+        tool is the machine's, not the program's (the 0 in ``points_mm`` is
+        only a placeholder, as in LinuxCNC's interpreter).
+    """
+
+    points_mm: np.ndarray
+    start_mm: np.ndarray
+    rapid: np.ndarray
+    feed_mm_min: np.ndarray
+    line: np.ndarray
+    z_known: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.z_known is None:
+            object.__setattr__(self, "z_known", np.ones(len(self.points_mm), dtype=bool))
+        for name in ("points_mm", "start_mm", "rapid", "feed_mm_min", "line", "z_known"):
+            a = np.array(getattr(self, name))
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+
+    def __len__(self) -> int:
+        return len(self.points_mm)
+
+    @property
+    def path_mm(self) -> np.ndarray:
+        """Start point followed by every end point: ``(N + 1, 3)``, the polyline the tool tip follows."""
+        return np.vstack([self.start_mm[None, :], self.points_mm])
+
+    @property
+    def feeds(self) -> np.ndarray:
+        """End points of the feed (cutting) moves only."""
+        return self.points_mm[~self.rapid]
+
+
+def parse_moves(text: str, source: str = "<program>") -> Moves:
+    """Read the straight moves of a point-list program.
+
+    Parameters
+    ----------
+    text : str
+        The program text (any line ending).
+    source : str
+        A name for messages (the file name).
+
+    Examples
+    --------
+    >>> m = parse_moves("%\\nO1000 (DEMO)\\nG21 G90\\nG00 X1. Y2.\\nG01 Z-0.5 F100.\\nX3.\\n%\\n")
+    >>> m.points_mm.tolist(), m.rapid.tolist()
+    ([[1.0, 2.0, 0.0], [1.0, 2.0, -0.5], [3.0, 2.0, -0.5]], [True, False, False])
+    """
+    pos = [0.0, 0.0, 0.0]
+    start = tuple(pos)
+    factor = 1.0  # mm per program unit
+    absolute = True
+    motion = None
+    feed = float("nan")
+    pts, rapid, feeds, lines, zk = [], [], [], [], []
+    z_seen = False
+    percent = 0
+    for no, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if not s:
+            continue
+        if s.startswith("%"):
+            percent += 1
+            if percent == 2:
+                break  # the end of the program: anything after is not read by a control
+            continue
+        if s.startswith("/"):
+            s = s[1:]  # block delete off: the block runs
+        s = _COMMENT.sub(" ", s)
+        if "(" in s:
+            raise ProgramError(f"{source}, line {no}: unclosed comment in {raw.strip()!r}")
+        s = s.split(";", 1)[0]
+        if not s.strip():
+            continue
+        words = _WORD.findall(s)
+        rest = _WORD.sub("", s).strip()
+        if rest:
+            raise ProgramError(f"{source}, line {no}: cannot read {rest!r} in {raw.strip()!r}")
+        target = {}
+        new_motion = None
+        for letter, value in words:
+            letter = letter.upper()
+            v = float(value)
+            if letter == "G":
+                g = round(v, 1)
+                if g in (0, 1):
+                    new_motion = int(g)
+                elif g == 20:
+                    factor = 25.4
+                elif g == 21:
+                    factor = 1.0
+                elif g == 90:
+                    absolute = True
+                elif g == 91:
+                    absolute = False
+                elif g in _IGNORED_G:
+                    pass
+                else:
+                    raise ProgramError(f"{source}, line {no}: G{value} is not a straight move; "
+                                       "only point-list programs (G00/G01) can be read")
+            elif letter in "XYZ":
+                if letter in target:
+                    raise ProgramError(f"{source}, line {no}: {letter} given twice")
+                target[letter] = v
+            elif letter == "F":
+                feed = v
+            elif letter == "O":
+                continue
+            elif letter in _IGNORED_LETTERS:
+                continue
+            else:
+                raise ProgramError(f"{source}, line {no}: word {letter}{value} is not part of a point-list program")
+        if new_motion is not None:
+            motion = new_motion
+        if not target:
+            continue
+        if motion is None:
+            raise ProgramError(f"{source}, line {no}: a coordinate before any G00 or G01")
+        z_seen = z_seen or "Z" in target
+        for k, letter in enumerate("XYZ"):
+            if letter in target:
+                v = target[letter] * factor
+                pos[k] = v if absolute else pos[k] + v
+        pts.append(tuple(pos))
+        rapid.append(motion == 0)
+        feeds.append(feed * factor)
+        lines.append(no)
+        zk.append(z_seen)
+    return Moves(
+        points_mm=np.array(pts, dtype=float).reshape(-1, 3),
+        start_mm=np.array(start, dtype=float),
+        rapid=np.array(rapid, dtype=bool),
+        feed_mm_min=np.array(feeds, dtype=float),
+        line=np.array(lines, dtype=int),
+        z_known=np.array(zk, dtype=bool),
+    )
+
+
+def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.ndarray]:
+    """The tool-tip polyline of a program and which of its segments are rapids, for plotting.
+
+    Returns
+    -------
+    points : ndarray, shape (N, 3)
+        Tip positions in mm, from the first one the program states fully (its
+        first move with a Z) to the end.
+    rapid : ndarray of bool, shape (N - 1,)
+        ``rapid[k]`` is True when the move from ``points[k]`` to
+        ``points[k + 1]`` is a ``G00``.
+
+    Examples
+    --------
+    >>> pts, rapid = move_points("G00 X1. Y2.\\nZ5.\\nG01 Z0. F100.\\nX3.\\n")
+    >>> pts.tolist(), rapid.tolist()
+    ([[1.0, 2.0, 5.0], [1.0, 2.0, 0.0], [3.0, 2.0, 0.0]], [False, False])
+    """
+    m = parse_moves(text, source)
+    known = np.flatnonzero(m.z_known)
+    if not len(known):
+        return np.zeros((0, 3)), np.zeros(0, dtype=bool)
+    first = int(known[0])
+    return np.array(m.points_mm[first:]), np.array(m.rapid[first + 1:])

@@ -1,0 +1,26 @@
+"""Fanuc-style ISO programs, also read by Haas and by Bridgeport controls that take ISO code.
+
+``%`` framing, an ``O`` number with the title as a comment, and a safe-start
+block; programs end with ``M30``.
+"""
+
+from __future__ import annotations
+
+from .program import PointProgram, body, iso_comment, register, units_word
+
+__all__ = ["blocks"]
+
+
+@register("fanuc")
+def blocks(program: PointProgram) -> list[str]:
+    """The blocks of a Fanuc point-list program."""
+    s = program.settings
+    title = iso_comment(program.title)
+    out = ["%", f"O{int(s.program_number):04d}" + (f" ({title})" if title else "")]
+    if program.tool_comment:
+        out.append(f"({iso_comment(program.tool_comment)})")
+    out += [f"{units_word(s)} G17 G40 G49 G80 G90 G94", s.work_offset, f"T{s.tool_number} M06",
+            f"S{int(round(s.spindle_rpm))} M03"]
+    out += body(program)
+    out += ["M05", "M30", "%"]
+    return out

@@ -1,0 +1,640 @@
+"""Raster toolpaths with gouge-free cutter locations.
+
+The pipeline follows OpenCAMLib's four steps, each its own function:
+
+1. **path pattern** (:func:`raster_pattern`): a zig-zag of rows along x or y
+   over the control points' box, side step and forward step in millimetres;
+2. **cutter locations** (:func:`drop_cutter`): at each ``(x, y)`` the tool is
+   lowered until it touches the exact surface anywhere under it;
+3. **filtering** (:func:`filter_rows`): with a chordal tolerance, points whose
+   removal keeps the moves within the tolerance of the true cutter path go;
+4. the program text, in :mod:`lagsym.post`.
+
+Terms are used as in CAM: the *cutter location* (CL) is the programmed point,
+here the tool tip; the *cutter contact* (CC) point is where the tool touches
+the surface.
+
+Drop-cutter
+-----------
+For a ball of radius ``R`` centred over ``c = (cx, cy)`` the tip height is
+
+    CL(c) = max over p in D(c, R) ∩ B of  F(p) + sqrt(R**2 - |p - c|**2) - R,
+
+and for a flat end ``max F(p)`` over the same set; ``D`` is the disc under the
+tool and ``B`` the box spanned by the control points.  Only the surface inside
+the box counts: the polynomial is never evaluated outside it (beyond the box
+lies no part, not a cliff and not an extrapolated surface), so near an edge the
+tool rests on what lies inside.  The maximum is found by a dense lattice of
+candidate contact points in the disc, then a pattern search from the best few
+candidates that shrinks to ``1e-9`` of the tool radius (where the maximum lies on
+the rim or on a box edge the height converges only as fast as the step).  Every value found is
+the height of a real contact, so it can only err low; :data:`CL_MARGIN` (a
+relative ``1e-7``, far below any program's resolution) is added to absorb
+that error.  No normal offset is
+involved, so concave regions tighter than the tool are handled: the tool rests
+on the two walls instead of cutting into them.
+
+Chordal error
+-------------
+Between two cutter locations the control moves in a straight line, which cuts
+below the true cutter path over convex regions.  Each row is therefore sampled
+more finely than it is emitted; the largest sag of every move below the finely
+sampled cutter path, plus a quarter of the path's downward second difference
+at each sample (the bend between samples they do not show, such as the
+square-root onset where a ball starts to roll over a box edge), is measured
+and both ends of the move are lifted by it.
+Emitted points thus lie on or above the exact drop-cutter value and at most the
+chordal error (the tolerance, when one is given) above it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.polynomial import polynomial as P
+
+from .errors import ToolpathError
+from .machine import MachineSettings, RasterSpec, Tool
+
+__all__ = [
+    "Toolpath",
+    "SurfaceEvaluator",
+    "raster_pattern",
+    "drop_cutter",
+    "filter_rows",
+    "scallop_stepover",
+    "plan_toolpath",
+    "CL_MARGIN",
+]
+
+CL_MARGIN = 1e-7
+"""Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
+
+_CHUNK = 1 << 12  # positions per pass: about 30 MB of candidates
+
+
+def _readonly(a) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+class SurfaceEvaluator:
+    """Value of a Lagrange surface at scattered points, fast, from its exact coefficients.
+
+    The exact power-basis coefficients are first re-expressed, exactly, in the
+    normalised variables ``u, v`` that map the box onto ``[-1, 1]**2``; only
+    then are they rounded to floats.  Evaluation in ``u, v`` is well conditioned
+    for the degrees lagsym handles, unlike the raw power basis over a box far
+    from the origin.
+    """
+
+    def __init__(self, surface):
+        from fractions import Fraction
+
+        x0, x1, y0, y1 = surface.grid.bounds
+        mx, hx = (x0 + x1) / 2, (x1 - x0) / 2
+        my, hy = (y0 + y1) / 2, (y1 - y0) / 2
+        c = surface.coefficients
+        n, m = len(c), len(c[0])
+
+        def shift(mid, half, deg):
+            s = [[Fraction(0)] * deg for _ in range(deg)]
+            for a in range(deg):
+                for k in range(a + 1):
+                    s[a][k] = math.comb(a, k) * mid ** (a - k) * half ** k
+            return s
+
+        sx, sy = shift(mx, hx, n), shift(my, hy, m)
+        # d[k][l] = sum_ab sx[a][k] c[a][b] sy[b][l], exactly.
+        t = [[sum(sx[a][k] * c[a][b] for a in range(n)) for b in range(m)] for k in range(n)]
+        d = [[sum(t[k][b] * sy[b][l] for b in range(m)) for l in range(m)] for k in range(n)]
+        self.coef = np.array([[float(v) for v in row] for row in d])
+        self.coef.setflags(write=False)
+        self.mid = (float(mx), float(my))
+        self.half = (float(hx), float(hy))
+        self.bounds = tuple(float(v) for v in surface.grid.bounds)
+
+    def __call__(self, x, y) -> np.ndarray:
+        """``F(x, y)``; ``x`` and ``y`` broadcast together."""
+        u = (np.asarray(x, dtype=float) - self.mid[0]) / self.half[0]
+        v = (np.asarray(y, dtype=float) - self.mid[1]) / self.half[1]
+        return P.polyval2d(u, v, self.coef)
+
+    def curvature_bound(self, samples: int = 41) -> float:
+        """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on a sample grid (per surface unit)."""
+        u = np.linspace(-1.0, 1.0, samples)
+        uu, vv = np.meshgrid(u, u, indexing="ij")
+        hx, hy = self.half
+        out = 0.0
+        for dx, dy, s in ((2, 0, hx * hx), (0, 2, hy * hy), (1, 1, hx * hy)):
+            c = P.polyder(P.polyder(self.coef, dx, axis=0), dy, axis=1) if (dx or dy) else self.coef
+            if c.size:
+                out = max(out, float(np.abs(P.polyval2d(uu, vv, c)).max()) / s)
+        return out
+
+
+def _lattice(radius: float, spacing: float) -> np.ndarray:
+    """Offsets of a square lattice inside the disc, plus points on its rim (for a flat end)."""
+    k = max(int(math.ceil(radius / spacing)), 1)
+    t = np.linspace(-radius, radius, 2 * k + 1)
+    gx, gy = np.meshgrid(t, t, indexing="ij")
+    inside = gx**2 + gy**2 <= radius**2 * (1 + 1e-12)
+    rim_n = max(8 * k, 16)
+    a = np.linspace(0.0, 2 * math.pi, rim_n, endpoint=False)
+    rim = radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+    return np.concatenate([np.stack([gx[inside], gy[inside]], axis=1), rim])
+
+
+def _project(px, py, cx, cy, radius, box):
+    """Move candidate contact points into the box, then into the disc (the box is convex and holds the centre)."""
+    x0, x1, y0, y1 = box
+    px = np.clip(px, x0, x1)
+    py = np.clip(py, y0, y1)
+    dx, dy = px - cx, py - cy
+    d2 = dx * dx + dy * dy
+    over = d2 > radius * radius
+    if np.any(over):
+        f = np.where(over, radius / np.sqrt(np.where(over, d2, 1.0)), 1.0)
+        px, py = cx + dx * f, cy + dy * f
+        dx, dy = px - cx, py - cy
+        d2 = dx * dx + dy * dy
+    return px, py, d2
+
+
+def _edge_points(cx, cy, radius, box):
+    """Box corners, and for each box edge the foot of the perpendicular from the centre and the rim crossings."""
+    x0, x1, y0, y1 = box
+    n = cx.size
+    xs, ys = [], []
+    for a in (x0, x1):
+        for b in (y0, y1):
+            xs.append(np.full(n, a))
+            ys.append(np.full(n, b))
+    for a in (x0, x1):  # vertical edges
+        w = np.sqrt(np.maximum(radius**2 - (cx - a) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(np.full(n, a))
+            ys.append(cy + off * w)
+    for b in (y0, y1):  # horizontal edges
+        w = np.sqrt(np.maximum(radius**2 - (cy - b) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(cx + off * w)
+            ys.append(np.full(n, b))
+    return np.stack(xs, axis=1), np.stack(ys, axis=1)
+
+
+def _height(ev, px, py, d2, radius, shape):
+    z = ev(px, py)
+    if shape == "ball":
+        z = z + np.sqrt(np.maximum(radius * radius - d2, 0.0)) - radius
+    return z
+
+
+def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 3,
+                margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+    """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+        The exact surface; only its part inside the control points' box counts.
+    x, y : array_like
+        Tool axis positions in surface units, inside the box.
+    radius : float
+        Tool radius in surface units (0: a point, the surface itself).
+    shape : {"ball", "flat"}
+        Cutter shape.
+    lattice : int
+        Candidate contact points per tool radius in the first, dense search.
+    starts : int
+        How many of the best candidates the local search refines.
+    margin : bool
+        Add :data:`CL_MARGIN`; without it the value is the best contact found,
+        a lower bound of the exact one.
+
+    Returns
+    -------
+    numpy.ndarray
+        Tip heights, shape of ``x`` broadcast with ``y``; never below the exact
+        drop-cutter value, above it by at most :data:`CL_MARGIN` relative.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 0), (0, 2, 0), (2, 0, 0), (2, 2, 0)]))
+    >>> round(float(drop_cutter(s, 1.0, 1.0, 0.5)), 6)
+    0.0
+    """
+    ev = evaluator or SurfaceEvaluator(surface)
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    shape_out = x.shape
+    cx, cy = x.ravel(), y.ravel()
+    box = ev.bounds
+    x0, x1, y0, y1 = box
+    eps_box = 1e-9 * max(x1 - x0, y1 - y0)
+    outside = (cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)
+    if np.any(outside):
+        bad = int(np.flatnonzero(outside)[0])
+        raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+    cx, cy = np.clip(cx, x0, x1), np.clip(cy, y0, y1)
+    radius = float(radius)
+    if radius < 0:
+        raise ToolpathError(f"tool radius {radius!r} must not be negative")
+    if radius == 0:
+        return ev(cx, cy).reshape(shape_out)
+    if shape not in ("ball", "flat"):
+        raise ToolpathError(f"tool shape {shape!r} is not one of ball, flat")
+    deg = max(len(ev.coef), len(ev.coef[0]), 2)
+    feature = min(x1 - x0, y1 - y0) / (2 * deg)
+    spacing = min(radius / lattice, feature / 2)
+    spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
+    offsets = _lattice(radius, spacing)
+    span = float(np.ptp(ev.coef)) + radius + 1.0
+    out = np.empty(cx.size)
+    for s in range(0, cx.size, _CHUNK):
+        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets, spacing,
+                                        starts, box, 0.01 * CL_MARGIN * span)
+    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+_DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1)], dtype=float)
+_SIGNS = np.array([1.0, -1.0])[None, :, None]
+_HALF = math.sqrt(0.5)
+
+
+def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box, settle):
+    n, k = cx.size, len(offsets)
+    best_val = np.full(n, -np.inf)
+    # Dense candidates, a block of offsets at a time to bound memory.
+    block = max(1, (1 << 22) // max(n, 1))
+    cand_val = np.empty((n, k))
+    cand_px = np.empty((n, k))
+    cand_py = np.empty((n, k))
+    for s in range(0, k, block):
+        ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
+        px, py, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
+        cand_val[:, s:s + block] = _height(ev, px, py, d2, radius, shape)
+        cand_px[:, s:s + block], cand_py[:, s:s + block] = px, py
+    # The corners of the region under the tool: box corners, and where the rim crosses a box edge.
+    ex, ey = _edge_points(cx, cy, radius, box)
+    px, py, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
+    cand_val = np.concatenate([cand_val, _height(ev, px, py, d2, radius, shape)], axis=1)
+    cand_px = np.concatenate([cand_px, px], axis=1)
+    cand_py = np.concatenate([cand_py, py], axis=1)
+    order = _spread_starts(cand_val, cand_px, cand_py, starts, 2.5 * spacing)
+    rows = np.arange(n)[:, None]
+    px = cand_px[rows, order].ravel()
+    py = cand_py[rows, order].ravel()
+    val = cand_val[rows, order].ravel()
+    ccx, ccy = np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1])
+    h = np.full(px.size, spacing)
+    stop = radius * 1e-9
+    for _ in range(120):
+        active = h > stop
+        if not active.any():
+            break
+        ia = np.flatnonzero(active)
+        # Axis steps follow the box edges; radial and tangential steps follow the rim of the disc.
+        ox, oy = px[ia] - ccx[ia], py[ia] - ccy[ia]
+        norm = np.hypot(ox, oy)
+        at_centre = norm <= stop
+        norm = np.where(at_centre, 1.0, norm)
+        # At the centre there is no radius to follow: step along the diagonals instead.
+        er = np.stack([np.where(at_centre, _HALF, ox / norm), np.where(at_centre, _HALF, oy / norm)], axis=1)
+        et = np.stack([-er[:, 1], er[:, 0]], axis=1)
+        dirs = np.concatenate([np.broadcast_to(_DIRS[None, :, :], (ia.size, 4, 2)),
+                               er[:, None, :] * _SIGNS, et[:, None, :] * _SIGNS], axis=1)
+        qx = px[ia, None] + h[ia, None] * dirs[:, :, 0]
+        qy = py[ia, None] + h[ia, None] * dirs[:, :, 1]
+        qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
+        qv = _height(ev, qx, qy, d2, radius, shape)
+        j = np.argmax(qv, axis=1)
+        bv = qv[np.arange(ia.size), j]
+        up = bv > val[ia]
+        iu = ia[up]
+        nx, ny = qx[up, j[up]], qy[up, j[up]]
+        # A step the projection shortened to a creep along a constraint counts as a failure too:
+        # shrinking lets the steps along the rim or edge stop overshooting the maximum.
+        creep = np.hypot(nx - px[iu], ny - py[iu]) < 0.25 * h[iu]
+        px[iu], py[iu], val[iu] = nx, ny, bv[up]
+        h[ia[~up]] *= 0.5
+        h[iu[creep]] *= 0.5
+        # Where no neighbour differs by more than a hundredth of the margin, the value has settled.
+        settled = ~up & (np.max(np.abs(np.where(np.isfinite(qv), qv, val[ia, None]) - val[ia, None]), axis=1) < settle)
+        h[ia[settled]] = 0.0
+    best_val = np.maximum(best_val, val.reshape(n, -1).max(axis=1))
+    return np.maximum(best_val, cand_val.max(axis=1))
+
+
+def _spread_starts(val, px, py, starts, apart):
+    """For each row, the best candidate and then the best ones at least ``apart`` from those already chosen.
+
+    Two nearly equal peaks under the tool are then both refined, instead of
+    two neighbours on the slope of one of them.
+    """
+    n, k = val.shape
+    top = np.argsort(-val, axis=1)[:, :min(k, 8 * starts)]
+    rows = np.arange(n)[:, None]
+    tx, ty = px[rows, top], py[rows, top]
+    chosen = [top[:, 0]]
+    far = np.ones(top.shape, dtype=bool)
+    for _ in range(1, starts):
+        last = chosen[-1]
+        lx, ly = px[np.arange(n), last], py[np.arange(n), last]
+        far &= np.hypot(tx - lx[:, None], ty - ly[:, None]) >= apart
+        j = np.argmax(far, axis=1)  # the first (best) far candidate, or 0 if none is far
+        chosen.append(np.where(far[np.arange(n), j], top[np.arange(n), j], top[:, min(len(chosen), top.shape[1] - 1)]))
+    return np.stack(chosen, axis=1)
+
+
+def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
+    """Side step of a ball-end cutter that leaves cusps ``scallop_mm`` high on a flat floor.
+
+    ``2 * sqrt(2 R h - h**2)``, from the circle of the ball over the cusp.
+
+    >>> round(scallop_stepover(3.0, 0.01), 4)
+    0.4895
+    """
+    r, h = float(radius_mm), float(scallop_mm)
+    if r <= 0:
+        raise ToolpathError("a scallop height needs a ball-end cutter with a diameter above 0")
+    if h >= r:
+        raise ToolpathError(f"scallop height {h:g} mm must be less than the tool radius {r:g} mm")
+    return 2.0 * math.sqrt(2.0 * r * h - h * h)
+
+
+def _levels(lo: float, hi: float, step: float) -> np.ndarray:
+    count = max(int(math.ceil((hi - lo) / step - 1e-9)), 1)
+    return np.linspace(lo, hi, count + 1)
+
+
+def raster_pattern(bounds, direction: str, stepover: float, step: float):
+    """A zig-zag over ``bounds`` = ``(x0, x1, y0, y1)``: row levels and along-row positions.
+
+    Rows run along ``direction``; both are evenly spaced, never wider than the
+    steps given, and include the box edges.  Odd rows run backwards.
+
+    Returns
+    -------
+    levels : ndarray
+        Cross coordinate of each row.
+    along : ndarray
+        Positions along a row (forwards).
+    """
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    if direction == "x":
+        return _levels(y0, y1, stepover), _levels(x0, x1, step)
+    return _levels(x0, x1, stepover), _levels(y0, y1, step)
+
+
+def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the points of one row to keep so that straight moves stay within ``tolerance`` of ``z``.
+
+    Greedy, as OpenCAMLib's line filter: from each kept point the move reaches
+    as far as every skipped point lies within ``tolerance`` (vertically) of it.
+    The first and last points are always kept.  ``extra`` (per point) is added
+    to a skipped point's distance below the chord: the part of the true path's
+    bend between samples that they do not show.
+    """
+    n = len(along)
+    if extra is None:
+        extra = np.zeros(n)
+    keep = [0]
+    i = 0
+    while i < n - 1:
+        lo, hi = i + 1, min(n - 1, i + 2)
+        # Grow the reach by doubling, then bisect back to the last good end.
+        while hi < n - 1 and _within(along, z, i, hi, tolerance, extra):
+            lo, hi = hi, min(n - 1, i + 2 * (hi - i))
+        if _within(along, z, i, hi, tolerance, extra):
+            lo = hi
+        else:
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if _within(along, z, i, mid, tolerance, extra):
+                    lo = mid
+                else:
+                    hi = mid
+        keep.append(lo)
+        i = lo
+    return np.array(keep, dtype=int)
+
+
+def _within(t, z, i, j, tol, extra):
+    if j - i < 2:
+        return True
+    s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
+    dev = z[i + 1:j] - (z[i] + s * (z[j] - z[i]))
+    return bool(np.all((-dev <= tol) & (dev + extra[i + 1:j] <= tol)))
+
+
+def _bend(z: np.ndarray) -> np.ndarray:
+    """A quarter of each sample's downward second difference: how far the path between samples may bend below them.
+
+    For a parabola this is half the sag of a move over two samples that the
+    middle sample shows; for the square-root onset where a ball starts to
+    roll over a box edge it covers the part of the sag the samples miss.
+    """
+    out = np.zeros(len(z))
+    if len(z) > 2:
+        out[1:-1] = np.maximum(0.0, -(z[:-2] - 2.0 * z[1:-1] + z[2:])) / 4.0
+    return out
+
+
+def _sag(t, z, keep, extra):
+    """Largest height of the fine cutter path above each kept move (0 where the move lies above it)."""
+    sag = np.zeros(len(keep) - 1)
+    for m, (i, j) in enumerate(zip(keep[:-1], keep[1:])):
+        if j - i >= 2:
+            s = (t[i + 1:j] - t[i]) / (t[j] - t[i])
+            chord = z[i] + s * (z[j] - z[i])
+            sag[m] = max(0.0, float(np.max(z[i + 1:j] - chord + extra[i + 1:j])))
+    return sag
+
+
+@dataclass(frozen=True)
+class Toolpath:
+    """A planned zig-zag: cutter locations (tool tip) in machine millimetres, in cutting order.
+
+    Attributes
+    ----------
+    points_mm : ndarray, shape (N, 3)
+        Programmed tip positions X, Y, Z in mm, work offset and stock included;
+        read-only.
+    rows : ndarray, shape (N,)
+        Row number of each point; read-only.
+    exact_mm : ndarray, shape (N,)
+        The drop-cutter height at each point before the lift for chordal
+        error; ``points_mm[:, 2] - exact_mm`` is that lift (0 or more).
+    tool : Tool
+    raster : RasterSpec
+    stepover_mm, step_mm : float
+        The side step and forward step actually used (with a chordal
+        tolerance, ``step_mm`` is the sampling step the filter started from).
+    bounds_mm : tuple of float
+        The control points' box on the machine, ``(x0, x1, y0, y1)``: the
+        envelope of the tool positions.
+    """
+
+    points_mm: np.ndarray
+    rows: np.ndarray
+    exact_mm: np.ndarray
+    tool: Tool
+    raster: RasterSpec
+    stepover_mm: float
+    step_mm: float
+    bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+
+    def __post_init__(self):
+        for name in ("points_mm", "rows", "exact_mm"):
+            a = np.array(getattr(self, name))
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+
+    def __len__(self) -> int:
+        return len(self.points_mm)
+
+    @property
+    def lift_mm(self) -> np.ndarray:
+        """How far each point was raised above its drop-cutter value to keep the moves above the cutter path."""
+        return self.points_mm[:, 2] - self.exact_mm
+
+
+def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
+                  evaluator: SurfaceEvaluator | None = None) -> Toolpath:
+    """Plan a zig-zag raster of gouge-free cutter locations over the surface.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+        The exact surface; lengths in its units become mm by ``settings.scale``.
+    tool : Tool
+        Cutter shape and diameter (mm).
+    raster : RasterSpec
+        Direction and steps (mm), or scallop height and chordal tolerance.
+    settings : MachineSettings
+        Scale, work offset and stock to leave.
+
+    Returns
+    -------
+    Toolpath
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 1, 1), (1, 0, 1), (1, 1, 1)]))
+    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(scale=1.0))
+    >>> tp.points_mm[:, :2].tolist()  # zig-zag: along x, up the edge, back
+    [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5], [0.0, 1.0], [0.5, 1.0], [1.0, 1.0]]
+    >>> bool((tp.points_mm[:, 2] == 1.0).all()), tp.rows.tolist()
+    (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
+    """
+    ev = evaluator or SurfaceEvaluator(surface)
+    scale = settings.scale
+    r_mm = tool.radius_mm
+    stock = settings.stock_to_leave_mm
+    if raster.stepover_mm is not None:
+        stepover = raster.stepover_mm
+    else:
+        if tool.shape != "ball":
+            raise ToolpathError("a scallop height (--scallop) needs a ball-end cutter; give --stepover for a flat end")
+        stepover = scallop_stepover(r_mm, raster.scallop_mm)
+    tol = raster.tolerance_mm
+    if raster.step_mm is not None:
+        step = raster.step_mm
+        fine = step / 4.0 if tol is None else min(step, _tolerance_step(ev, tol, scale))
+    else:
+        fine = _tolerance_step(ev, tol, scale)
+        step = fine
+    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / scale, fine / scale)
+    emit_every = None
+    if tol is None:
+        # Fixed forward step: a fine sample halfway along each move measures its sag.
+        emit_every = 2
+        n = len(_levels(along[0], along[-1], step / scale)) - 1
+        along = np.linspace(along[0], along[-1], n * emit_every + 1)
+    # Drop the tool over every fine sample of every row and of the links between rows.
+    r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / scale
+    lift_tip = r - r_mm / scale if tool.shape == "ball" else stock / scale
+    a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
+    xs, ys = (a_grid, l_grid) if raster.direction == "x" else (l_grid, a_grid)
+    z_rows = (drop_cutter(surface, xs, ys, r, tool.shape, evaluator=ev) + lift_tip) * scale  # tool tip, mm
+    gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
+    link_n = max(2, 2 * int(math.ceil(gap * scale / fine / 2)))
+    u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
+    ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
+    link_a = np.repeat(ends, len(u))
+    link_l = (levels[:-1, None] + u[None, :] * gap).ravel()
+    lx, ly = (link_a, link_l) if raster.direction == "x" else (link_l, link_a)
+    z_links = ((drop_cutter(surface, lx, ly, r, tool.shape, evaluator=ev) + lift_tip) * scale
+               if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
+    # One fine polyline through all rows and links, then the points to emit on it.
+    fa, fl, fz, frow, keep = [], [], [], [], []
+    count = 0
+    for i in range(len(levels)):
+        fwd = i % 2 == 0
+        t = along if fwd else along[::-1]
+        piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
+        if i + 1 < len(levels):
+            piece.append((np.full_like(u, t[-1]), levels[i] + u * gap, z_links[i]))
+        for pa, pl, pz in piece:
+            fa.append(pa)
+            fl.append(pl)
+            fz.append(pz)
+            frow.append(np.full(len(pa), i))
+        # The row runs over fine indices [count, count + len(t)), the link after it up to the next row's start.
+        row_end = count + len(t) - 1
+        nxt = row_end + len(u) + 1 if i + 1 < len(levels) else None
+        for lo, hi, is_row in ((count, row_end, True), (row_end, nxt, False)):
+            if hi is not None:
+                keep.append((lo, hi, is_row))
+        count = row_end + len(u) + 1 if i + 1 < len(levels) else row_end + 1
+    fa, fl, fz, frow = (np.concatenate(v) for v in (fa, fl, fz, frow))
+    fx, fy = (fa, fl) if raster.direction == "x" else (fl, fa)
+    fx, fy = fx * scale, fy * scale
+    s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))])
+    bend = np.concatenate([_bend(fz[lo:hi + 1])[:-1] for lo, hi, _ in keep] + [[0.0]])
+    kept = [0]
+    for lo, hi, is_row in keep:
+        if tol is not None:
+            k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], fz[lo:hi + 1], tol, bend[lo:hi + 1]) + lo
+        elif is_row:
+            k = np.arange(lo, hi + 1, emit_every)
+        else:
+            k = np.array([lo, hi])
+        kept.extend(int(v) for v in k[1:])
+    kept = np.array(kept, dtype=int)
+    sag = _sag(s_mm, fz, kept, bend)
+    lift = np.zeros(len(kept))
+    if len(sag):
+        lift[:-1] = sag
+        lift[1:] = np.maximum(lift[1:], sag)
+    ox, oy, oz = settings.origin_mm
+    points = np.stack([fx[kept] + ox, fy[kept] + oy, fz[kept] + lift + oz], axis=1)
+    b = ev.bounds
+    return Toolpath(
+        points_mm=points,
+        rows=frow[kept],
+        exact_mm=fz[kept] + oz,
+        tool=tool,
+        raster=raster,
+        stepover_mm=float((levels[1] - levels[0]) * scale) if len(levels) > 1 else float(stepover),
+        step_mm=float(step),
+        bounds_mm=(b[0] * scale + ox, b[1] * scale + ox, b[2] * scale + oy, b[3] * scale + oy),
+    )
+
+
+def _tolerance_step(ev: SurfaceEvaluator, tol: float, scale: float) -> float:
+    """A sampling step whose own chordal error on the surface is a quarter of ``tol`` (mm)."""
+    kappa = ev.curvature_bound() / scale  # 1/mm
+    x0, x1, y0, y1 = ev.bounds
+    longest = max(x1 - x0, y1 - y0) * scale
+    if kappa <= 0:
+        return longest / 4
+    return float(min(math.sqrt(2.0 * tol / kappa), longest / 4))

@@ -1,0 +1,127 @@
+"""Cut simulation: lagsym's programs do not gouge, a normal-offset path and a doctored program do."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from lagsym.gcode import parse_moves
+from lagsym.grid import grid_from_table
+from lagsym.io import read_points
+from lagsym.lagrange import lagrange_surface
+from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.post.program import PointProgram, point_program, write_program
+from lagsym.toolpath import plan_toolpath
+from lagsym.verify import simulate_cut
+
+from conftest import EXAMPLES
+
+EX2 = EXAMPLES / "paper-example-2.json"
+
+
+def valley():
+    """z = (x - 2)**2 / 2 + 1 over [0, 4] x [0, 2] (surface units): curvature radius 1 at the floor."""
+    xs = [Fraction(i) for i in range(5)]
+    ys = [Fraction(0), Fraction(2)]
+    return lagrange_surface(grid_from_table(xs, ys, [[(x - 2) ** 2 / 2 + 1] * 2 for x in xs]))
+
+
+@pytest.fixture(scope="module")
+def ex2_program():
+    surf = lagrange_surface(read_points(EX2))
+    s = MachineSettings(dialect="linuxcnc", scale=10.0, safe_z_mm=60.0)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s)
+    return surf, tp, s, write_program(point_program(tp, s))
+
+
+def test_lagsyms_program_does_not_gouge(ex2_program):
+    surf, tp, _, text = ex2_program
+    report = simulate_cut(surf, parse_moves(text), tp.tool, scale=10.0, cell_mm=0.25)
+    assert not report.gouges
+    assert report.gouge_mm <= 1e-4
+    assert report.unreached_mm2 == 0.0
+    assert 0.0 < report.scallop_mm < 10.0
+    with pytest.raises(ValueError):
+        report.cut_mm[0, 0] = 0.0
+
+
+def test_a_lowered_point_is_found(ex2_program):
+    surf, tp, s, _ = ex2_program
+    p = np.array(tp.points_mm)
+    k = len(p) // 2
+    p[k, 2] -= 0.3
+    moves = parse_moves(write_program(PointProgram(p, s)))
+    report = simulate_cut(surf, moves, tp.tool, scale=10.0, cell_mm=0.25)
+    assert report.gouges
+    assert 0.2 <= report.gouge_mm <= 0.3 + 1e-9
+    assert np.hypot(report.gouge_at[0] - p[k, 0], report.gouge_at[1] - p[k, 1]) <= 3.0
+
+
+def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
+    """The textbook offset (tip = surface point + R n - R z) against drop-cutter.
+
+    The valley's curvature radius is 10 mm at the floor, the ball's radius 15 mm.
+    """
+    surf = valley()
+    scale, r = 10.0, 15.0
+    x = np.linspace(0.0, 4.0, 161)
+    y = np.full_like(x, 1.0)
+    z = surf.evaluate(x, y)
+    slope = (x - 2.0)  # dF/dx, surface units
+    n = np.stack([-slope, np.zeros_like(x), np.ones_like(x)]) / np.sqrt(1 + slope**2)
+    centre = np.stack([x * scale, y * scale, z * scale]) + r * n
+    offset = np.stack([centre[0], centre[1], centre[2] - r], axis=1)
+    inside = (offset[:, 0] >= 0) & (offset[:, 0] <= 40.0)
+    s = MachineSettings(scale=scale, safe_z_mm=200.0)
+    bad = parse_moves(write_program(PointProgram(offset[inside], s)))
+    tool = Tool("ball", 2 * r)
+    assert simulate_cut(surf, bad, tool, scale=scale, cell_mm=0.25).gouge_mm > 1.0
+    tp = plan_toolpath(surf, tool, RasterSpec("x", 20.0, 0.25), s)
+    good = parse_moves(write_program(point_program(tp, s)))
+    assert not simulate_cut(surf, good, tool, scale=scale, cell_mm=0.25).gouges
+
+
+def test_moves_before_the_first_z_do_not_cut():
+    surf = lagrange_surface(read_points(EX2))
+    moves = parse_moves("G00 X10. Y10.\nG00 Z30.\nG01 X40. Y40. F100.\n")
+    report = simulate_cut(surf, moves, Tool("ball", 6.0), scale=10.0, cell_mm=0.5)
+    assert report.gouge_mm == 0.0 and report.unreached_mm2 > 0.0
+
+
+def test_verify_command_exit_statuses(run_cli, tmp_path, ex2_program):
+    _, _, _, text = ex2_program
+    good = tmp_path / "good.ngc"
+    good.write_text(text)
+    status, out, err = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3")
+    assert status == 0, err
+    assert "worst gouge" in out and "none" in out
+    status, out, _ = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "8", "--cell", "0.3")
+    assert status == 1 and "GOUGE" in out  # the program was made for a smaller ball
+    arcs = tmp_path / "arcs.ngc"
+    arcs.write_text("G0 X0 Y0 Z5\nG2 X1 Y1 I1 J0\n")
+    status, _, err = run_cli("verify", EX2, arcs, "--scale", "10")
+    assert status == 2 and "arcs.ngc, line 2" in err
+    status, _, err = run_cli("verify", EX2, tmp_path / "missing.nc")
+    assert status == 2 and "missing.nc" in err
+
+
+def test_toolpath_command_writes_a_program_the_interpreter_accepts(run_cli, tmp_path, rs274):
+    from gcheck import interpret
+
+    out_file = tmp_path / "O1000.nc"
+    status, out, err = run_cli("toolpath", EX2, "--scale", "10", "--tool-diameter", "6", "--stepover", "2",
+                               "--step", "1", "--feed", "600", "--safe-z", "80", "--dialect", "fanuc",
+                               "--line-ending", "crlf", "-o", out_file)
+    assert status == 0, err
+    text = out_file.read_bytes().decode("ascii")
+    assert text.startswith("%\r\nO1000 (PAPER-EXAMPLE-2.JSON)\r\n")
+    feeds, _ = interpret(rs274, text)
+    assert len(feeds) > 100
+    status, out, err = run_cli("toolpath", EX2, "--origin", "1,2")
+    assert status == 2 and "--origin" in err
+    status, out, err = run_cli("toolpath", EX2, "--tool-shape", "flat", "--scallop", "0.01")
+    assert status == 2 and "ball" in err
+    status, out, _ = run_cli("toolpath", EX2, "--scale", "5", "--stepover", "3", "--step", "2", "--dialect", "grbl")
+    assert status == 0 and out.startswith("(PAPER-EXAMPLE-2.JSON)")
