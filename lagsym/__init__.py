@@ -20,13 +20,17 @@ from .errors import (
 from .evaluate import SurfaceEvaluator, surface_evaluator
 from .export import write_sample
 from .formula import Formula, parse_formula
+from .gcode import Moves, move_points, parse_moves
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
 from .io import read_any_points, read_curve_points, read_points
 from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
 from .macro import MacroProgram, macro_program, planned_points, predicted_error, program_stats
+from .post.program import PointProgram, point_program, write_program
 from .sampling import Sample, SampleGrid, sample, sample_grid
 from .simulate import ControlAlarm, Simulation, simulate
 from .surfaces import bezier_surface, bspline_surface, hermite_surface, make_surface
+from .toolpath import Toolpath, drop_cutter, plan_toolpath, raster_pattern, scallop_stepover
+from .verify import CutReport, simulate_cut
 
 __version__ = "0.1.0"
 
@@ -57,6 +61,19 @@ __all__ = [
     "predicted_error",
     "program_stats",
     "simulate",
+    "CutReport",
+    "Moves",
+    "PointProgram",
+    "Toolpath",
+    "drop_cutter",
+    "move_points",
+    "parse_moves",
+    "plan_toolpath",
+    "point_program",
+    "raster_pattern",
+    "scallop_stepover",
+    "simulate_cut",
+    "write_program",
     "ControlGrid",
     "CurvePoints",
     "ExitStatus",

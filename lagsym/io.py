@@ -27,6 +27,7 @@ __all__ = [
     "read_points",
     "read_curve_points",
     "read_any_points",
+    "read_program",
     "parse_points",
     "exact_number",
     "atomic_path",
@@ -314,6 +315,30 @@ def _arity(name: str, text: str, kind: str) -> int:
     if isinstance(data, list) and data and isinstance(data[0], list):
         return len(data[0])
     return 3
+
+
+def read_program(path: str | os.PathLike) -> str:
+    """Read a part program as a control reads it: ASCII text, line endings kept as they are.
+
+    Raises
+    ------
+    InputError
+        For a missing or unreadable file, a directory, or a byte that is not ASCII.
+    """
+    name = str(path)
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{name}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{name}: is a directory, not a program") from None
+    except OSError as e:
+        raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    try:
+        return raw.decode("ascii")
+    except UnicodeDecodeError as e:
+        raise InputError(f"{name}: byte 0x{raw[e.start]:02x} at offset {e.start} is not ASCII; "
+                         f"a control reads ASCII programs") from None
 
 
 @contextlib.contextmanager

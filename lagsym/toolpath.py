@@ -357,6 +357,8 @@ def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
 
     ``2 * sqrt(2 R h - h**2)``, from the circle of the ball over the cusp.
 
+    Examples
+    --------
     >>> round(scallop_stepover(3.0, 0.01), 4)
     0.4895
     """

@@ -366,6 +366,21 @@ def test_cli_writes_pictures(run_cli, tmp_path, file, show):
     assert ink(np.asarray(Image.open(out).convert("RGB"))) > 0.01
 
 
+def test_cli_draws_a_program_over_the_surface(run_cli, tmp_path):
+    program = tmp_path / "rough.nc"
+    status, _, err = run_cli("toolpath", EXAMPLES / "paper-example-4.json", "--scale", "20", "--tool-diameter", "6",
+                             "--stepover", "4", "--step", "2", "--safe-z", "80", "-o", program)
+    assert status == 0, err
+    out = tmp_path / "tp.png"
+    status, _, err = run_cli("plot", EXAMPLES / "paper-example-4.json", "--show", "toolpath", program,
+                             "--scale", "20", "-o", out, "--size", "300x200", "--samples", "9")
+    assert (status, err) == (0, "")
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    assert img.shape == (200, 300, 3) and ink(img) > 0.05
+    red = (img[..., 0] > 180) & (img[..., 1] < 120) & (img[..., 2] < 80)
+    assert red.mean() > 0.002  # the feed moves are drawn
+
+
 def test_cli_show_before_file(run_cli, tmp_path):
     out = tmp_path / "b.png"
     status, _, stderr = run_cli("plot", "--show", "basis", EXAMPLES / "paper-example-1.json", "-o", out,
@@ -390,6 +405,7 @@ def test_cli_units_reach_the_axes(run_cli, tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("argv, message", [
     (["--show", "toolpath"], "--show toolpath needs exactly one PROGRAM file"),
+    (["--show", "toolpath", "part.ngc", "-o", "x.png"], "part.ngc: no such file"),
     (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath"),
     (["--show", "basis", "extra"], "--show basis takes no file, but got 'extra'"),
     (["-o", "out.svg"], "cannot tell the image format from '.svg'"),

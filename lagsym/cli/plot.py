@@ -29,7 +29,9 @@ examples:
   lagsym plot examples/paper-example-4.json --show basis -o basis.png
   lagsym plot examples/paper-curve-3rd.json -o curve.png
   lagsym plot examples/paper-example-4.json --show compare -o compare.png
-  lagsym plot examples/paper-example-1.json --size 800x600 --units in -o small.png"""
+  lagsym plot examples/paper-example-1.json --size 800x600 --units in -o small.png
+  lagsym toolpath examples/paper-example-4.json --scale 20 --stepover 2 --step 1 --safe-z 80 -o rough.nc
+  lagsym plot examples/paper-example-4.json --show toolpath rough.nc --scale 20 -o toolpath.png"""
 
 SHOW = ("surface", "basis", "compare", "toolpath")
 
@@ -53,6 +55,8 @@ def add_arguments(p) -> None:
     p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
     p.add_argument("--scale", type=float, default=1.0,
                    help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
+    p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
+                   help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
 
 
 def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None, str]:
@@ -125,7 +129,15 @@ def _control_points(grid):
 
 def _toolpath_figure(plot, grid, program, args, opts):
     """The moves of a G-code program drawn over the surface (the paper's Figures 12 and 14)."""
-    from ..gcode import read_program
+    import numpy as np
 
-    moves = read_program(program)
-    return plot.toolpath_figure(lagrange_surface(grid), moves.tip_points_surface(args.scale), rapid=moves.rapid, **opts)
+    from ..gcode import move_points
+    from ..io import read_program
+    from .toolpath import origin
+
+    points_mm, rapid = move_points(read_program(program), source=program)
+    if not len(points_mm):
+        raise InputError(f"{program}: no move with a Z position to draw")
+    tips = (points_mm - np.array(origin(args.origin))) / args.scale  # machine mm to surface units
+    ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
+    return plot.toolpath_figure(lagrange_surface(grid), tips, rapid=ends_rapid, **opts)

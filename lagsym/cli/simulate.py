@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from ..errors import InputError
+from ..io import read_program
 from ..simulate import SIM_DIALECTS, detect_dialect, moves_csv, simulate
 from ._common import emit
 
@@ -37,17 +35,7 @@ def add_arguments(p) -> None:
 
 
 def run(args, out, err) -> int:
-    path = Path(args.program)
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"{args.program}: no such file") from None
-    except OSError as e:
-        raise InputError(f"{args.program}: {e.strerror or e}") from None
-    try:
-        text = raw.decode("ascii")
-    except UnicodeDecodeError as e:
-        raise InputError(f"{args.program}: byte {e.start} is not ASCII; a control reads ASCII programs") from None
+    text = read_program(args.program)
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or (15 if dialect == "linuxcnc" else 8)
     sim = simulate(text, dialect, precision, max_blocks=args.max_blocks)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..errors import ExitStatus, InputError
 from ..gcode import parse_moves
-from ..io import read_points
+from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Tool
 from .toolpath import origin
@@ -23,7 +23,7 @@ input (an unreadable file, a program with arcs or canned cycles).
 
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
-  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-shape flat --tool-diameter 4 --cell 0.1"""
+  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1"""
 
 
 def add_arguments(p) -> None:
@@ -45,15 +45,7 @@ def run(args, out, err) -> int:
     if not args.scale > 0:
         raise InputError(f"--scale {args.scale!r} must be a positive number")
     surface = lagrange_surface(read_points(args.surface))
-    try:
-        with open(args.program, encoding="ascii", errors="strict", newline="") as fh:
-            text = fh.read()
-    except FileNotFoundError:
-        raise InputError(f"{args.program}: no such file") from None
-    except UnicodeDecodeError as e:
-        raise InputError(f"{args.program}: byte {e.start} is not ISO/ASCII text") from None
-    except OSError as e:
-        raise InputError(f"{args.program}: {e.strerror}") from None
+    text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
     report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), scale=args.scale,
                           origin_mm=origin(args.origin), cell_mm=args.cell, gouge_limit_mm=args.gouge_limit)

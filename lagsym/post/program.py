@@ -73,6 +73,8 @@ _NOT_ISO = re.compile(r"[^A-Z0-9 .,:=+\-/*#_]")
 def iso_comment(text: str) -> str:
     """Comment text a control accepts: upper-case ISO characters, no parentheses.
 
+    Examples
+    --------
     >>> iso_comment("Paper example 4 (5x5) – Ø6 ball")
     'PAPER EXAMPLE 4 5X5 - 6 BALL'
     """
