@@ -1,0 +1,250 @@
+"""A simulated CNC control at the far end of a real pseudo-terminal pair made by socat.
+
+A pty has no baud rate, so the control paces itself: it takes characters
+from its end no faster than the line rate of its baud, holds them in a small
+buffer that the "machine" empties at ``drain_cps``, sends DC3 at the high
+water mark and DC1 at the low one, and records every byte.  It counts
+overflow the way a Fanuc raises alarm 087: characters that arrive after its
+DC3 beyond ``tolerance``.  Time the simulation itself lost to the scheduler
+is not charged to the sender (a real control's UART interrupt answers at once).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+import threading
+import time
+
+import serial
+
+DC1, DC2, DC3, DC4 = b"\x11", b"\x12", b"\x13", b"\x14"
+_LOOP_S = 0.0005
+
+
+def chars_per_s(baud: int, bytesize: int = 7, parity: str = "even", stopbits: float = 2) -> float:
+    """Characters per second on a line."""
+    return baud / (1 + bytesize + (parity != "none") + stopbits)
+
+
+class PtyPair:
+    """Two linked pseudo-terminals from socat: ``near`` for lagsym, ``far`` for the simulated control."""
+
+    def __init__(self, directory: str | None = None):
+        if shutil.which("socat") is None:
+            raise RuntimeError("socat is not installed (apt-get install socat)")
+        self._tmp = tempfile.mkdtemp(prefix="lagsym-pty-", dir=directory)
+        self.near = os.path.join(self._tmp, "near")
+        self.far = os.path.join(self._tmp, "far")
+        self.proc = subprocess.Popen(
+            ["socat", "-t", "0", f"pty,raw,echo=0,link={self.near}", f"pty,raw,echo=0,link={self.far}"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 10
+        while not (os.path.exists(self.near) and os.path.exists(self.far)):
+            if self.proc.poll() is not None or time.monotonic() > deadline:
+                self.close()
+                raise RuntimeError("socat did not make the pty pair")
+            time.sleep(0.01)
+
+    def hang_up(self) -> None:
+        """Cut the line: both ends see a hang-up at once."""
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+
+    def close(self) -> None:
+        self.hang_up()
+        shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class SimControl(threading.Thread):
+    """The control: reads at its line rate, buffers, says XOFF/XON, records, and can misbehave on request.
+
+    Parameters
+    ----------
+    path : str
+        Its end of the pty pair.
+    baud, bytesize, parity, stopbits
+        The line, for the pacing.
+    buffer_chars, high_water, low_water : int
+        The input buffer and the marks at which DC3 and DC1 go out.
+    drain_cps : float or None
+        How fast the machine empties the buffer; None: at once (never XOFF).
+    tolerance : int
+        Characters accepted after DC3 before counting overflow (a Fanuc: about 10).
+    ignore_xon : bool
+        Send DC3 and never DC1.
+    drop_on_xoff : int or None
+        At this XOFF, wait ``drop_settle_s`` and then cut the line.
+    drop_after_bytes : int or None
+        Cut the line as soon as this many bytes have arrived.
+    pair : PtyPair
+        What to hang up when cutting the line.
+    """
+
+    def __init__(self, path: str, baud: int = 9600, bytesize: int = 7, parity: str = "even", stopbits: float = 2,
+                 buffer_chars: int = 256, high_water: int = 192, low_water: int = 64, drain_cps: float | None = None,
+                 tolerance: int = 10, ignore_xon: bool = False, drop_on_xoff: int | None = None,
+                 drop_settle_s: float = 0.4, drop_after_bytes: int | None = None, pair: PtyPair | None = None):
+        super().__init__(daemon=True)
+        self.cps = chars_per_s(baud, bytesize, parity, stopbits)
+        self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
+        self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
+        self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
+        self.pair = pair
+        self.port = serial.Serial(path, baudrate=baud, timeout=0)
+        self.received = bytearray()
+        self.overflow = 0  # characters past the tolerance after DC3, summed over XOFF episodes
+        self.max_after_xoff = 0
+        self.xoffs = 0
+        self.dropped = False
+        self.error: BaseException | None = None
+        self._halt = threading.Event()
+        self.first_byte_at: float | None = None
+        self.last_byte_at: float | None = None
+
+    # -- results -------------------------------------------------------------------------------------
+
+    def lines(self) -> list[str]:
+        """Complete lines received (a partial last line, cut by a drop, is discarded), without leader NULs."""
+        text = self.received.replace(b"\x00", b"").decode("ascii")
+        parts = text.replace("\r\n", "\n").split("\n")
+        return parts[:-1]
+
+    def wait_for(self, count: int, timeout: float = 30.0) -> bool:
+        """Wait until ``count`` bytes have arrived."""
+        deadline = time.monotonic() + timeout
+        while len(self.received) < count and time.monotonic() < deadline and self.is_alive():
+            time.sleep(0.01)
+        return len(self.received) >= count
+
+    def stop(self) -> None:
+        self._halt.set()
+        self.join(10)
+        try:
+            self.port.close()
+        except (serial.SerialException, OSError):
+            pass
+        if self.error is not None and not self.dropped:
+            raise self.error
+
+    # -- the control ----------------------------------------------------------------------------------
+
+    def _cut(self) -> None:
+        self.dropped = True
+        try:
+            self.port.close()
+        finally:
+            if self.pair is not None:
+                self.pair.hang_up()
+
+    def run(self) -> None:
+        try:
+            self._run()
+        except (serial.SerialException, OSError) as e:
+            self.error = e
+
+    def _run(self) -> None:
+        buffered = 0.0
+        credit = 0.0
+        xoff = False
+        after = 0  # characters since DC3 (or since the high-water crossing, when DC3 went late)
+        excused = 0.0  # characters that arrived while the simulation itself was descheduled
+        drop_at: float | None = None
+        last = time.monotonic()
+        while not self._halt.is_set():
+            now = time.monotonic()
+            gap = now - last
+            last = now
+            if drop_at is not None and now >= drop_at:
+                self.port.read(4096)  # whatever was still on the way arrives before the cut
+                self._cut()
+                return
+            if self.drain_cps is None:
+                buffered = 0.0
+            else:
+                buffered = max(0.0, buffered - self.drain_cps * gap)
+            pending = self.port.in_waiting
+            if pending:
+                credit = min(credit + gap * self.cps, max(4.0, self.cps * 0.05))
+            else:
+                credit = 0.0
+            n = min(pending, int(credit))
+            crossed = False
+            if n:
+                data = self.port.read(n)
+                credit -= len(data)
+                now = time.monotonic()
+                if self.first_byte_at is None:
+                    self.first_byte_at = now
+                self.last_byte_at = now
+                late = max(0.0, (gap - 5 * _LOOP_S - 0.001)) * self.cps
+                for k, byte in enumerate(data):
+                    self.received.append(byte)
+                    buffered += 1
+                    if xoff:
+                        after += 1
+                    elif buffered >= self.high:
+                        crossed = True
+                        xoff = True
+                        after = 0
+                        excused = late
+                    if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
+                        self._cut()
+                        return
+                if crossed:
+                    self.port.write(DC3)
+                    self.xoffs += 1
+                    if self.drop_on_xoff is not None and self.xoffs == self.drop_on_xoff:
+                        drop_at = time.monotonic() + self.drop_settle_s
+                if xoff:
+                    self.max_after_xoff = max(self.max_after_xoff, after)
+            if xoff and not self.ignore_xon and drop_at is None and buffered <= self.low:
+                self.overflow += max(0, int(after - excused) - self.tolerance)
+                xoff = False
+                self.port.write(DC1)
+            time.sleep(_LOOP_S)
+        if xoff:
+            self.overflow += max(0, int(after - excused) - self.tolerance)
+
+
+def punch(path: str, data: bytes, baud: int = 9600, bytesize: int = 7, parity: str = "even", stopbits: float = 2,
+          delay_s: float = 0.3) -> None:
+    """Send ``data`` from the control's end at the line rate, as a control punching a program does."""
+    cps = chars_per_s(baud, bytesize, parity, stopbits)
+    with serial.Serial(path, baudrate=baud, timeout=0) as port:
+        time.sleep(delay_s)
+        start = time.monotonic()
+        sent = 0
+        while sent < len(data):
+            due = int((time.monotonic() - start) * cps) + 1
+            if due > sent:
+                sent += port.write(data[sent:min(due, len(data))])
+            time.sleep(0.001)
+        port.flush()
+        time.sleep(0.2)
+
+
+def program_text(blocks: int, seed: int = 1) -> str:
+    """A plausible drip-feed program of ``blocks`` blocks (about 30 characters each)."""
+    lines = ["O1000", "G21 G17 G90 G54", "T1 M6", "S3000 M3", "G0 Z50.", "G0 X0. Y0.", "G1 Z-1. F600."]
+    x = 0
+    k = 0
+    while len(lines) < blocks - 2:
+        k += 1
+        x += 1
+        y = (k * 37 + seed) % 1000
+        lines.append(f"G1 X{x * 0.125:.3f} Y{y * 0.051:.3f} Z{-1 - (k % 7) * 0.01:.3f}")
+    lines += ["G0 Z50.", "M30"]
+    return "%\n" + "\n".join(lines) + "\n%\n"
+
+
+__all__ = ["PtyPair", "SimControl", "punch", "program_text", "chars_per_s"]
