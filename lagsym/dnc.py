@@ -110,7 +110,7 @@ class LineSettings:
     percent: bool = True
     dtr: bool = True
     stall_timeout_s: float = 120.0
-    overrun_chars: int = 8
+    overrun_chars: int = 4
     wait_for_xon: bool = False
 
     def __post_init__(self):
@@ -149,11 +149,11 @@ class LineSettings:
 # Sources for each profile are in docs/dnc.md.
 PROFILES: dict[str, LineSettings] = {
     "fanuc": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2, flow="xonxoff", eol="lf",
-                          leader="\x00" * 20, trailer="\x00" * 20, percent=True, overrun_chars=8),
+                          leader="\x00" * 20, trailer="\x00" * 20, percent=True),
     "haas": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", eol="crlf",
-                         leader="", trailer="", percent=True, overrun_chars=8),
+                         leader="", trailer="", percent=True),
     "heidenhain": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", eol="crlf",
-                               leader="\x00" * 50, trailer="\x03", percent=False, overrun_chars=8),
+                               leader="\x00" * 50, trailer="\x03", percent=False),
 }
 
 
@@ -237,12 +237,16 @@ class LineFault(TransferError):
     start_block : int or None
         The ``--start-block`` that resumes a drip feed, or None for an upload
         (which must be sent again whole).
+    last_sent_block : int
+        The last block written whole: blocks after ``last_block`` up to this
+        one were on their way and may have arrived too.
     """
 
-    def __init__(self, message: str, last_block: int, start_block: int | None):
+    def __init__(self, message: str, last_block: int, start_block: int | None, last_sent_block: int | None = None):
         super().__init__(message)
         self.last_block = last_block
         self.start_block = start_block
+        self.last_sent_block = last_block if last_sent_block is None else last_sent_block
 
 
 def plan_transfer(program: Program, settings: LineSettings, mode: str = "upload", start_block: int = 1,
@@ -356,6 +360,10 @@ class _Sender:
         done = self.blocks_surely_done()
         return self.ends[done - 1][1] if done else self.first_block - 1
 
+    def last_sent_block(self) -> int:
+        sent = [number for end, number in self.ends if end <= self.pos]
+        return sent[-1] if sent else self.first_block - 1
+
     def report(self, start: float, now: float) -> None:
         if self.progress:
             self.progress(TransferProgress(self.blocks_surely_done(), self.blocks_total, self.sure, len(self.data),
@@ -364,6 +372,9 @@ class _Sender:
     def fault(self, what: str, todo: str) -> LineFault:
         last = self.last_sure_block()
         where = f"block {last} surely reached the control" if last else "no block surely reached the control"
+        sent = self.last_sent_block()
+        if sent > last:
+            where += f" (blocks {last + 1} to {sent} were on their way and may have arrived too)"
         if self.mode == "drip":
             resume = last + 1
             hint = (f"{todo}, then resume with --start-block {resume}" if resume > 1
@@ -375,7 +386,7 @@ class _Sender:
             resume = None
             message = f"{what} on {self.port}; {where}; the upload is incomplete: {todo}, then send the whole program again"
         self.log(f"fault: {message}")
-        return LineFault(message, last, resume)
+        return LineFault(message, last, resume, sent)
 
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""

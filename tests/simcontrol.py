@@ -11,11 +11,12 @@ is not charged to the sender (a real control's UART interrupt answers at once).
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
-import threading
 import time
 
 import serial
@@ -38,6 +39,7 @@ class PtyPair:
         self._tmp = tempfile.mkdtemp(prefix="lagsym-pty-", dir=directory)
         self.near = os.path.join(self._tmp, "near")
         self.far = os.path.join(self._tmp, "far")
+        self._owner = os.getpid()
         self.proc = subprocess.Popen(
             ["socat", "-t", "0", f"pty,raw,echo=0,link={self.near}", f"pty,raw,echo=0,link={self.far}"],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -49,9 +51,12 @@ class PtyPair:
             time.sleep(0.01)
 
     def hang_up(self) -> None:
-        """Cut the line: both ends see a hang-up at once."""
-        if self.proc.poll() is None:
-            self.proc.kill()
+        """Cut the line: both ends see a hang-up at once (callable from the control's process too)."""
+        try:
+            os.kill(self.proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        if os.getpid() == self._owner:
             self.proc.wait()
 
     def close(self) -> None:
@@ -65,8 +70,13 @@ class PtyPair:
         self.close()
 
 
-class SimControl(threading.Thread):
+class SimControl:
     """The control: reads at its line rate, buffers, says XOFF/XON, records, and can misbehave on request.
+
+    It runs in a process of its own, so that its pace does not depend on the
+    sender's interpreter.  Its record (``received``, ``overflow``, ``xoffs``,
+    ``max_after_xoff``, ``dropped``) is read once it has stopped; reading it
+    stops it.
 
     Parameters
     ----------
@@ -90,130 +100,158 @@ class SimControl(threading.Thread):
         What to hang up when cutting the line.
     """
 
-    def __init__(self, path: str, baud: int = 9600, bytesize: int = 7, parity: str = "even", stopbits: float = 2,
-                 buffer_chars: int = 256, high_water: int = 192, low_water: int = 64, drain_cps: float | None = None,
-                 tolerance: int = 10, ignore_xon: bool = False, drop_on_xoff: int | None = None,
-                 drop_settle_s: float = 0.4, drop_after_bytes: int | None = None, pair: PtyPair | None = None):
-        super().__init__(daemon=True)
-        self.cps = chars_per_s(baud, bytesize, parity, stopbits)
-        self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
-        self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
-        self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
-        self.pair = pair
-        self.port = serial.Serial(path, baudrate=baud, timeout=0)
-        self.received = bytearray()
-        self.overflow = 0  # characters past the tolerance after DC3, summed over XOFF episodes
-        self.max_after_xoff = 0
-        self.xoffs = 0
-        self.dropped = False
-        self.error: BaseException | None = None
-        self._halt = threading.Event()
-        self.first_byte_at: float | None = None
-        self.last_byte_at: float | None = None
+    def __init__(self, path: str, pair: PtyPair | None = None, **params):
+        ctx = multiprocessing.get_context("fork")
+        self.cps = chars_per_s(params.get("baud", 9600), params.get("bytesize", 7), params.get("parity", "even"),
+                               params.get("stopbits", 2))
+        self._count = ctx.Value("q", 0, lock=False)
+        self._halt = ctx.Event()
+        self._ready = ctx.Event()
+        self._results, child_end = ctx.Pipe(duplex=False)
+        socat_pid = pair.proc.pid if pair is not None else None
+        self._proc = ctx.Process(target=_control_main, args=(path, params, socat_pid, self._count, self._halt, self._ready, child_end),
+                                 daemon=True)
+        self._record: dict | None = None
 
-    # -- results -------------------------------------------------------------------------------------
-
-    def lines(self) -> list[str]:
-        """Complete lines received (a partial last line, cut by a drop, is discarded), without leader NULs."""
-        text = self.received.replace(b"\x00", b"").decode("ascii")
-        parts = text.replace("\r\n", "\n").split("\n")
-        return parts[:-1]
+    def start(self) -> None:
+        """Start the control and wait until its end of the line is open (opening it clears its input)."""
+        self._proc.start()
+        if not self._ready.wait(10):
+            self._proc.kill()
+            raise RuntimeError("the simulated control did not open its end of the line")
 
     def wait_for(self, count: int, timeout: float = 30.0) -> bool:
         """Wait until ``count`` bytes have arrived."""
         deadline = time.monotonic() + timeout
-        while len(self.received) < count and time.monotonic() < deadline and self.is_alive():
+        while self._count.value < count and time.monotonic() < deadline and self._proc.is_alive():
             time.sleep(0.01)
-        return len(self.received) >= count
+        return self._count.value >= count
 
-    def stop(self) -> None:
-        self._halt.set()
-        self.join(10)
-        try:
-            self.port.close()
-        except (serial.SerialException, OSError):
-            pass
-        if self.error is not None and not self.dropped:
-            raise self.error
+    def stop(self) -> dict:
+        """Stop the control (if the line has not already ended it) and return its record."""
+        if self._record is None:
+            self._halt.set()
+            if not self._results.poll(15):
+                self._proc.kill()
+                raise RuntimeError("the simulated control did not stop")
+            self._record = self._results.recv()
+            self._proc.join(5)
+            if self._record["error"] and not self._record["dropped"]:
+                raise RuntimeError(f"the simulated control failed: {self._record['error']}")
+        return self._record
 
-    # -- the control ----------------------------------------------------------------------------------
+    def __getattr__(self, name):
+        if name in ("received", "overflow", "max_after_xoff", "xoffs", "dropped", "first_byte_at", "last_byte_at"):
+            return self.stop()[name]
+        raise AttributeError(name)
 
-    def _cut(self) -> None:
+    def lines(self) -> list[str]:
+        """Complete lines received (a partial last line, cut by a drop, is discarded), without leader NULs."""
+        text = self.received.replace(b"\x00", b"").decode("ascii")
+        return text.replace("\r\n", "\n").split("\n")[:-1]
+
+
+def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
+    control = _Control(path, socat_pid, count, halt, **params)
+    ready.set()
+    try:
+        control.run()
+    except (serial.SerialException, OSError) as e:
+        control.error = str(e)
+    if control.xoff:
+        control.close_episode()
+    results.send({"received": bytes(control.received), "overflow": control.overflow, "xoffs": control.xoffs,
+                  "max_after_xoff": control.max_after_xoff, "dropped": control.dropped, "error": control.error,
+                  "first_byte_at": control.first_byte_at, "last_byte_at": control.last_byte_at})
+
+
+class _Control:
+    def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
+                 buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
+                 drop_on_xoff=None, drop_settle_s=0.4, drop_after_bytes=None):
+        self.cps = chars_per_s(baud, bytesize, parity, stopbits)
+        self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
+        self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
+        self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
+        self.socat_pid, self.count, self.halt = socat_pid, count, halt
+        self.port = serial.Serial(path, baudrate=baud, timeout=0)
+        self.received = bytearray()
+        self.overflow = 0
+        self.max_after_xoff = 0
+        self.xoffs = 0
+        self.dropped = False
+        self.error = None
+        self.xoff = False
+        self.after = 0  # characters since the high-water crossing
+        self.excused = 0.0  # characters that arrived while the simulation itself was descheduled
+        self.first_byte_at = None
+        self.last_byte_at = None
+
+    def close_episode(self) -> None:
+        self.overflow += max(0, int(self.after - self.excused) - self.tolerance)
+
+    def cut(self) -> None:
         self.dropped = True
         try:
             self.port.close()
         finally:
-            if self.pair is not None:
-                self.pair.hang_up()
+            if self.socat_pid is not None:
+                try:
+                    os.kill(self.socat_pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
 
     def run(self) -> None:
-        try:
-            self._run()
-        except (serial.SerialException, OSError) as e:
-            self.error = e
-
-    def _run(self) -> None:
         buffered = 0.0
         credit = 0.0
-        xoff = False
-        after = 0  # characters since DC3 (or since the high-water crossing, when DC3 went late)
-        excused = 0.0  # characters that arrived while the simulation itself was descheduled
-        drop_at: float | None = None
+        drop_at = None
         last = time.monotonic()
-        while not self._halt.is_set():
+        while not self.halt.is_set():
             now = time.monotonic()
             gap = now - last
             last = now
             if drop_at is not None and now >= drop_at:
-                self.port.read(4096)  # whatever was still on the way arrives before the cut
-                self._cut()
+                self.received += self.port.read(4096)  # whatever was still on the way arrives before the cut
+                self.count.value = len(self.received)
+                self.cut()
                 return
-            if self.drain_cps is None:
-                buffered = 0.0
-            else:
-                buffered = max(0.0, buffered - self.drain_cps * gap)
+            buffered = 0.0 if self.drain_cps is None else max(0.0, buffered - self.drain_cps * gap)
             pending = self.port.in_waiting
-            if pending:
-                credit = min(credit + gap * self.cps, max(4.0, self.cps * 0.05))
-            else:
-                credit = 0.0
+            credit = min(credit + gap * self.cps, max(4.0, self.cps * 0.05)) if pending else 0.0
             n = min(pending, int(credit))
             crossed = False
             if n:
                 data = self.port.read(n)
                 credit -= len(data)
                 now = time.monotonic()
-                if self.first_byte_at is None:
-                    self.first_byte_at = now
+                self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
-                late = max(0.0, (gap - 5 * _LOOP_S - 0.001)) * self.cps
-                for k, byte in enumerate(data):
+                late = max(0.0, gap - 0.002) * self.cps
+                for byte in data:
                     self.received.append(byte)
                     buffered += 1
-                    if xoff:
-                        after += 1
+                    if self.xoff:
+                        self.after += 1
                     elif buffered >= self.high:
-                        crossed = True
-                        xoff = True
-                        after = 0
-                        excused = late
+                        crossed = self.xoff = True
+                        self.after, self.excused = 0, late
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
-                        self._cut()
+                        self.count.value = len(self.received)
+                        self.cut()
                         return
+                self.count.value = len(self.received)
                 if crossed:
                     self.port.write(DC3)
                     self.xoffs += 1
                     if self.drop_on_xoff is not None and self.xoffs == self.drop_on_xoff:
                         drop_at = time.monotonic() + self.drop_settle_s
-                if xoff:
-                    self.max_after_xoff = max(self.max_after_xoff, after)
-            if xoff and not self.ignore_xon and drop_at is None and buffered <= self.low:
-                self.overflow += max(0, int(after - excused) - self.tolerance)
-                xoff = False
+                if self.xoff:
+                    self.max_after_xoff = max(self.max_after_xoff, self.after)
+            if self.xoff and not self.ignore_xon and drop_at is None and buffered <= self.low:
+                self.close_episode()
+                self.xoff = False
                 self.port.write(DC1)
             time.sleep(_LOOP_S)
-        if xoff:
-            self.overflow += max(0, int(after - excused) - self.tolerance)
 
 
 def punch(path: str, data: bytes, baud: int = 9600, bytesize: int = 7, parity: str = "even", stopbits: float = 2,

@@ -1,0 +1,366 @@
+"""The RS-232 link: framing, resume planning, and real transfers over a socat pty pair to a simulated control."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import shutil
+import socket
+import threading
+
+import pytest
+
+from lagsym.dnc import (
+    PROFILES,
+    LineFault,
+    LineSettings,
+    parse_filler,
+    plan_transfer,
+    profile,
+    send_program,
+)
+from lagsym.dncplan import parse_program, resume_setup
+from lagsym.errors import InputError, TransferError
+from simcontrol import PtyPair, SimControl, chars_per_s, program_text, punch
+
+needs_socat = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
+
+
+def program_blocks(text: str) -> list[str]:
+    return list(parse_program(text).blocks)
+
+
+def write(tmp_path, text: str, name: str = "prog.nc"):
+    path = tmp_path / name
+    path.write_text(text, newline="")
+    return path
+
+
+def resume_hint(stderr: str) -> int:
+    m = re.search(r"--start-block (\d+)", stderr)
+    assert m, stderr
+    return int(m.group(1))
+
+
+# -- pure parts ---------------------------------------------------------------------------------------------
+
+
+def test_blocks_are_the_non_empty_lines_inside_the_percent_framing():
+    p = parse_program("%\r\nO1000\r\n\r\nG21 G90 \r\nM30\r\n%\r\n")
+    assert p.blocks == ("O1000", "G21 G90", "M30")
+    assert p.block(1) == "O1000"
+
+
+@pytest.mark.parametrize("text, words", [
+    ("O1\nG0 X1.\x13\n", "DC3"),
+    ("O1\nG0 X1.é\n", "7-bit"),
+    ("O1\n%\nG0 X1.\n", "after the closing %"),
+    ("%\n\n%\n", "no blocks"),
+])
+def test_programs_a_line_cannot_carry_are_refused_with_the_line(text, words):
+    with pytest.raises(InputError, match=words):
+        parse_program(text, "p.nc")
+
+
+def test_framing_puts_leader_percent_blocks_percent_trailer_on_the_line():
+    settings = LineSettings(eol="crlf", leader="\x00\x00", trailer="\x03")
+    wire = b"".join(b for _, b in plan_transfer(parse_program("O1\nM30"), settings))
+    assert wire == b"\x00\x00%\r\nO1\r\nM30\r\n%\r\n\x03"
+
+
+def test_profiles_fill_in_settings_and_any_can_be_overridden():
+    fanuc = profile("fanuc", baud=4800)
+    assert (fanuc.baud, fanuc.bytesize, fanuc.parity, fanuc.stopbits, fanuc.flow) == (4800, 7, "even", 2.0, "xonxoff")
+    assert PROFILES["heidenhain"].percent is False and PROFILES["heidenhain"].trailer == "\x03"
+    assert PROFILES["haas"].eol == "crlf"
+    with pytest.raises(InputError, match="fanuc, haas, heidenhain"):
+        profile("mazak")
+
+
+def test_settings_are_frozen_and_checked_against_their_choices():
+    s = LineSettings()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.baud = 19200
+    with pytest.raises(InputError, match="none, even, odd, mark, space"):
+        LineSettings(parity="evn")
+    with pytest.raises(InputError, match="xonxoff, rtscts, none"):
+        LineSettings(flow="dtr")
+    assert LineSettings(bytesize=8, parity="none", stopbits=1).bits_per_char == 10
+
+
+def test_leader_and_trailer_specs():
+    assert parse_filler("2*NUL,ETX") == "\x00\x00\x03"
+    with pytest.raises(InputError, match="NUL"):
+        parse_filler("3*BEL")
+
+
+PROGRAM = """%
+O1000
+G21 G17 G90 G54
+T2 M6
+S4000 M3
+G0 Z25.
+G0 X0. Y0.
+M8
+G1 Z-1. F300.
+G1 X10. Y0. F600.
+G2 X20. Y10. I10. J0.
+G1 X30.
+G0 Z25.
+M30
+%
+"""
+
+
+def test_resume_setup_restores_modes_retracts_and_approaches():
+    p = parse_program(PROGRAM)
+    setup = resume_setup(p, 11)
+    assert setup == ("(RESUME AT BLOCK 11)", "G21 G17 G90 G54", "T2 M6", "S4000 M3", "G0 Z25.",
+                     "G0 X20. Y10.", "M8", "G1 Z-1. F600.", "G2")
+    assert resume_setup(p, 11, safe_z="40")[4] == "G0 Z40."
+
+
+@pytest.mark.parametrize("text, start, words", [
+    (PROGRAM, 1, "outside the program"),
+    (PROGRAM, 99, "outside the program"),
+    ("O1\nG21 G90\n#1=5\nG0 Z#1\nG1 X1. F100.", 5, "macro variables"),
+    ("O1\nG90 G0 Z5.\nG1 X1. F100.", 3, "G20 or G21"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG81 Z-2. R1. F100.\nX2.", 5, "G81"),
+    ("O1\nG21 G90\nG1 X1. Y1. Z-1. F100.\nX2.", 4, "safe-z"),
+])
+def test_resume_refuses_what_it_cannot_replay(text, start, words):
+    with pytest.raises(InputError, match=words):
+        resume_setup(parse_program(text, "p.nc"), start)
+
+
+def test_start_block_is_only_for_drip_feeds():
+    with pytest.raises(InputError, match="drip"):
+        plan_transfer(parse_program(PROGRAM), LineSettings(), "upload", start_block=4)
+
+
+# -- command line without a control -------------------------------------------------------------------------
+
+
+def test_send_over_loop_url_reports_what_it_sent(run_cli, tmp_path):
+    path = write(tmp_path, PROGRAM)
+    status, out, err = run_cli("send", path, "--port", "loop://", "--baud", "115200")
+    assert status == 0, err
+    assert "sent 13 blocks" in out
+
+
+def test_a_missing_port_is_a_line_fault_not_a_traceback(run_cli, tmp_path):
+    path = write(tmp_path, PROGRAM)
+    status, out, err = run_cli("send", path, "--port", str(tmp_path / "ttyUSB9"), "--quiet")
+    assert status == 3
+    assert err.startswith("lagsym: error: cannot open") and "check the cable" in err
+    status, out, err = run_cli("receive", "--port", "socket://127.0.0.1:1", "--quiet")
+    assert status == 3 and "cannot open socket://127.0.0.1:1" in err
+
+
+def test_bad_options_are_input_errors(run_cli, tmp_path):
+    path = write(tmp_path, PROGRAM)
+    status, _, err = run_cli("send", path, "--port", "loop://", "--mode", "upload", "--start-block", "5")
+    assert status == 2 and "drip" in err
+    status, _, err = run_cli("send", path, "--port", "loop://", "--leader", "4*BEL")
+    assert status == 2 and "BEL" in err
+
+
+def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp_path):
+    text = program_text(400)
+    path = write(tmp_path, text)
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+
+    def gateway():
+        conn, _ = server.accept()
+        got = b""
+        while len(got) < 3000:
+            got += conn.recv(4096)
+        conn.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
+        conn.close()
+
+    t = threading.Thread(target=gateway, daemon=True)
+    t.start()
+    port = f"socket://127.0.0.1:{server.getsockname()[1]}"
+    status, _, err = run_cli("send", path, "--port", port, "--mode", "drip", "--baud", "115200", "--quiet")
+    server.close()
+    t.join(5)
+    assert status == 3, err
+    assert "the line was lost" in err
+    assert 2 <= resume_hint(err) <= 3000 // 20
+
+
+# -- real transfers over a pty pair -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def line():
+    """A socat pty pair; yields a function that starts a simulated control on its far end."""
+    pairs, sims = [], []
+
+    def start(**kwargs):
+        pair = PtyPair()
+        pairs.append(pair)
+        sim = SimControl(pair.far, pair=pair, **kwargs)
+        sim.start()
+        sims.append(sim)
+        return pair, sim
+
+    yield start
+    for sim in sims:
+        sim.stop()
+    for pair in pairs:
+        pair.close()
+
+
+@needs_socat
+def test_large_drip_feed_arrives_byte_exact(line):
+    baud = 115200
+    prog = parse_program(program_text(1200))
+    settings = profile("fanuc", baud=baud, stall_timeout_s=10)
+    pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=1024, high_water=512, low_water=128)
+    expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
+    assert len(expected) > 30_000
+    result = send_program(pair.near, prog, settings, "drip")
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert sim.xoffs > 3 and result.xoff_count == sim.xoffs
+    assert result.blocks == len(prog)
+    # When lagsym saw XOFF, no more than its limit was on the way; what the control counts after its
+    # DC3 also holds the pty relay's delay, which at this rate is worth many characters.
+    assert result.max_in_flight_at_xoff <= settings.overrun_chars
+    assert sim.max_after_xoff < 512 - 128
+
+
+@needs_socat
+def test_xoff_is_obeyed_within_a_fanucs_tolerance(line):
+    # 4800 baud, a Fanuc's classic rate: the 10 characters it tolerates past DC3 are worth 23 ms, which
+    # covers the pty relay's delay on a loaded machine as well as a real UART's.
+    baud = 4800
+    prog = parse_program(program_text(40))
+    settings = profile("fanuc", baud=baud)
+    pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192, low_water=64,
+                     tolerance=10)
+    expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
+    send_program(pair.near, prog, settings, "drip")
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert sim.xoffs >= 3
+    assert sim.overflow == 0, sim.max_after_xoff
+
+
+@needs_socat
+def test_progress_counts_only_what_has_left_the_line(line):
+    baud = 38400
+    prog = parse_program(program_text(120))
+    settings = profile("haas", baud=baud)
+    pair, sim = line(baud=baud, stopbits=1)
+    seen = []
+    send_program(pair.near, prog, settings, "upload", progress=seen.append)
+    assert seen[-1].blocks_done == seen[-1].blocks_total == len(prog)
+    assert seen[-1].bytes_done == seen[-1].bytes_total
+    assert all(a.bytes_done <= b.bytes_done for a, b in zip(seen, seen[1:]))
+    # The line rate bounds what can have left it at any moment.
+    cps = settings.chars_per_s
+    assert all(p.bytes_done <= cps * p.elapsed_s + settings.overrun_chars for p in seen)
+
+
+def _resume_and_check(line, run_cli, path, text, baud, first_lines, start, tmp_path):
+    """Resume at ``start`` on a fresh line; check that the two sessions hold every block once, in order."""
+    blocks = program_blocks(text)
+    # The first session holds the framing % and exactly the blocks before the resume block.
+    assert first_lines[0] == "%"
+    assert first_lines[1:] == blocks[:start - 1]
+    pair, sim = line(baud=baud)
+    log = tmp_path / "resume.log"
+    status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
+                               "--mode", "drip", "--start-block", start, "--quiet", "--log", log)
+    assert status == 0, err
+    setup = list(resume_setup(parse_program(text), start))
+    tail = blocks[start - 1:]
+    assert sim.wait_for(len("\n".join(["%"] + setup + tail + ["%"])))
+    second = sim.lines()
+    assert second == ["%"] + setup + tail + ["%"]
+    assert first_lines[1:] + second[1 + len(setup):-1] == blocks
+    assert "done:" in log.read_text()
+
+
+@needs_socat
+def test_xoff_without_xon_stalls_with_exit_3_and_the_resume_block(line, run_cli, tmp_path):
+    baud = 38400
+    text = program_text(300)
+    path = write(tmp_path, text)
+    pair, sim = line(baud=baud, ignore_xon=True, drain_cps=0.5 * chars_per_s(baud),
+                     buffer_chars=1200, high_water=1000, low_water=200)
+    status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
+                               "--mode", "drip", "--stall-timeout", "1", "--quiet")
+    assert status == 3, err
+    assert "held XOFF (DC3) for more than 1 s" in err
+    start = resume_hint(err)
+    assert f"block {start - 1} surely reached the control" in err
+    assert sim.xoffs == 1
+    _resume_and_check(line, run_cli, path, text, baud, sim.lines(), start, tmp_path)
+
+
+@needs_socat
+def test_a_control_that_drops_the_line_half_way_then_a_resume_completes_it(line, run_cli, tmp_path):
+    baud = 38400
+    text = program_text(500)
+    path = write(tmp_path, text)
+    pair, sim = line(baud=baud, drain_cps=0.6 * chars_per_s(baud), buffer_chars=600, high_water=500,
+                     low_water=100, drop_on_xoff=6)
+    status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
+                               "--mode", "drip", "--quiet")
+    assert sim.dropped
+    assert status == 3, err
+    assert "the line was lost" in err
+    start = resume_hint(err)
+    assert 50 < start < 450
+    _resume_and_check(line, run_cli, path, text, baud, sim.lines(), start, tmp_path)
+
+
+@needs_socat
+def test_a_cut_mid_block_loses_nothing(line, tmp_path):
+    baud = 38400
+    prog = parse_program(program_text(300))
+    settings = profile("fanuc", baud=baud)
+    pair, sim = line(baud=baud, drop_after_bytes=4011)
+    with pytest.raises(LineFault) as info:
+        send_program(pair.near, prog, settings, "drip")
+    fault = info.value
+    assert isinstance(fault, TransferError) and fault.start_block == fault.last_block + 1
+    got = sim.lines()[1:]
+    # Every block the sender counts as delivered is at the control; of the blocks on their way at the
+    # cut, the message names the range that may have arrived too.
+    assert got == list(prog.blocks[:len(got)])
+    assert fault.last_block <= len(got) <= fault.last_sent_block
+    assert f"blocks {fault.last_block + 1} to {fault.last_sent_block} were on their way" in str(fault)
+
+
+@needs_socat
+def test_receive_a_program_punched_with_dc2_dc4(line, run_cli, tmp_path):
+    baud = 19200
+    pair = PtyPair()
+    try:
+        text = program_text(60)
+        punched = b"\x12" + b"\x00" * 20 + text.replace("\n", "\r\n").encode() + b"\x00" * 10 + b"\x14"
+        t = threading.Thread(target=punch, args=(pair.far, punched, baud), kwargs={"stopbits": 1}, daemon=True)
+        t.start()
+        out_file = tmp_path / "from-control.nc"
+        status, out, err = run_cli("receive", "--port", pair.near, "--profile", "haas", "--baud", baud,
+                                   "--timeout", "20", "-o", out_file)
+        t.join(10)
+        assert status == 0, err
+        assert out_file.read_text() == text
+        assert "received 62 lines" in err
+    finally:
+        pair.close()
+
+
+@needs_socat
+def test_receive_that_hears_nothing_says_what_to_do(run_cli, tmp_path):
+    with PtyPair() as pair:
+        status, out, err = run_cli("receive", "--port", pair.near, "--timeout", "0.5", "-o", tmp_path / "x.nc")
+    assert status == 3 and "PUNCH" in err
+    assert not (tmp_path / "x.nc").exists()
