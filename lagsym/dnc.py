@@ -6,13 +6,15 @@ The sender does its own XON/XOFF: it paces writes to the line rate
 reads the line for DC3 (XOFF) and DC1 (XON) before every write.  The kernel's
 IXON is left off on purpose: it would swallow DC3 before lagsym could see it,
 and many USB adapters keep sending after it anyway.  A Fanuc accepts only
-about 10 characters past DC3 before alarm 087, so the default keeps 8 or
-fewer in flight.
+about 10 characters past DC3 before alarm 087, so the default keeps 4 or
+fewer in flight, which leaves room for the DC3 to travel back.
 
 A block counts as *delivered* once all its bytes have had time to leave the
-line (by the line clock and the driver's output queue) and a later look at
-the port found it still healthy.  A fault names the last delivered block and
-the ``--start-block`` that resumes the drip feed without loss or repeat.
+line (by the line clock and the driver's output queue), a short settling
+time has passed, and a later look at the port found it still healthy.  A
+fault names the last delivered block and the ``--start-block`` that resumes
+the drip feed after it; a cut in mid-transfer also names the blocks that
+were on their way and may have arrived too.
 """
 
 from __future__ import annotations
@@ -333,7 +335,7 @@ class _Sender:
         self.line_free = 0.0  # when the last written byte will have left the line
         self.paused = settings.wait_for_xon
         self.pause_since = 0.0
-        self.pause_reason = "waiting for the control's DC1 (XON) to start"
+        self.pause_reason = "the control sent no DC1 (XON) to start the transfer within {t} s"
         self.xoffs = 0
         self.max_in_flight = 0
         self.queue_stuck_since: float | None = None
@@ -380,6 +382,7 @@ class _Sender:
             hint = (f"{todo}, then resume with --start-block {resume}" if resume > 1
                     else f"{todo}, then send again")
             if last and last >= self.ends[-1][1]:
+                resume = None
                 hint = f"{todo}; every block arrived, only the closing framing may be missing"
             message = f"{what} on {self.port}; {where}; {hint}"
         else:
@@ -397,7 +400,7 @@ class _Sender:
             if byte == DC3 and self.settings.flow == "xonxoff":
                 if not self.paused:
                     self.paused, self.pause_since = True, now
-                    self.pause_reason = "the control held XOFF (DC3)"
+                    self.pause_reason = "the control held XOFF (DC3) for more than {t} s"
                     self.xoffs += 1
                     self.max_in_flight = max(self.max_in_flight, self.in_flight(now))
                     self.log(f"XOFF after {self.pos} bytes")
@@ -408,7 +411,7 @@ class _Sender:
         if self.settings.flow == "rtscts":
             cts = _cts(self.ser)
             if not cts and not self.paused:
-                self.paused, self.pause_since, self.pause_reason = True, now, "CTS stayed low (the control is not ready)"
+                self.paused, self.pause_since, self.pause_reason = True, now, "CTS stayed low (control not ready) for more than {t} s"
             elif cts and self.paused and self.pause_reason.startswith("CTS"):
                 self.paused = False
 
@@ -445,7 +448,7 @@ class _Sender:
             self.check_queue(now)
             if self.paused:
                 if now - self.pause_since > self.settings.stall_timeout_s:
-                    raise self.fault(f"{self.pause_reason} for more than {self.settings.stall_timeout_s:g} s",
+                    raise self.fault(self.pause_reason.format(t=f"{self.settings.stall_timeout_s:g}"),
                                      "clear the control (reset any alarm) and put it back in DNC or READ mode")
                 time.sleep(_POLL_S)
                 continue

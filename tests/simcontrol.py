@@ -96,6 +96,8 @@ class SimControl:
         At this XOFF, wait ``drop_settle_s`` and then cut the line.
     drop_after_bytes : int or None
         Cut the line as soon as this many bytes have arrived.
+    xon_after_s : float or None
+        Send DC1 this long after starting, as a Fanuc does when READ is pressed.
     pair : PtyPair
         What to hang up when cutting the line.
     """
@@ -168,12 +170,13 @@ def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
 class _Control:
     def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
                  buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
-                 drop_on_xoff=None, drop_settle_s=0.4, drop_after_bytes=None):
+                 drop_on_xoff=None, drop_settle_s=0.4, drop_after_bytes=None, xon_after_s=None):
         self.cps = chars_per_s(baud, bytesize, parity, stopbits)
         self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
         self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
         self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
         self.socat_pid, self.count, self.halt = socat_pid, count, halt
+        self.xon_after_s = xon_after_s
         self.port = serial.Serial(path, baudrate=baud, timeout=0)
         self.received = bytearray()
         self.overflow = 0
@@ -206,10 +209,14 @@ class _Control:
         credit = 0.0
         drop_at = None
         last = time.monotonic()
+        xon_at = None if self.xon_after_s is None else last + self.xon_after_s
         while not self.halt.is_set():
             now = time.monotonic()
             gap = now - last
             last = now
+            if xon_at is not None and now >= xon_at:
+                self.port.write(DC1)  # READ pressed: the control asks for the program
+                xon_at = None
             if drop_at is not None and now >= drop_at:
                 self.received += self.port.read(4096)  # whatever was still on the way arrives before the cut
                 self.count.value = len(self.received)

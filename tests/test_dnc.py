@@ -251,6 +251,31 @@ def test_xoff_is_obeyed_within_a_fanucs_tolerance(line):
 
 
 @needs_socat
+def test_wait_for_xon_starts_only_when_the_control_asks(line):
+    baud = 38400
+    prog = parse_program(program_text(30))
+    settings = profile("fanuc", baud=baud, wait_for_xon=True, stall_timeout_s=5)
+    pair, sim = line(baud=baud, xon_after_s=0.6)
+    events = []
+    send_program(pair.near, prog, settings, "upload", log=events.append)
+    expected = b"".join(b for _, b in plan_transfer(prog, settings, "upload"))
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert any(e.startswith("XON after 0.") for e in events), events
+
+
+@needs_socat
+def test_a_control_that_never_asks_for_the_program_stalls(line):
+    settings = profile("fanuc", baud=38400, wait_for_xon=True, stall_timeout_s=0.5)
+    pair, sim = line(baud=38400)
+    with pytest.raises(LineFault, match="sent no DC1 .XON. to start the transfer within 0.5 s") as info:
+        send_program(pair.near, parse_program(PROGRAM), settings, "drip")
+    assert info.value.last_block == 0 and info.value.start_block == 1
+    assert "then send again" in str(info.value)
+    assert sim.received == b""
+
+
+@needs_socat
 def test_progress_counts_only_what_has_left_the_line(line):
     baud = 38400
     prog = parse_program(program_text(120))
