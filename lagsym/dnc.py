@@ -387,7 +387,8 @@ class _Sender:
             message = f"{what} on {self.port}; {where}; {hint}"
         else:
             resume = None
-            message = f"{what} on {self.port}; {where}; the upload is incomplete: {todo}, then send the whole program again"
+            message = (f"{what} on {self.port}; {where}; the upload is incomplete: {todo}, "
+                       "then send the whole program again")
         self.log(f"fault: {message}")
         return LineFault(message, last, resume, sent)
 
@@ -411,7 +412,8 @@ class _Sender:
         if self.settings.flow == "rtscts":
             cts = _cts(self.ser)
             if not cts and not self.paused:
-                self.paused, self.pause_since, self.pause_reason = True, now, "CTS stayed low (control not ready) for more than {t} s"
+                self.paused, self.pause_since = True, now
+                self.pause_reason = "CTS stayed low (control not ready) for more than {t} s"
             elif cts and self.paused and self.pause_reason.startswith("CTS"):
                 self.paused = False
 

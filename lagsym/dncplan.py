@@ -236,7 +236,8 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     """
     total = len(program)
     if not 2 <= start_block <= total:
-        raise InputError(f"--start-block {start_block} is outside the program ({program.source} has blocks 1 to {total}; "
+        raise InputError(f"--start-block {start_block} is outside the program "
+                         f"({program.source} has blocks 1 to {total}; "
                          "block 1 starts from the beginning)")
     state = _Modal()
     for number in range(1, start_block):

@@ -111,8 +111,8 @@ class SimControl:
         self._ready = ctx.Event()
         self._results, child_end = ctx.Pipe(duplex=False)
         socat_pid = pair.proc.pid if pair is not None else None
-        self._proc = ctx.Process(target=_control_main, args=(path, params, socat_pid, self._count, self._halt, self._ready, child_end),
-                                 daemon=True)
+        args = (path, params, socat_pid, self._count, self._halt, self._ready, child_end)
+        self._proc = ctx.Process(target=_control_main, args=args, daemon=True)
         self._record: dict | None = None
 
     def start(self) -> None:
