@@ -437,7 +437,7 @@ class _Sender:
         self.line_free = start
         last_report = -1.0
         limit = self.settings.overrun_chars
-        low = max(1, limit // 2)
+        low = limit - 1  # top up as soon as a character has left: the most margin against late wake-ups
         seg = 0
         total = len(self.data)
         self.log(f"sending {total} bytes, {self.blocks_total} blocks, at {self.cps:.1f} characters/s")
@@ -470,7 +470,8 @@ class _Sender:
             written = n if written is None else written
             self.line_free = max(self.line_free, now) + written / self.cps
             self.pos += written
-        # One more healthy look after the last byte left, so the last block counts as delivered.
+        # A healthy look once the last byte has settled, so the last block counts as delivered.
+        time.sleep(_SETTLE_S)
         now = time.monotonic()
         self.poll(now)
         self.sure = self.pos
@@ -514,8 +515,8 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     Raises
     ------
     LineFault
-        On a stall or a lost line, naming the last block that surely arrived
-        and the ``--start-block`` to resume with.
+        On a stall, a lost line or Ctrl-C, naming the last block that surely
+        arrived and the ``--start-block`` to resume with.
     TransferError
         If the port cannot be opened.
     InputError
@@ -526,6 +527,8 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     sender = _Sender(ser, segments, settings, mode, port, progress, log)
     try:
         return sender.run()
+    except KeyboardInterrupt:
+        raise sender.fault("stopped by the user", "when the control is ready") from None
     except serial.SerialTimeoutException:
         raise sender.fault(f"a write waited more than {settings.stall_timeout_s:g} s",
                            "check the cable, the flow control setting and that the control is reading") from None

@@ -11,12 +11,15 @@ is not charged to the sender (a real control's UART interrupt answers at once).
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import multiprocessing
 import os
 import shutil
 import signal
 import subprocess
 import tempfile
+import termios
 import time
 
 import serial
@@ -70,6 +73,63 @@ class PtyPair:
         self.close()
 
 
+class KernelPty:
+    """A pty pair straight from the kernel: ``near`` for lagsym, the master ``fd`` for the simulated control.
+
+    Unlike the socat pair, no relay process stands between the two ends, so a
+    DC3 is readable at ``near`` the moment the control writes it, as it is at
+    a real UART.  On a loaded machine the relay can take 100 ms to pass a DC3
+    back, which would be charged to the sender as overflow; the overflow
+    measurements use this pair.
+    """
+
+    def __init__(self):
+        self.fd, self._slave = os.openpty()
+        self.near = os.ttyname(self._slave)
+        self.far = self.fd
+
+    def close(self) -> None:
+        for fd in (self.fd, self._slave):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class _FdPort:
+    """The few pyserial calls the control makes, on a pty master descriptor."""
+
+    def __init__(self, fd: int):
+        self.fd = fd
+        os.set_blocking(fd, False)
+
+    @property
+    def in_waiting(self) -> int:
+        return int.from_bytes(fcntl.ioctl(self.fd, termios.FIONREAD, b"\0\0\0\0"), "little")
+
+    def read(self, n: int) -> bytes:
+        try:
+            return os.read(self.fd, n)
+        except BlockingIOError:
+            return b""
+        except OSError as e:
+            if e.errno == errno.EIO:  # no one has the near end open
+                return b""
+            raise
+
+    def write(self, data: bytes) -> int:
+        return os.write(self.fd, data)
+
+    def close(self) -> None:
+        os.close(self.fd)
+
+
 class SimControl:
     """The control: reads at its line rate, buffers, says XOFF/XON, records, and can misbehave on request.
 
@@ -80,8 +140,8 @@ class SimControl:
 
     Parameters
     ----------
-    path : str
-        Its end of the pty pair.
+    path : str or int
+        Its end of the pty pair: a path (socat's pair) or a master descriptor (:class:`KernelPty`).
     baud, bytesize, parity, stopbits
         The line, for the pacing.
     buffer_chars, high_water, low_water : int
@@ -177,7 +237,7 @@ class _Control:
         self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
         self.socat_pid, self.count, self.halt = socat_pid, count, halt
         self.xon_after_s = xon_after_s
-        self.port = serial.Serial(path, baudrate=baud, timeout=0)
+        self.port = _FdPort(path) if isinstance(path, int) else serial.Serial(path, baudrate=baud, timeout=0)
         self.received = bytearray()
         self.overflow = 0
         self.max_after_xoff = 0
@@ -292,4 +352,4 @@ def program_text(blocks: int, seed: int = 1) -> str:
     return "%\n" + "\n".join(lines) + "\n%\n"
 
 
-__all__ = ["PtyPair", "SimControl", "punch", "program_text", "chars_per_s"]
+__all__ = ["PtyPair", "KernelPty", "SimControl", "punch", "program_text", "chars_per_s"]

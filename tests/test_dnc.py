@@ -21,7 +21,7 @@ from lagsym.dnc import (
 )
 from lagsym.dncplan import parse_program, resume_setup
 from lagsym.errors import InputError, TransferError
-from simcontrol import PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
 
 needs_socat = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
 
@@ -196,13 +196,13 @@ def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp
 
 @pytest.fixture
 def line():
-    """A socat pty pair; yields a function that starts a simulated control on its far end."""
+    """A socat pty pair (or with ``kernel=True`` a relay-free kernel pair); starts a simulated control on its far end."""
     pairs, sims = [], []
 
-    def start(**kwargs):
-        pair = PtyPair()
+    def start(kernel: bool = False, **kwargs):
+        pair = KernelPty() if kernel else PtyPair()
         pairs.append(pair)
-        sim = SimControl(pair.far, pair=pair, **kwargs)
+        sim = SimControl(pair.far, pair=None if kernel else pair, **kwargs)
         sim.start()
         sims.append(sim)
         return pair, sim
@@ -235,13 +235,13 @@ def test_large_drip_feed_arrives_byte_exact(line):
 
 @needs_socat
 def test_xoff_is_obeyed_within_a_fanucs_tolerance(line):
-    # 4800 baud, a Fanuc's classic rate: the 10 characters it tolerates past DC3 are worth 23 ms, which
-    # covers the pty relay's delay on a loaded machine as well as a real UART's.
-    baud = 4800
-    prog = parse_program(program_text(40))
+    # A kernel pty pair: socat's relay can take 100 ms to pass the DC3 back on a loaded machine, which a
+    # real UART does not, and that delay would be charged to the sender.
+    baud = 9600
+    prog = parse_program(program_text(80))
     settings = profile("fanuc", baud=baud)
-    pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192, low_water=64,
-                     tolerance=10)
+    pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
+                     low_water=64, tolerance=10)
     expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
     send_program(pair.near, prog, settings, "drip")
     assert sim.wait_for(len(expected))

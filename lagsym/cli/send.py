@@ -25,7 +25,7 @@ approach to where the program was), then block N onwards.
 
 The port is a device or a pyserial URL: /dev/ttyUSB0, COM3,
 socket://host:4001, rfc2217://host:4001, loop://.  Exit status 3 on a line
-fault or stall.
+fault, a stall or Ctrl-C; the message says which --start-block resumes.
 
 examples:
   lagsym send O1000.nc --port /dev/ttyUSB0 --baud 9600 --bytesize 7 --parity even --stopbits 2 --flow xonxoff
