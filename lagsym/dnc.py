@@ -54,7 +54,10 @@ MODES = ("upload", "drip")
 _FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
 _POLL_S = 0.002  # longest sleep between looks at the port while the line is busy
 _PROGRESS_S = 0.1
-_SETTLE_S = 0.05  # a byte counts as arrived only this long after the line clock says it left
+# A byte counts as arrived only this long after the line clock says it left: longer through a network
+# serial server, which holds what it has not yet put on its line.
+_SETTLE_S = 0.05
+_SETTLE_NETWORK_S = 0.25
 
 
 def _check(value, options, what: str):
@@ -330,6 +333,8 @@ class _Sender:
         self.blocks_total = len(self.ends)
         self.first_block = self.ends[0][1] if self.ends else 1
         self.cps = settings.chars_per_s
+        network = "://" in port and not port.startswith("loop://")
+        self.settle_s = _SETTLE_NETWORK_S if network else _SETTLE_S
         self.pos = 0  # bytes written to the port
         self.sure = 0  # bytes surely on the control's side
         self.line_free = 0.0  # when the last written byte will have left the line
@@ -347,8 +352,8 @@ class _Sender:
         return max(math.ceil(clock), _out_waiting(self.ser))
 
     def unsettled(self, now: float) -> int:
-        """Bytes that may not have reached the far side yet: in flight, or left less than _SETTLE_S ago."""
-        return max(self.in_flight(now), self.in_flight(now - _SETTLE_S))
+        """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
+        return max(self.in_flight(now), self.in_flight(now - self.settle_s))
 
     def blocks_surely_done(self) -> int:
         done = 0
@@ -471,7 +476,7 @@ class _Sender:
             self.line_free = max(self.line_free, now) + written / self.cps
             self.pos += written
         # A healthy look once the last byte has settled, so the last block counts as delivered.
-        time.sleep(_SETTLE_S)
+        time.sleep(self.settle_s)
         now = time.monotonic()
         self.poll(now)
         self.sure = self.pos

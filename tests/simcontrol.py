@@ -24,6 +24,8 @@ import time
 
 import serial
 
+__all__ = ["PtyPair", "KernelPty", "SimControl", "punch", "program_text", "chars_per_s"]
+
 DC1, DC2, DC3, DC4 = b"\x11", b"\x12", b"\x13", b"\x14"
 _LOOP_S = 0.0005
 
@@ -293,7 +295,6 @@ class _Control:
                 now = time.monotonic()
                 self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
-                late = max(0.0, gap - 0.002) * self.cps
                 for byte in data:
                     self.received.append(byte)
                     buffered += 1
@@ -301,7 +302,7 @@ class _Control:
                         self.after += 1
                     elif buffered >= self.high:
                         crossed = self.xoff = True
-                        self.after, self.excused = 0, late
+                        self.after = 0
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
                         self.count.value = len(self.received)
                         self.cut()
@@ -309,6 +310,10 @@ class _Control:
                 self.count.value = len(self.received)
                 if crossed:
                     self.port.write(DC3)
+                    # Time the simulation lost between its previous look and this DC3 (descheduled before
+                    # or after the read) is its own lateness, not the sender's: excuse what came in then.
+                    late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S - 0.002
+                    self.excused = max(0.0, late_s) * self.cps
                     self.xoffs += 1
                     if self.drop_on_xoff is not None and self.xoffs == self.drop_on_xoff:
                         drop_at = time.monotonic() + self.drop_settle_s
@@ -351,5 +356,3 @@ def program_text(blocks: int, seed: int = 1) -> str:
     lines += ["G0 Z50.", "M30"]
     return "%\n" + "\n".join(lines) + "\n%\n"
 
-
-__all__ = ["PtyPair", "KernelPty", "SimControl", "punch", "program_text", "chars_per_s"]
