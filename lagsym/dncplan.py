@@ -124,6 +124,9 @@ class _Modal:
     feed: str | None = None
     position: dict = field(default_factory=lambda: {"X": None, "Y": None, "Z": None})
     rapid_z: Decimal | None = None
+    cycle: str | None = None
+    cutter_comp: str | None = None
+    transforms: set = field(default_factory=set)
 
 
 def _words(block: str) -> list[tuple[str, str]]:
@@ -134,12 +137,17 @@ def _number(text: str) -> Decimal:
     return Decimal(text)
 
 
+_TRANSFORMS = {"68": "G68 rotation", "51": "G51 scaling", "51.1": "G51.1 mirror image", "16": "G16 polar coordinates"}
+_TRANSFORM_ENDS = {"69": "68", "50": "51", "50.1": "51.1", "15": "16"}
+
+
 def _track(state: _Modal, block: str, where: str) -> None:
+    """Update ``state`` with one block, as a control would."""
     words = _words(block)
-    gs = [v for k, v in words if k == "G"]
+    gs = [_g(v) for k, v in words if k == "G"]
     ms = [v for k, v in words if k == "M"]
-    for g in gs:
-        code = _g(g)
+    homing = False
+    for code in gs:
         if code in ("20", "21"):
             state.units = "G" + code
         elif code in ("17", "18", "19"):
@@ -150,16 +158,29 @@ def _track(state: _Modal, block: str, where: str) -> None:
             state.offset = "G" + code
         elif code in ("0", "1", "2", "3"):
             state.motion = "G" + code
+            state.cycle = None  # a motion code cancels a canned cycle
         elif code in ("43", "44"):
             h = next((v for k, v in words if k == "H"), None)
             state.length_comp = f"G{code}" + (f" H{h}" if h else "")
         elif code == "49":
             state.length_comp = None
-        elif code in ("28", "30", "53", "92", "52") or code.startswith("8"):
-            if code in ("80",):
-                continue
-            raise InputError(f"{where}: G{code} moves or redefines coordinates in a way a resume cannot replay; "
-                             "pick a later --start-block or send from the start")
+        elif code in ("41", "42"):
+            state.cutter_comp = "G" + code
+        elif code == "40":
+            state.cutter_comp = None
+        elif code == "80":
+            state.cycle = None
+        elif len(code) == 2 and code.startswith("8"):
+            state.cycle = "G" + code
+        elif code in ("28", "30", "53"):
+            homing = True
+        elif code in ("52", "92"):
+            raise InputError(f"{where}: G{code} shifts the coordinate system in a way a resume cannot replay; "
+                             "send the program from the start")
+        elif code in _TRANSFORMS:
+            state.transforms.add(code)
+        elif code in _TRANSFORM_ENDS:
+            state.transforms.discard(_TRANSFORM_ENDS[code])
     if state.offset == "G54.1":
         p = next((v for k, v in words if k == "P"), None)
         if p:
@@ -180,16 +201,23 @@ def _track(state: _Modal, block: str, where: str) -> None:
         elif k == "F":
             state.feed = v
     moves = {k: _number(v) for k, v in words if k in "XYZ"}
-    if moves:
-        for axis, value in moves.items():
-            if state.distance == "G91":
-                old = state.position[axis]
-                state.position[axis] = None if old is None else old + value
-            else:
-                state.position[axis] = value
-        if state.motion == "G0" and "Z" in moves and state.position["Z"] is not None:
-            z = state.position["Z"]
-            state.rapid_z = z if state.rapid_z is None else max(state.rapid_z, z)
+    if homing:
+        # G28/G30 go to a reference point and G53 moves in machine coordinates: the work position of
+        # the named axes (all of them when none is named) is unknown until the program sets it again.
+        for axis in moves or "XYZ":
+            state.position[axis] = None
+        return
+    for axis, value in moves.items():
+        if state.distance == "G91":
+            old = state.position[axis]
+            state.position[axis] = None if old is None else old + value
+        else:
+            state.position[axis] = value
+    if state.cycle is not None and moves:
+        state.position["Z"] = None  # a drilling cycle ends at its R or initial level
+    elif state.motion == "G0" and "Z" in moves and state.position["Z"] is not None:
+        z = state.position["Z"]
+        state.rapid_z = z if state.rapid_z is None else max(state.rapid_z, z)
 
 
 def _g(text: str) -> str:
@@ -225,9 +253,11 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     Raises
     ------
     InputError
-        If ``start_block`` is outside the program, or the program before it
-        uses macro variables, jumps, subprogram calls or canned cycles, or
-        leaves the position or the safe Z unknown: a set-up could then not
+        If ``start_block`` is outside the program; if the program before it
+        uses macro variables, jumps, subprogram calls, G52 or G92; if a
+        canned cycle, cutter compensation, rotation, scaling, mirror image or
+        polar coordinates is still on at ``start_block``; or if the position,
+        the units, the feed or the safe Z is unknown.  A set-up could then not
         be trusted.
 
     >>> p = parse_program("O1\\nG21 G17 G90 G54\\nT1 M6\\nS3000 M3\\nG0 Z50.\\nG0 X0 Y0\\nG1 Z-1. F200.\\nX10.\\nX20.")
@@ -252,6 +282,12 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
             raise InputError(f"{where}: {block!r} holds a number lagsym cannot read") from None
     if state.units is None:
         raise InputError(f"{program.source}: no G20 or G21 before block {start_block}; the set-up cannot choose units")
+    active = [v for v in (state.cycle and f"canned cycle {state.cycle}",
+                          state.cutter_comp and f"cutter compensation {state.cutter_comp}") if v]
+    active += sorted(_TRANSFORMS[t] for t in state.transforms)
+    if active:
+        raise InputError(f"{program.source}: {' and '.join(active)} is still on at block {start_block}; "
+                         "a resume cannot re-enter it safely, so pick a block where it is off")
     pos = state.position
     if any(pos[a] is None for a in "XYZ"):
         missing = ", ".join(a for a in "XYZ" if pos[a] is None)
