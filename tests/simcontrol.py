@@ -268,7 +268,8 @@ class _Control:
 
     def run(self) -> None:
         buffered = 0.0
-        credit = 0.0
+        line_t = 0.0  # when the wire will have delivered everything read so far
+        was_pending = False
         drop_at = None
         last = time.monotonic()
         xon_at = None if self.xon_after_s is None else last + self.xon_after_s
@@ -286,12 +287,14 @@ class _Control:
                 return
             buffered = 0.0 if self.drain_cps is None else max(0.0, buffered - self.drain_cps * gap)
             pending = self.port.in_waiting
-            credit = min(credit + gap * self.cps, max(4.0, self.cps * 0.05)) if pending else 0.0
-            n = min(pending, int(credit))
+            if pending and not was_pending:
+                line_t = max(line_t, now - gap)  # an idle line starts again when the data came, about the last look
+            n = min(pending, int((now - line_t) * self.cps)) if pending else 0
+            was_pending = pending > n
             crossed = False
             if n:
                 data = self.port.read(n)
-                credit -= len(data)
+                line_t += len(data) / self.cps
                 now = time.monotonic()
                 self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
