@@ -315,7 +315,7 @@ class _Control:
                     self.port.write(DC3)
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
-                    late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S - 0.002
+                    late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S
                     self.excused = max(0.0, late_s) * self.cps
                     self.xoffs += 1
                     if self.drop_on_xoff is not None and self.xoffs == self.drop_on_xoff:

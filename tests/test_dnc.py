@@ -185,7 +185,7 @@ def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp
     def gateway():
         conn, _ = server.accept()
         got = b""
-        while len(got) < 3000:
+        while len(got) < 6000:
             got += conn.recv(4096)
         conn.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
         conn.close()
@@ -198,7 +198,7 @@ def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp
     t.join(5)
     assert status == 3, err
     assert "the line was lost" in err
-    assert 2 <= resume_hint(err) <= 3000 // 20
+    assert 2 <= resume_hint(err) <= 6000 // 20
 
 
 # -- real transfers over a pty pair -------------------------------------------------------------------------
