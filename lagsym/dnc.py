@@ -462,6 +462,7 @@ class _Sender:
             in_flight = self.in_flight(now)
             if self.pos >= total:
                 if in_flight == 0:
+                    finished = now  # the last byte has left the line
                     break
                 time.sleep(min(_POLL_S, in_flight / self.cps))
                 continue
@@ -481,7 +482,7 @@ class _Sender:
         self.poll(now)
         self.sure = self.pos
         self.report(start, now)
-        elapsed = now - start
+        elapsed = finished - start
         self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF")
         return TransferResult(self.blocks_total, total, elapsed, self.xoffs, self.max_in_flight, self.cps)
 

@@ -243,7 +243,6 @@ def test_large_drip_feed_arrives_byte_exact(line):
     assert sim.max_after_xoff < 512 - 128
 
 
-@needs_socat
 def test_xoff_is_obeyed_within_a_fanucs_tolerance(line):
     # A kernel pty pair: socat's relay can take 100 ms to pass the DC3 back on a loaded machine, which a
     # real UART does not, and that delay would be charged to the sender.
