@@ -398,3 +398,46 @@ def test_receive_that_hears_nothing_says_what_to_do(run_cli, tmp_path):
         status, out, err = run_cli("receive", "--port", pair.near, "--timeout", "0.5", "-o", tmp_path / "x.nc")
     assert status == 3 and "PUNCH" in err
     assert not (tmp_path / "x.nc").exists()
+
+
+@needs_socat
+def test_receive_without_the_closing_percent_is_a_line_fault(run_cli, tmp_path):
+    with PtyPair() as pair:
+        punched = b"\x12%\nO1000\nG0 Z50.\n"
+        t = threading.Thread(target=punch, args=(pair.far, punched, 38400), daemon=True)
+        t.start()
+        status, out, err = run_cli("receive", "--port", pair.near, "--baud", 38400, "--idle-timeout", "0.5",
+                                   "-o", tmp_path / "x.nc")
+        t.join(10)
+    assert status == 3 and "without its closing %" in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+@needs_socat
+def test_receive_a_heidenhain_program_ended_by_etx(run_cli, tmp_path):
+    text = "0 BEGIN PGM 1 MM\n1 TOOL CALL 1 Z S3000\n2 L Z+50 R0 FMAX M3\n3 END PGM 1 MM\n"
+    with PtyPair() as pair:
+        punched = b"\x00" * 50 + text.replace("\n", "\r\n").encode() + b"\x03"
+        t = threading.Thread(target=punch, args=(pair.far, punched, 38400), kwargs={"stopbits": 1}, daemon=True)
+        t.start()
+        status, out, err = run_cli("receive", "--port", pair.near, "--profile", "heidenhain", "--baud", 38400,
+                                   "--quiet")
+        t.join(10)
+    assert status == 0, err
+    assert out == text
+
+
+def test_ctrl_c_names_the_block_to_resume_at():
+    calls = []
+
+    def progress(p):
+        calls.append(p)
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+
+    settings = LineSettings(baud=9600)
+    with pytest.raises(LineFault, match="stopped by the user") as info:
+        send_program("loop://", parse_program(program_text(200)), settings, "drip", progress=progress)
+    fault = info.value
+    assert fault.start_block == fault.last_block + 1 > 1
+    assert f"--start-block {fault.start_block}" in str(fault)
