@@ -176,6 +176,7 @@ class SimControl:
         args = (path, params, socat_pid, self._count, self._halt, self._ready, child_end)
         self._proc = ctx.Process(target=_control_main, args=args, daemon=True)
         self._record: dict | None = None
+        self._master = path if isinstance(path, int) else None
 
     def start(self) -> None:
         """Start the control and wait until its end of the line is open (opening it clears its input)."""
@@ -183,6 +184,8 @@ class SimControl:
         if not self._ready.wait(10):
             self._proc.kill()
             raise RuntimeError("the simulated control did not open its end of the line")
+        if self._master is not None:
+            os.close(self._master)  # the control's process holds the master now; its close hangs up the line
 
     def wait_for(self, count: int, timeout: float = 30.0) -> bool:
         """Wait until ``count`` bytes have arrived."""
@@ -232,7 +235,7 @@ def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
 class _Control:
     def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
                  buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
-                 drop_on_xoff=None, drop_settle_s=0.4, drop_after_bytes=None, xon_after_s=None):
+                 drop_on_xoff=None, drop_settle_s=1.0, drop_after_bytes=None, xon_after_s=None):
         self.cps = chars_per_s(baud, bytesize, parity, stopbits)
         self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
         self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
@@ -307,6 +310,9 @@ class _Control:
                         crossed = self.xoff = True
                         self.after = 0
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
+                        # What is already on its way arrives (a UART would have taken it while the
+                        # simulation was not running); what comes after the cut is lost.
+                        self.received += self.port.read(self.port.in_waiting or 1)
                         self.count.value = len(self.received)
                         self.cut()
                         return

@@ -237,26 +237,32 @@ def test_large_drip_feed_arrives_byte_exact(line):
     assert bytes(sim.received) == expected
     assert sim.xoffs > 3 and result.xoff_count == sim.xoffs
     assert result.blocks == len(prog)
-    # When lagsym saw XOFF, no more than its limit was on the way; what the control counts after its
-    # DC3 also holds the pty relay's delay, which at this rate is worth many characters.
+    # When lagsym saw XOFF, no more than its limit was on the way.
     assert result.max_in_flight_at_xoff <= settings.overrun_chars
-    assert sim.max_after_xoff < 512 - 128
 
 
-def test_xoff_is_obeyed_within_a_fanucs_tolerance(line):
+def test_xoff_stops_the_sender_within_its_limit(line):
     # A kernel pty pair: socat's relay can take 100 ms to pass the DC3 back on a loaded machine, which a
     # real UART does not, and that delay would be charged to the sender.
     baud = 9600
     prog = parse_program(program_text(80))
     settings = profile("fanuc", baud=baud)
+    sim_tolerance = 10
     pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
-                     low_water=64, tolerance=10)
+                     low_water=64, tolerance=sim_tolerance)
     expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
-    send_program(pair.near, prog, settings, "drip")
+    events = []
+    result = send_program(pair.near, prog, settings, "drip", log=events.append)
     assert sim.wait_for(len(expected))
     assert bytes(sim.received) == expected
-    assert sim.xoffs >= 3
-    assert sim.overflow == 0, sim.max_after_xoff
+    assert sim.xoffs >= 3 and result.xoff_count == sim.xoffs
+    # lagsym never had more than its limit on the way when it saw XOFF, and wrote nothing until XON.
+    assert result.max_in_flight_at_xoff <= settings.overrun_chars < sim_tolerance
+    pauses = [e for e in events if e.startswith(("XOFF", "XON"))]
+    assert [p.split()[0] for p in pauses] == ["XOFF", "XON"] * sim.xoffs
+    # What the control counted past its DC3 also holds the time the DC3 took to come back, which a
+    # starved machine can stretch; the benchmark reports that figure (0 overflow when the machine is
+    # not starved), a test cannot promise it.
 
 
 @needs_socat
@@ -339,27 +345,31 @@ def test_xoff_without_xon_stalls_with_exit_3_and_the_resume_block(line, run_cli,
 
 @needs_socat
 def test_a_control_that_drops_the_line_half_way_then_a_resume_completes_it(line, run_cli, tmp_path):
-    baud = 38400
-    text = program_text(500)
+    # The control drains at a fifth of the line rate, so it says XOFF even when a loaded machine slows
+    # the sender down; at its third XOFF it waits a second and cuts the line.
+    baud = 19200
+    text = program_text(300)
     path = write(tmp_path, text)
-    pair, sim = line(baud=baud, drain_cps=0.6 * chars_per_s(baud), buffer_chars=600, high_water=500,
-                     low_water=100, drop_on_xoff=6)
+    pair, sim = line(baud=baud, drain_cps=0.2 * chars_per_s(baud), buffer_chars=600, high_water=500,
+                     low_water=100, drop_on_xoff=3)
     status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
                                "--mode", "drip", "--quiet")
     assert sim.dropped
     assert status == 3, err
     assert "the line was lost" in err
     start = resume_hint(err)
-    assert 50 < start < 450
+    assert 2 <= start <= 300
     _resume_and_check(line, run_cli, path, text, baud, sim.lines(), start, tmp_path)
 
 
-@needs_socat
 def test_a_cut_mid_block_loses_nothing(line, tmp_path):
+    # A kernel pty pair: the control takes what is on its way and closes its end, and the sender sees
+    # the hang-up at once.  (A relay process can hold characters for a long time on a loaded machine;
+    # what it holds when it dies is lost in a way no real line loses it.)
     baud = 38400
     prog = parse_program(program_text(300))
     settings = profile("fanuc", baud=baud)
-    pair, sim = line(baud=baud, drop_after_bytes=4011)
+    pair, sim = line(kernel=True, baud=baud, drop_after_bytes=4011)
     with pytest.raises(LineFault) as info:
         send_program(pair.near, prog, settings, "drip")
     fault = info.value
