@@ -1,0 +1,46 @@
+"""``lagsym receive --port PORT -o FILE``: take a program the control punches out."""
+
+from __future__ import annotations
+
+from ._common import emit
+from .send import add_line_arguments, event_log, line_settings
+
+NAME = "receive"
+ORDER = 85
+HELP = "receive a program punched out by a CNC control over RS-232"
+DESCRIPTION = """Wait for a program from a CNC control (PUNCH or OUTPUT on the control) and
+write it to FILE, or to standard output.  The program runs from DC2 (or its
+first character) to DC4, its closing %, ETX, or a silence of --idle-timeout
+seconds; leader and control codes are dropped and blocks end in LF.  The
+file is written only when the whole program has arrived.  Exit status 3 on a
+line fault, a timeout, or a program without its closing %.
+
+examples:
+  lagsym receive --port /dev/ttyUSB0 --profile fanuc -o from-control.nc
+  lagsym receive --port socket://dnc-gateway.shop.lan:4001 --profile haas --timeout 300 -o O2000.nc"""
+
+
+def add_arguments(p) -> None:
+    add_line_arguments(p)
+    p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+    p.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
+                   help="how long to wait for the control to start (default 60)")
+    p.add_argument("--idle-timeout", type=float, default=5.0, metavar="SECONDS",
+                   help="silence that ends a program without DC4 or closing %% (default 5)")
+
+
+def run(args, out, err) -> int:
+    from ..dnc import receive_program
+    from ..errors import InputError
+
+    for name in ("timeout", "idle_timeout"):
+        if not getattr(args, name) > 0:
+            raise InputError(f"--{name.replace('_', '-')} {getattr(args, name)!r} must be a positive number of seconds")
+    settings = line_settings(args)
+    with event_log(args.log) as log:
+        text = receive_program(args.port, settings, start_timeout_s=args.timeout, idle_timeout_s=args.idle_timeout,
+                               log=log)
+    emit(text, args.output, out)
+    if not args.quiet and args.output and args.output != "-":
+        err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
+    return 0

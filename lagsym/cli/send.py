@@ -1,0 +1,174 @@
+"""``lagsym send FILE --port PORT``: upload or drip-feed a program to a control over RS-232."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import time
+from pathlib import Path
+
+from ..errors import InputError
+
+NAME = "send"
+ORDER = 80
+HELP = "send a program to a CNC control over RS-232 (upload to memory or drip feed)"
+DESCRIPTION = """Send the program in FILE to a CNC control over a serial line, with XON/XOFF
+handled by lagsym itself (paced to the line rate, at most a few characters
+past the control's DC3), a progress bar of what has really left the line,
+and a fault message that names the last block that surely arrived and the
+--start-block that resumes a drip feed.
+
+Block N is the N-th non-empty line after the leading % (the O-number line
+is block 1).  --start-block N sends the program's modal set-up first (units,
+plane, absolute mode, work offset, tool, spindle, coolant, a safe Z and the
+approach to where the program was), then block N onwards.
+
+The port is a device or a pyserial URL: /dev/ttyUSB0, COM3,
+socket://host:4001, rfc2217://host:4001, loop://.  Exit status 3 on a line
+fault, a stall or Ctrl-C; the message says which --start-block resumes.
+
+examples:
+  lagsym send O1000.nc --port /dev/ttyUSB0 --baud 9600 --bytesize 7 --parity even --stopbits 2 --flow xonxoff
+  lagsym send big.nc --port /dev/ttyUSB0 --mode drip --profile fanuc
+  lagsym send big.nc --port socket://dnc-gateway.shop.lan:4001 --mode drip --start-block 4120"""
+
+
+def add_line_arguments(p) -> None:
+    """The serial line options ``send`` and ``receive`` share."""
+    from ..dnc import FLOW_CONTROLS, LINE_ENDINGS, PARITIES, PROFILES
+
+    p.add_argument("--port", required=True, help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port)")
+    g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
+    g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
+    g.add_argument("--baud", type=int, help="bits per second (default 9600)")
+    g.add_argument("--bytesize", type=int, choices=(5, 6, 7, 8), help="data bits (default 7)")
+    g.add_argument("--parity", choices=tuple(PARITIES), help="parity (default even)")
+    g.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help="stop bits (default 2)")
+    g.add_argument("--flow", choices=FLOW_CONTROLS, help="flow control (default xonxoff)")
+    g.add_argument("--eol", choices=tuple(LINE_ENDINGS), help="end of block (default lf)")
+    g.add_argument("--leader", metavar="SPEC", help="characters before the program: a count of NULs or e.g. 50*NUL")
+    g.add_argument("--trailer", metavar="SPEC", help="characters after the program, e.g. 20, ETX or 10*NUL,ETX")
+    g.add_argument("--percent", action=argparse.BooleanOptionalAction, default=None,
+                   help="frame the program with %% lines (default on)")
+    g.add_argument("--dtr", action=argparse.BooleanOptionalAction, default=None, help="assert DTR (default on)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--log", metavar="FILE", help="append a line per event (XOFF, XON, faults) to FILE")
+
+
+def line_settings(args):
+    """The :class:`~lagsym.dnc.LineSettings` the options ask for."""
+    from ..dnc import LineSettings, parse_filler, profile
+
+    overrides = {}
+    for option, field in (("baud", "baud"), ("bytesize", "bytesize"), ("parity", "parity"), ("stopbits", "stopbits"),
+                          ("flow", "flow"), ("eol", "eol"), ("percent", "percent"), ("dtr", "dtr")):
+        value = getattr(args, option, None)
+        if value is not None:
+            overrides[field] = value
+    for option in ("leader", "trailer"):
+        value = getattr(args, option, None)
+        if value is not None:
+            overrides[option] = parse_filler(value)
+    if getattr(args, "stall_timeout", None) is not None:
+        overrides["stall_timeout_s"] = args.stall_timeout
+    if getattr(args, "overrun_chars", None) is not None:
+        overrides["overrun_chars"] = args.overrun_chars
+    if getattr(args, "wait_for_xon", False):
+        overrides["wait_for_xon"] = True
+    if args.profile:
+        return profile(args.profile, **overrides)
+    return LineSettings(**overrides)
+
+
+@contextlib.contextmanager
+def event_log(path: str | None):
+    """A function that appends a time-stamped line to ``path`` (or does nothing)."""
+    if not path:
+        yield None
+        return
+    try:
+        fh = open(path, "a", encoding="utf-8")
+    except OSError as e:
+        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
+    with fh:
+        def log(message: str) -> None:
+            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
+            fh.flush()
+
+        yield log
+
+
+@contextlib.contextmanager
+def progress_bar(err, quiet: bool, what: str):
+    """A rich progress bar on ``err`` fed by :class:`~lagsym.dnc.TransferProgress` values, or None."""
+    if quiet:
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn, TransferSpeedColumn
+
+    console = Console(file=err, stderr=True)
+    columns = (TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[blocks]}"), DownloadColumn(),
+               TransferSpeedColumn(), TimeRemainingColumn(), TextColumn("{task.fields[state]}"))
+    with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
+        task = bar.add_task(what, total=None, blocks="", state="")
+
+        def update(p) -> None:
+            bar.update(task, total=p.bytes_total, completed=p.bytes_done,
+                       blocks=f"{p.blocks_done}/{p.blocks_total} blocks", state="XOFF" if p.paused else "")
+
+        yield update
+
+
+def read_program(path: str):
+    """Read a program file into a :class:`~lagsym.dncplan.Program`."""
+    from ..dncplan import parse_program
+
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a directory, not a program") from None
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError as e:
+        raise InputError(f"{path}: byte 0x{raw[e.start]:02x} at offset {e.start} is not 7-bit ASCII; "
+                         "a control cannot read it") from None
+    return parse_program(text, source=str(path))
+
+
+def add_arguments(p) -> None:
+    from ..dnc import MODES
+
+    p.add_argument("file", help="the program (G-code or Heidenhain text)")
+    add_line_arguments(p)
+    t = p.add_argument_group("transfer")
+    t.add_argument("--mode", choices=MODES, default="upload",
+                   help="upload: store in the control's memory (needed for macro programs); drip: feed while it runs")
+    t.add_argument("--start-block", type=int, default=1, metavar="N",
+                   help="resume a drip feed at block N, after the program's modal set-up (as a fault message says)")
+    t.add_argument("--safe-z", metavar="Z", help="retract height for a resume, in program units "
+                                                  "(default: the highest rapid Z before block N)")
+    t.add_argument("--stall-timeout", type=float, metavar="SECONDS",
+                   help="give up when XOFF or CTS low lasts longer (default 120)")
+    t.add_argument("--overrun-chars", type=int, metavar="N",
+                   help="most characters in flight, so at most N arrive after XOFF (default 8; Fanuc tolerates ~10)")
+    t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
+
+
+def run(args, out, err) -> int:
+    from ..dnc import send_program
+
+    program = read_program(args.file)
+    settings = line_settings(args)
+    with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:
+        result = send_program(args.port, program, settings, mode=args.mode, start_block=args.start_block,
+                              safe_z=args.safe_z, progress=bar, log=log)
+    if not args.quiet:
+        out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
+                  f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")
+    return 0
