@@ -6,6 +6,18 @@ with other surfaces, plans toolpaths and writes programs for CNC controls.
 """
 
 from .compare import Comparison, DeviationMeasures, compare_surfaces, deviation_measures, render_table
+from .dnc import (
+    PROFILES,
+    LineFault,
+    LineSettings,
+    TransferProgress,
+    TransferResult,
+    plan_transfer,
+    profile,
+    receive_program,
+    send_program,
+)
+from .dncplan import Program, parse_program, resume_setup
 from .errors import (
     ExitStatus,
     FormulaError,
@@ -74,6 +86,18 @@ __all__ = [
     "scallop_stepover",
     "simulate_cut",
     "write_program",
+    "PROFILES",
+    "LineFault",
+    "LineSettings",
+    "Program",
+    "TransferProgress",
+    "TransferResult",
+    "parse_program",
+    "plan_transfer",
+    "profile",
+    "receive_program",
+    "resume_setup",
+    "send_program",
     "ControlGrid",
     "CurvePoints",
     "ExitStatus",

@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 
 import serial
 
-from .dncplan import DC1, DC2, DC3, DC4, Program, frame, parse_program, resume_setup
+from .dncplan import DC1, DC2, DC3, DC4, Program, frame, resume_setup
 from .errors import InputError, TransferError
 
 __all__ = [

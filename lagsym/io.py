@@ -14,8 +14,9 @@ import json
 import os
 import re
 import tempfile
+import time
 from collections.abc import Iterator
-from decimal import Decimal, InvalidOperation
+from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 from typing import IO, Any
@@ -28,6 +29,7 @@ __all__ = [
     "read_curve_points",
     "read_any_points",
     "read_program",
+    "event_log",
     "parse_points",
     "exact_number",
     "atomic_path",
@@ -339,6 +341,24 @@ def read_program(path: str | os.PathLike) -> str:
     except UnicodeDecodeError as e:
         raise InputError(f"{name}: byte 0x{raw[e.start]:02x} at offset {e.start} is not ASCII; "
                          f"a control reads ASCII programs") from None
+
+
+@contextlib.contextmanager
+def event_log(path: str | os.PathLike | None) -> Iterator:
+    """A function that appends a time-stamped line to the log file ``path``, or None without a path."""
+    if not path:
+        yield None
+        return
+    try:
+        fh = open(path, "a", encoding="utf-8")
+    except OSError as e:
+        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
+    with fh:
+        def log(message: str) -> None:
+            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
+            fh.flush()
+
+        yield log
 
 
 @contextlib.contextmanager

@@ -8,7 +8,7 @@ in surface units (the control points' units) are turned into millimetres by
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from .errors import ToolpathError
 

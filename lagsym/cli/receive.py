@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from ._common import emit
-from .send import add_line_arguments, event_log, line_settings
+from ..io import event_log
+from .send import add_line_arguments, line_settings
 
 NAME = "receive"
 ORDER = 85

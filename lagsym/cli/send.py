@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import time
 from pathlib import Path
 
-from ..errors import InputError
+from ..dncplan import parse_program
+from ..io import event_log, read_program
 
 NAME = "send"
 ORDER = 80
@@ -30,7 +30,8 @@ fault, a stall or Ctrl-C; the message says which --start-block resumes.
 examples:
   lagsym send O1000.nc --port /dev/ttyUSB0 --baud 9600 --bytesize 7 --parity even --stopbits 2 --flow xonxoff
   lagsym send big.nc --port /dev/ttyUSB0 --mode drip --profile fanuc
-  lagsym send big.nc --port socket://dnc-gateway.shop.lan:4001 --mode drip --start-block 4120"""
+  lagsym send big.nc --port socket://dnc-gateway.shop.lan:4001 --mode drip --start-block 4120
+  lagsym send O1000.nc --port loop:// --profile fanuc --baud 115200 --quiet"""
 
 
 def add_line_arguments(p) -> None:
@@ -81,24 +82,6 @@ def line_settings(args):
 
 
 @contextlib.contextmanager
-def event_log(path: str | None):
-    """A function that appends a time-stamped line to ``path`` (or does nothing)."""
-    if not path:
-        yield None
-        return
-    try:
-        fh = open(path, "a", encoding="utf-8")
-    except OSError as e:
-        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
-    with fh:
-        def log(message: str) -> None:
-            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
-            fh.flush()
-
-        yield log
-
-
-@contextlib.contextmanager
 def progress_bar(err, quiet: bool, what: str):
     """A rich progress bar on ``err`` fed by :class:`~lagsym.dnc.TransferProgress` values, or None."""
     if quiet:
@@ -118,27 +101,6 @@ def progress_bar(err, quiet: bool, what: str):
                        blocks=f"{p.blocks_done}/{p.blocks_total} blocks", state="XOFF" if p.paused else "")
 
         yield update
-
-
-def read_program(path: str):
-    """Read a program file into a :class:`~lagsym.dncplan.Program`."""
-    from ..dncplan import parse_program
-
-    p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a directory, not a program") from None
-    except OSError as e:
-        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
-    try:
-        text = raw.decode("ascii")
-    except UnicodeDecodeError as e:
-        raise InputError(f"{path}: byte 0x{raw[e.start]:02x} at offset {e.start} is not 7-bit ASCII; "
-                         "a control cannot read it") from None
-    return parse_program(text, source=str(path))
 
 
 def add_arguments(p) -> None:
@@ -163,7 +125,7 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     from ..dnc import send_program
 
-    program = read_program(args.file)
+    program = parse_program(read_program(args.file), source=args.file)
     settings = line_settings(args)
     with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:
         result = send_program(args.port, program, settings, mode=args.mode, start_block=args.start_block,

@@ -38,7 +38,6 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
 
     dp = settings.digits
     out = ["%", f"O{settings.program_number:04d} {_comment('lagsym surface macro')}"]
-    f = plan.form
     out.append(_comment(f"surface {plan.form.shape[0]}x{plan.form.shape[1]} normalized {plan.form.kind}, "
                         f"{precision} digit arithmetic"))
     out.append(_comment(f"{plan.raster.size} points, rows along {plan.raster.direction}"))
