@@ -145,6 +145,8 @@ class LineSettings:
     def chars_per_s(self) -> float:
         """The line rate in characters per second.
 
+        Examples
+        --------
         >>> LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2).chars_per_s
         872.7272727272727
         """
@@ -165,6 +167,8 @@ PROFILES: dict[str, LineSettings] = {
 def profile(name: str, **overrides) -> LineSettings:
     """The usual line settings of a control family, with any field overridden.
 
+    Examples
+    --------
     >>> profile("haas", baud=19200).eol
     'crlf'
     """
@@ -175,6 +179,8 @@ def profile(name: str, **overrides) -> LineSettings:
 def parse_filler(spec: str) -> str:
     """Read a leader or trailer: a count of NULs (``20``) or items like ``50*NUL,ETX``.
 
+    Examples
+    --------
     >>> parse_filler("3"), parse_filler("2*NUL,ETX"), parse_filler("")
     ('\\x00\\x00\\x00', '\\x00\\x00\\x03', '')
     """
@@ -262,6 +268,9 @@ def plan_transfer(program: Program, settings: LineSettings, mode: str = "upload"
     :func:`lagsym.dncplan.resume_setup` goes first, then block ``start_block``
     onwards.
 
+    Examples
+    --------
+    >>> from lagsym.dncplan import parse_program
     >>> p = parse_program("O1\\nM30")
     >>> b"".join(b for _, b in plan_transfer(p, LineSettings(eol="crlf")))
     b'%\\r\\nO1\\r\\nM30\\r\\n%\\r\\n'

@@ -59,6 +59,8 @@ def parse_program(text: str, source: str = "<program>") -> Program:
     the sender adds its own.  Characters a 7-bit line cannot carry, and the
     DC1 to DC4 codes that steer the line, are refused with the line they are on.
 
+    Examples
+    --------
     >>> parse_program("%\\nO1000\\nG21 G90\\n\\nG0 Z50.\\n%\\n").blocks
     ('O1000', 'G21 G90', 'G0 Z50.')
     """
@@ -94,6 +96,8 @@ def frame(blocks, eol: str, percent: bool, leader: str = "", trailer: str = "") 
     marks a block that is not part of the program (a resume set-up block).
     Framing (leader, ``%`` lines, trailer) also has ``None``.
 
+    Examples
+    --------
     >>> frame([(1, "O1"), (2, "M30")], "\\n", True)
     [(None, b'%\\n'), (1, b'O1\\n'), (2, b'M30\\n'), (None, b'%\\n')]
     """
@@ -260,6 +264,8 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
         the units, the feed or the safe Z is unknown.  A set-up could then not
         be trusted.
 
+    Examples
+    --------
     >>> p = parse_program("O1\\nG21 G17 G90 G54\\nT1 M6\\nS3000 M3\\nG0 Z50.\\nG0 X0 Y0\\nG1 Z-1. F200.\\nX10.\\nX20.")
     >>> resume_setup(p, 9)
     ('(RESUME AT BLOCK 9)', 'G21 G17 G90 G54', 'T1 M6', 'S3000 M3', 'G0 Z50.', 'G0 X10. Y0.', 'G1 Z-1. F200.')
