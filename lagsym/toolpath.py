@@ -158,8 +158,14 @@ class SurfaceEvaluator:
         return out
 
 
-def _lattice(radius: float, spacing: float) -> np.ndarray:
-    """Offsets of a square lattice inside the disc, plus points on its rim (for a flat end)."""
+@functools.lru_cache(maxsize=16)
+def _lattice(radius: float, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Offsets of a square lattice inside the disc, plus points on its rim (for a flat end).
+
+    Also returns the lattice's mask of points inside the disc (its square
+    ``2 k + 1`` by ``2 k + 1``, in the order of the offsets), and for each rim
+    point the index of the lattice point nearest to it.
+    """
     k = max(int(math.ceil(radius / spacing)), 1)
     t = np.linspace(-radius, radius, 2 * k + 1)
     gx, gy = np.meshgrid(t, t, indexing="ij")
@@ -167,7 +173,34 @@ def _lattice(radius: float, spacing: float) -> np.ndarray:
     rim_n = max(8 * k, 16)
     a = np.linspace(0.0, 2 * math.pi, rim_n, endpoint=False)
     rim = radius * np.stack([np.cos(a), np.sin(a)], axis=1)
-    return np.concatenate([np.stack([gx[inside], gy[inside]], axis=1), rim])
+    pts = np.stack([gx[inside], gy[inside]], axis=1)
+    nearest = np.argmin(((rim[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2), axis=1)
+    out = (np.concatenate([pts, rim]), inside, nearest)
+    for v in out:
+        v.setflags(write=False)
+    return out
+
+
+def _peaks(val, inside, nearest):
+    """Which candidates are local maxima of the sampled heights: no neighbour on the lattice (or rim) higher.
+
+    The corners of the region under the tool, after the lattice and rim, always count.
+    """
+    n, m, w = val.shape[0], int(inside.sum()), inside.shape[0]
+    g = np.full((n, w + 2, w + 2), -np.inf)
+    g[:, 1:-1, 1:-1][:, inside] = val[:, :m]
+    c = g[:, 1:-1, 1:-1]
+    top = np.ones(c.shape, dtype=bool)
+    for di in (0, 1, 2):
+        for dj in (0, 1, 2):
+            if di != 1 or dj != 1:
+                top &= c >= g[:, di:di + w, dj:dj + w]
+    peak = np.ones(val.shape, dtype=bool)
+    peak[:, :m] = top[:, inside]
+    rim = val[:, m:m + len(nearest)]
+    peak[:, m:m + len(nearest)] = ((rim >= np.roll(rim, 1, axis=1)) & (rim >= np.roll(rim, -1, axis=1))
+                                   & (rim >= val[:, nearest]))
+    return peak
 
 
 def _project(px, py, cx, cy, radius, box):
@@ -275,12 +308,12 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     feature = min(x1 - x0, y1 - y0) / (2 * deg)
     spacing = min(radius / lattice, feature / 2)
     spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
-    offsets = _lattice(radius, spacing)
+    offsets, inside, nearest = _lattice(radius, spacing)
     span = float(np.ptp(ev.coef)) + radius + 1.0
     out = np.empty(cx.size)
     for s in range(0, cx.size, _CHUNK):
-        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets, spacing,
-                                        starts, box, 0.01 * CL_MARGIN * span)
+        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets,
+                                        (inside, nearest), spacing, starts, box, 0.01 * CL_MARGIN * span)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
@@ -289,7 +322,7 @@ _SIGNS = np.array([1.0, -1.0])[None, :, None]
 _HALF = math.sqrt(0.5)
 
 
-def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box, settle):
+def _drop_chunk(ev, cx, cy, radius, shape, offsets, lattice, spacing, starts, box, settle):
     n, k = cx.size, len(offsets)
     best_val = np.full(n, -np.inf)
     # Dense candidates, a block of offsets at a time to bound memory.
@@ -308,7 +341,17 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box, settle
     cand_val = np.concatenate([cand_val, _height(ev, px, py, d2, radius, shape)], axis=1)
     cand_px = np.concatenate([cand_px, px], axis=1)
     cand_py = np.concatenate([cand_py, py], axis=1)
-    order = _spread_starts(cand_val, cand_px, cand_py, starts, 2.5 * spacing)
+    # Starts: the best candidates of distinct basins.  Only a local maximum of the sampled heights
+    # (no lattice neighbour higher; the region's corners always count) heads a basin of its own:
+    # the best few candidates overall may all lie on the slopes of one or two peaks, and a narrow
+    # peak elsewhere, its samples all below them, would never be refined.
+    # A lattice or rim point the box moved is a copy of a point on its edge, maybe one of many: its peaks
+    # come after the others.  The best candidate of all comes first in any case.
+    moved = np.zeros(cand_val.shape, dtype=bool)
+    moved[:, :k] = (cand_px[:, :k] != cx[:, None] + offsets[:, 0]) | (cand_py[:, :k] != cy[:, None] + offsets[:, 1])
+    rank = np.where(_peaks(cand_val, *lattice), np.where(moved, 1, 0), 2)
+    rank[np.arange(n), np.argmax(cand_val, axis=1)] = 0
+    order = _spread_starts(cand_val, cand_px, cand_py, starts, 2.5 * spacing, rank)
     rows = np.arange(n)[:, None]
     px = cand_px[rows, order].ravel()
     py = cand_py[rows, order].ravel()
@@ -353,14 +396,17 @@ def _drop_chunk(ev, cx, cy, radius, shape, offsets, spacing, starts, box, settle
     return np.maximum(best_val, cand_val.max(axis=1))
 
 
-def _spread_starts(val, px, py, starts, apart):
+def _spread_starts(val, px, py, starts, apart, rank=None):
     """For each row, the best candidate and then the best ones at least ``apart`` from those already chosen.
 
     Two nearly equal peaks under the tool are then both refined, instead of
-    two neighbours on the slope of one of them.
+    two neighbours on the slope of one of them.  Where ``rank`` is given, the
+    candidates of rank 0 (the local maxima) come first, best first, then those
+    of rank 1, then those of rank 2.
     """
     n, k = val.shape
-    top = np.argsort(-val, axis=1)[:, :min(k, 8 * starts)]
+    key = val if rank is None else val - rank * (np.ptp(val, axis=1, keepdims=True) + 1.0)
+    top = np.argsort(-key, axis=1)[:, :min(k, 8 * starts + 32)]
     rows = np.arange(n)[:, None]
     tx, ty = px[rows, top], py[rows, top]
     chosen = [top[:, 0]]
