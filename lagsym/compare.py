@@ -46,6 +46,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ._arrays import readonly as _readonly
 from .errors import InputError
 from .grid import ControlGrid, _fmt
 from .surfaces import HERMITE_KINDS, METHODS, make_surface
@@ -174,12 +175,6 @@ def deviation_measures(z_f, z_a, tolerance: float = DEFAULT_TOLERANCE_MM) -> Dev
         mean_abs_deviation=float(a.mean()),
         rms_deviation=float(np.sqrt(np.mean(d * d))),
     )
-
-
-def _readonly(a) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True)

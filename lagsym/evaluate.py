@@ -35,6 +35,8 @@ from math import comb
 import flint
 import numpy as np
 
+from ._arrays import readonly as _readonly
+
 __all__ = [
     "CHUNK_POINTS",
     "SurfaceEvaluator",
@@ -56,12 +58,6 @@ __all__ = [
 EPS = float(np.finfo(float).eps)
 EPS_BASIS = float(np.finfo(np.longdouble).eps)  # the basis recurrence runs in longdouble
 CHUNK_POINTS = 1 << 16  # scattered points are evaluated in blocks of this many (bounded memory, warm caches)
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 def _fmpq(v: Fraction) -> flint.fmpq:

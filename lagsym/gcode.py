@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import freeze_fields
 from .errors import ProgramError
 
 __all__ = ["Moves", "parse_moves", "move_points"]
@@ -63,10 +64,7 @@ class Moves:
     def __post_init__(self):
         if self.z_known is None:
             object.__setattr__(self, "z_known", np.ones(len(self.points_mm), dtype=bool))
-        for name in ("points_mm", "start_mm", "rapid", "feed_mm_min", "line", "z_known"):
-            a = np.array(getattr(self, name))
-            a.setflags(write=False)
-            object.__setattr__(self, name, a)
+        freeze_fields(self, ("points_mm", "start_mm", "rapid", "feed_mm_min", "line", "z_known"))
 
     def __len__(self) -> int:
         return len(self.points_mm)

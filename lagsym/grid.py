@@ -9,13 +9,14 @@ points happens here, once.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
 
 import numpy as np
 
+from ._arrays import readonly as _readonly
 from .errors import GridError, InputError
 
 __all__ = ["ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points"]
@@ -37,12 +38,6 @@ def _fmt(v: Fraction) -> str:
             ctx.prec = 200
             return format(Decimal(v.numerator) / Decimal(v.denominator), "f")
     return f"{v.numerator}/{v.denominator}"
-
-
-def _readonly(values: Iterable) -> np.ndarray:
-    a = np.array([float(v) for v in values], dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True)
@@ -96,9 +91,7 @@ class ControlGrid:
     @cached_property
     def z_array(self) -> np.ndarray:
         """The heights as a read-only ``(n, m)`` float array."""
-        a = np.array([[float(v) for v in row] for row in self.z], dtype=float)
-        a.setflags(write=False)
-        return a
+        return _readonly(self.z)
 
     def z_range(self) -> tuple[Fraction, Fraction]:
         """Smallest and largest control height."""

@@ -31,6 +31,7 @@ __all__ = [
     "lagrange_surface",
     "lagrange_basis",
     "basis_coefficients",
+    "horner2",
 ]
 
 X, Y = sympy.symbols("x y", real=True)
@@ -195,14 +196,7 @@ class LagrangeSurface:
 
     def exact_value(self, x, y) -> Fraction:
         """``F(x, y)`` in exact arithmetic (nested Horner on the rational coefficients)."""
-        x, y = Fraction(x), Fraction(y)
-        acc = Fraction(0)
-        for row in reversed(self.coefficients):
-            inner = Fraction(0)
-            for c in reversed(row):
-                inner = inner * y + c
-            acc = acc * x + inner
-        return acc
+        return horner2(self.coefficients, Fraction(x), Fraction(y))
 
     def derivative(self, dx: int = 1, dy: int = 0) -> sympy.Poly:
         """The exact partial derivative ``d^(dx+dy) F / dx^dx dy^dy`` as a Poly."""
@@ -225,6 +219,23 @@ class LagrangeSurface:
         from .evaluate import lambdify_surface
 
         return lambdify_surface(self)
+
+
+def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
+    """``sum c[a][b] x**a y**b`` in nested Horner form, exact for exact arguments.
+
+    Examples
+    --------
+    >>> horner2(((1, 2), (3, 4)), Fraction(1, 2), Fraction(3))
+    Fraction(29, 2)
+    """
+    acc = Fraction(0)
+    for row in reversed(coefficients):
+        inner = Fraction(0)
+        for c in reversed(row):
+            inner = inner * y + c
+        acc = acc * x + inner
+    return acc
 
 
 def lagrange_curve(points: CurvePoints) -> LagrangeCurve:

@@ -77,6 +77,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import polynomial as P
 
+from ._arrays import freeze_fields
 from .errors import ToolpathError
 from .machine import MachineSettings, RasterSpec, Tool
 
@@ -95,12 +96,6 @@ CL_MARGIN = 1e-7
 """Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
 
 _CHUNK = 1 << 12  # positions per pass: about 30 MB of candidates
-
-
-def _readonly(a) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 class SurfaceEvaluator:
@@ -660,10 +655,7 @@ class Toolpath:
     bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
 
     def __post_init__(self):
-        for name in ("points_mm", "rows", "exact_mm"):
-            a = np.array(getattr(self, name))
-            a.setflags(write=False)
-            object.__setattr__(self, name, a)
+        freeze_fields(self, ("points_mm", "rows", "exact_mm"))
 
     def __len__(self) -> int:
         return len(self.points_mm)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import freeze_fields
 from .errors import ToolpathError
 from .evaluate import evaluate_grid
 from .gcode import Moves
@@ -78,10 +79,7 @@ class CutReport:
     positions: int
 
     def __post_init__(self):
-        for name in ("xs_mm", "ys_mm", "cut_mm", "surface_mm"):
-            a = np.array(getattr(self, name), dtype=float)
-            a.setflags(write=False)
-            object.__setattr__(self, name, a)
+        freeze_fields(self, ("xs_mm", "ys_mm", "cut_mm", "surface_mm"), dtype=float)
 
     @property
     def gouges(self) -> bool:

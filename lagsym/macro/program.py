@@ -33,7 +33,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import ProgramError, ToolpathError
-from ..lagrange import LagrangeSurface
+from ..lagrange import LagrangeSurface, horner2
 from ..machine import MachineSettings, RasterSpec, Tool, choice
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
@@ -99,14 +99,7 @@ class MacroPlan:
 
 def exact_height(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
     """The height of ``form`` at raster position (p, r), exact."""
-    u, v = (p - form.pc) * form.pk, (r - form.rc) * form.rk
-    acc = Fraction(0)
-    for row in reversed(form.coefficients):
-        inner = Fraction(0)
-        for c in reversed(row):
-            inner = inner * v + c
-        acc = acc * u + inner
-    return acc + form.z0
+    return horner2(form.coefficients, (p - form.pc) * form.pk, (r - form.rc) * form.rk) + form.z0
 
 
 def loop_plan(plan: MacroRaster, form: RowForm, row_code, point_code, outputs=("p", "r", "z")) -> tuple:

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import readonly as _readonly
 from ..errors import InputError
 from ..grid import ControlGrid
 
@@ -59,12 +60,6 @@ def difference_matrix(nodes) -> np.ndarray:
         d[i, lo] -= 1.0 / (x[hi] - x[lo])
         d[i, hi] += 1.0 / (x[hi] - x[lo])
     return d
-
-
-def _readonly(a) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True)
