@@ -113,24 +113,29 @@ def _short(v: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
+def _raw(path: str | os.PathLike, what: str, limit: int | None = None) -> bytes:
+    """The bytes of ``path``; every way reading can fail becomes one InputError naming the file."""
     p = Path(path)
     name = str(path)
     try:
         if p.is_dir():
-            raise InputError(f"{name}: is a directory, not a points file")
-        size = p.stat().st_size
-        if size > MAX_BYTES:
-            raise InputError(f"{name}: {size} bytes is too large for a points file")
-        raw = p.read_bytes()
+            raise InputError(f"{name}: is a directory, not {what}")
+        if limit is not None and (size := p.stat().st_size) > limit:
+            raise InputError(f"{name}: {size} bytes is too large for {what}")
+        return p.read_bytes()
     except FileNotFoundError:
         raise InputError(f"{name}: no such file") from None
     except PermissionError:
         raise InputError(f"{name}: permission denied") from None
     except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, not a points file") from None
+        raise InputError(f"{name}: is a directory, not {what}") from None
     except OSError as e:
         raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+
+
+def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
+    name = str(path)
+    raw = _raw(path, "a points file", MAX_BYTES)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -328,14 +333,7 @@ def read_program(path: str | os.PathLike) -> str:
         For a missing or unreadable file, a directory, or a byte that is not ASCII.
     """
     name = str(path)
-    try:
-        raw = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"{name}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, not a program") from None
-    except OSError as e:
-        raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    raw = _raw(path, "a program")
     try:
         return raw.decode("ascii")
     except UnicodeDecodeError as e:
