@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import IO
 
+from ..errors import InputError
 from ..io import write_text
 
 
@@ -15,3 +16,14 @@ def emit(text: str, output: str | None, out: IO[str]) -> None:
         write_text(output, text)
     else:
         out.write(text)
+
+
+def origin(text: str) -> tuple[float, float, float]:
+    """``X,Y,Z`` in millimetres."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(v == v and abs(v) != float("inf") for v in values):
+        raise InputError(f"--origin {text!r} must be three numbers X,Y,Z in mm")
+    return values

@@ -8,7 +8,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, program_stats
 from ..macro.form import FORMS
 from ..macro.plan import points_at, sample_positions
-from ._common import emit
+from ._common import emit, origin
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
@@ -35,15 +35,6 @@ examples:
       --variable-base 20 -o 1000.h"""
 
 
-def _triple(text: str) -> tuple[float, float, float]:
-    parts = [p for p in text.replace(",", " ").split()]
-    if len(parts) != 3:
-        import argparse
-
-        raise argparse.ArgumentTypeError(f"{text!r} is not X,Y,Z")
-    return tuple(float(p) for p in parts)
-
-
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help="control language (default fanuc)")
@@ -58,7 +49,7 @@ def add_arguments(p) -> None:
     p.add_argument("--variable-base", type=int, metavar="N",
                    help="first variable number: Fanuc #100 (default) or #500, Heidenhain Q1 (default)")
     p.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
-    p.add_argument("--origin", type=_triple, default=(0.0, 0.0, 0.0), metavar="X,Y,Z", help="work offset added, mm")
+    p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added, mm")
     p.add_argument("--units", choices=("mm", "inch"), default="mm", help="program units (default mm)")
     p.add_argument("--direction", choices=("x", "y"), default="x", help="rows run along x (default) or y")
     p.add_argument("--stepover", type=float, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
@@ -85,7 +76,7 @@ def add_arguments(p) -> None:
 def settings_from(args) -> tuple[MachineSettings, RasterSpec, Tool]:
     """The machine, raster and tool the arguments describe."""
     settings = MachineSettings(
-        dialect=args.dialect, scale=args.scale, origin_mm=args.origin, units=args.units,
+        dialect=args.dialect, scale=args.scale, origin_mm=origin(args.origin), units=args.units,
         feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
         safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock, program_number=args.program,
         work_offset=args.work_offset, line_ending=args.line_ending, decimals=args.decimals,

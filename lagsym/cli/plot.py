@@ -133,7 +133,7 @@ def _toolpath_figure(plot, grid, program, args, opts):
 
     from ..gcode import move_points
     from ..io import read_program
-    from .toolpath import origin
+    from ._common import origin
 
     points_mm, rapid = move_points(read_program(program), source=program)
     if not len(points_mm):

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from ..errors import InputError
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
 from ..machine import DIRECTIONS, LINE_ENDINGS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
 from ..post.program import point_program, write_program
+
+from ._common import origin
 
 NAME = "toolpath"
 ORDER = 60
@@ -57,17 +58,6 @@ def add_arguments(p) -> None:
     m.add_argument("--line-ending", choices=tuple(LINE_ENDINGS), default="lf", help="lf (default), crlf or cr")
     m.add_argument("--decimals", type=int, metavar="N", help="decimals in coordinates (default 3 for mm, 4 for inch)")
     m.add_argument("--title", help="comment at the top of the program (default: the points file's name)")
-
-
-def origin(text: str) -> tuple[float, float, float]:
-    """``X,Y,Z`` in millimetres."""
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != 3 or not all(v == v and abs(v) != float("inf") for v in values):
-        raise InputError(f"--origin {text!r} must be three numbers X,Y,Z in mm")
-    return values
 
 
 def settings_from(args, dialect: str) -> MachineSettings:

@@ -7,7 +7,7 @@ from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Tool
-from .toolpath import origin
+from ._common import origin
 
 NAME = "verify"
 ORDER = 65
