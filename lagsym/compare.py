@@ -50,6 +50,7 @@ from ._arrays import readonly as _readonly
 from .errors import InputError
 from .grid import ControlGrid, _fmt
 from .surfaces import HERMITE_KINDS, METHODS, make_surface
+from .values import choice
 
 __all__ = [
     "DEFAULT_SAMPLES",
@@ -327,10 +328,8 @@ def compare_surfaces(
     if not methods:
         raise InputError(f"no methods to compare; choose from {', '.join(METHODS)}")
     for m in methods:
-        if m not in METHODS:
-            raise InputError(f"method {m!r} is not one of {', '.join(METHODS)}")
-    if hermite not in HERMITE_KINDS:
-        raise InputError(f"Hermite kind {hermite!r} is not one of {', '.join(HERMITE_KINDS)}")
+        choice(m, METHODS, "method")
+    choice(hermite, HERMITE_KINDS, "Hermite kind")
     label, xs, ys, z_f = _reference_heights(reference, grid, samples)
     z_f = _readonly(z_f)
     bad = np.argwhere(~np.isfinite(z_f))
@@ -406,8 +405,7 @@ def render_table(c: Comparison, fmt: str = "text") -> str:
         ``text`` and ``markdown`` round to 4 decimals as the paper does;
         ``csv`` and ``json`` carry full precision.
     """
-    if fmt not in TABLE_FORMATS:
-        raise InputError(f"table format {fmt!r} is not one of {', '.join(TABLE_FORMATS)}")
+    choice(fmt, TABLE_FORMATS, "table format")
     names = [m.name for m in c.methods]
     if fmt == "json":
         doc = {

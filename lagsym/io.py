@@ -16,13 +16,13 @@ import re
 import tempfile
 import time
 from collections.abc import Iterator
-from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 from typing import IO, Any
 
 from .errors import InputError
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
+from .values import MAX_EXPONENT, NotANumber, exact_number
 
 __all__ = [
     "read_points",
@@ -38,48 +38,17 @@ __all__ = [
 ]
 
 MAX_BYTES = 64 * 1024 * 1024
-_MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
-_RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
-_DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
-
-
-class _Bad(Exception):
-    """A value that is not an exact number, with a reason."""
-
-
-def exact_number(text: str) -> Fraction:
-    """Read an exact decimal or rational from text.
-
-    Examples
-    --------
-    >>> exact_number("1.06"), exact_number("-1/3"), exact_number("2e3")
-    (Fraction(53, 50), Fraction(-1, 3), Fraction(2000, 1))
-    """
-    m = _RATIONAL.match(text)
-    if m:
-        num, den = m.groups()
-        if len(num) > _MAX_EXPONENT or len(den) > _MAX_EXPONENT:
-            raise _Bad(f"{text!r} is too large")
-        if int(den) == 0:
-            raise _Bad(f"{text!r} divides by zero")
-        return Fraction(int(num), int(den))
-    if not _DECIMAL.match(text):
-        raise _Bad(f"{text.strip()!r} is not a number")
-    d = Decimal(text.strip())
-    if len(d.as_tuple().digits) > _MAX_EXPONENT or abs(d.adjusted()) > _MAX_EXPONENT:
-        raise _Bad(f"{text.strip()!r} is out of range (overflow)")
-    return Fraction(d)
 
 
 def _json_float(text: str) -> Fraction:
     try:
         return exact_number(text)
-    except _Bad as e:
+    except NotANumber as e:
         raise _JsonValueError(str(e)) from None
 
 
 def _json_int(text: str) -> int:
-    if len(text.lstrip("-")) > _MAX_EXPONENT:
+    if len(text.lstrip("-")) > MAX_EXPONENT:
         raise _JsonValueError(f"{text[:20]}... is out of range (overflow)")
     return int(text)
 
@@ -100,7 +69,7 @@ def _value(v: Any, where: str) -> Fraction:
     if isinstance(v, str):
         try:
             return exact_number(v)
-        except _Bad as e:
+        except NotANumber as e:
             raise InputError(f"{where}: {e}") from None
     raise InputError(f"{where}: {_short(v)} is not a number")
 
@@ -209,7 +178,7 @@ def _csv_rows(name: str, text: str, arity: int) -> list[tuple[Fraction, ...]]:
         for c in (cells[j] for j in order):
             try:
                 values.append(exact_number(c))
-            except _Bad as e:
+            except NotANumber as e:
                 raise InputError(f"{name}: line {lineno}: {e}") from None
         points.append(tuple(values))
     return points

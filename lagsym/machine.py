@@ -11,28 +11,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .errors import ToolpathError
+from .values import choice, positive
 
-__all__ = ["Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "choice"]
+__all__ = ["Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "UNITS", "DIRECTIONS"]
 
 DIALECTS = ("fanuc", "linuxcnc", "heidenhain", "grbl")
 TOOL_SHAPES = ("ball", "flat")
 LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
 UNITS = ("mm", "inch")
 DIRECTIONS = ("x", "y")
-
-
-def choice(value: str, options, what: str) -> str:
-    """Check a string option against its list; the message names the valid choices."""
-    if value not in options:
-        raise ToolpathError(f"{what} {value!r} is not one of {', '.join(options)}")
-    return value
-
-
-def _positive(value: float, what: str, allow_zero: bool = False) -> float:
-    v = float(value)
-    if not (v > 0 or (allow_zero and v == 0)) or v != v or v in (float("inf"),):
-        raise ToolpathError(f"{what} {value!r} must be {'zero or ' if allow_zero else ''}a positive number")
-    return v
 
 
 @dataclass(frozen=True)
@@ -44,7 +31,7 @@ class Tool:
 
     def __post_init__(self):
         choice(self.shape, TOOL_SHAPES, "tool shape")
-        object.__setattr__(self, "diameter_mm", _positive(self.diameter_mm, "tool diameter", allow_zero=True))
+        object.__setattr__(self, "diameter_mm", positive(self.diameter_mm, "tool diameter", allow_zero=True))
 
     @property
     def radius_mm(self) -> float:
@@ -88,11 +75,11 @@ class MachineSettings:
         choice(self.dialect, DIALECTS, "dialect")
         choice(self.units, UNITS, "units")
         choice(self.line_ending, tuple(LINE_ENDINGS), "line ending")
-        _positive(self.scale, "scale")
-        _positive(self.feed_mm_min, "feed")
-        _positive(self.plunge_feed_mm_min, "plunge feed")
-        _positive(self.spindle_rpm, "spindle speed", allow_zero=True)
-        _positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
+        positive(self.scale, "scale")
+        positive(self.feed_mm_min, "feed")
+        positive(self.plunge_feed_mm_min, "plunge feed")
+        positive(self.spindle_rpm, "spindle speed", allow_zero=True)
+        positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
         if len(self.origin_mm) != 3:
             raise ToolpathError(f"origin {self.origin_mm!r} must be X,Y,Z")
         object.__setattr__(self, "origin_mm", tuple(float(v) for v in self.origin_mm))
@@ -143,4 +130,4 @@ class RasterSpec:
         for name in ("stepover_mm", "step_mm", "scallop_mm", "tolerance_mm"):
             v = getattr(self, name)
             if v is not None:
-                _positive(v, name.replace("_mm", "").replace("_", " "))
+                positive(v, name.replace("_mm", "").replace("_", " "))

@@ -23,6 +23,7 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
+from .values import as_exact
 
 __all__ = [
     "MAX_AXIS_POINTS",
@@ -148,26 +149,6 @@ class Block(NamedTuple):
     z: np.ndarray
 
 
-def _exact(v, name: str) -> Fraction:
-    if isinstance(v, bool):
-        raise InputError(f"{name} = {v!r} is not a number")
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            raise InputError(f"{name} = {v!r} is not a finite number")
-        return Fraction(v)
-    if isinstance(v, str):
-        from .io import _Bad, exact_number
-
-        try:
-            return exact_number(v)
-        except _Bad as e:
-            raise InputError(f"{name}: {e}") from None
-    try:
-        return Fraction(v)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {v!r} is not a number") from None
-
-
 def _count(v, name: str) -> int:
     if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
         raise InputError(f"{name} = {v!r} is not a whole number of grid lines")
@@ -239,7 +220,7 @@ def sample_grid(
     if len(given) != 4:
         raise InputError(f"box = {box!r} should be (x0, x1, y0, y1)")
     names = ("x0", "x1", "y0", "y1")
-    x0, x1, y0, y1 = (c if v is None else _exact(v, name) for v, c, name in zip(given, (cx0, cx1, cy0, cy1), names))
+    x0, x1, y0, y1 = (c if v is None else as_exact(v, name) for v, c, name in zip(given, (cx0, cx1, cy0, cy1), names))
     if not x0 < x1:
         raise InputError(f"x0 = {_show(x0)} should be less than x1 = {_show(x1)}")
     if not y0 < y1:
@@ -262,8 +243,8 @@ def sample_grid(
         if step is None and (dx is None or dy is None):
             raise InputError("give both dx and dy, or step for both directions")
         nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
-        sx = _exact(step if step is not None else dx, nxname)
-        sy = _exact(step if step is not None else dy, nyname)
+        sx = as_exact(step if step is not None else dx, nxname)
+        sy = as_exact(step if step is not None else dy, nyname)
         return SampleGrid(region, _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname))
     if nx is None or ny is None:
         raise InputError("give both nx and ny (or a spacing)")

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
 from conftest import EXAMPLES
-from lagsym.errors import ProgramError, ToolpathError
+from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
@@ -353,7 +353,7 @@ def test_inch_programs_are_in_inches():
 
 
 def test_unknown_dialect_names_the_choices():
-    with pytest.raises(ToolpathError, match="fanuc, linuxcnc, heidenhain"):
+    with pytest.raises(InputError, match="fanuc, linuxcnc, heidenhain"):
         macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
 
 

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lagsym.errors import ProgramError, ToolpathError
+from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
@@ -95,7 +95,7 @@ def test_safe_z_must_clear_the_path(path4):
 
 
 def test_unknown_dialect_names_the_choices():
-    with pytest.raises(ToolpathError, match="fanuc"):
+    with pytest.raises(InputError, match="fanuc"):
         MachineSettings(dialect="sinumerik")
     with pytest.raises(ProgramError, match="point-list writer"):
         writer("heidenhain")

@@ -36,7 +36,8 @@ from fractions import Fraction
 
 from ..grid import grid_from_table
 from ..lagrange import LagrangeSurface, lagrange_surface
-from ..machine import MachineSettings, choice
+from ..machine import MachineSettings
+from ..values import choice
 from .model import Assign, Const, Var, add, const, mul, sub, var
 from .plan import exact
 

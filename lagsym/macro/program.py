@@ -34,7 +34,8 @@ import numpy as np
 
 from ..errors import ProgramError, ToolpathError
 from ..lagrange import LagrangeSurface, horner2
-from ..machine import MachineSettings, RasterSpec, Tool, choice
+from ..machine import MachineSettings, RasterSpec, Tool
+from ..values import choice
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, decimal_context, mul, run, sub, var
 from .plan import MacroRaster, macro_raster, points_at, sample_positions

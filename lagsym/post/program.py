@@ -20,7 +20,8 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ProgramError
-from ..machine import DIALECTS, MachineSettings, choice
+from ..machine import DIALECTS, MachineSettings
+from ..values import choice
 from .numbers import fixed
 
 __all__ = ["PointProgram", "point_program", "write_program", "format_moves", "iso_comment", "WRITERS", "writer"]
