@@ -87,8 +87,11 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None
         pass
 
     Parser.out, Parser.err = out, err
+    # --traceback is accepted before or after the command: no default, so the command's parser cannot
+    # undo a --traceback given before it (main reads it with getattr).
     common = Parser(add_help=False)
-    common.add_argument("--traceback", action="store_true", help="show the full traceback on an error")
+    common.add_argument("--traceback", action="store_true", default=argparse.SUPPRESS,
+                        help="show the full traceback on an error")
     parser = Parser(
         prog="lagsym",
         description="Exact Lagrange surfaces from a few control points, to the machine.",
@@ -125,7 +128,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
     try:
         return int(args._run(args, out, err))
     except LagsymError as e:
-        if args.traceback:
+        if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         err.write(f"lagsym: error: {e}\n")
         return int(e.exit_status)
@@ -135,7 +138,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
     except BrokenPipeError:
         return ExitStatus.OK
     except Exception as e:  # a bug in lagsym: say so in one line unless the user asks for more
-        if args.traceback:
+        if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         else:
             err.write(f"lagsym: internal error: {type(e).__name__}: {e} (run again with --traceback and report it)\n")
