@@ -287,7 +287,7 @@ def test_rendering_backend_is_known():
 def test_xvfb_fallback_renders():
     """The last resort where neither EGL nor OSMesa works: a private Xvfb server, gone with its process."""
     code = (
-        "import os; from lagsym.plot import _start_xvfb\n"
+        "import os; from lagsym.plot.backend import _start_xvfb\n"
         "os.environ['DISPLAY'] = _start_xvfb()\n"
         "os.environ['VTK_DEFAULT_OPENGL_WINDOW'] = 'vtkXOpenGLRenderWindow'\n"
         "import pyvista as pv\n"
