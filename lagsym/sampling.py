@@ -2,9 +2,11 @@
 
 A :class:`SampleGrid` is a regular ``nx`` x ``ny`` grid over a box, with exact
 box corners; :func:`sample_grid` builds one from counts or from a spacing and
-checks it against the control box.  :func:`sample` returns the whole grid of
-heights; :func:`iter_blocks` yields it a block of x-rows at a time, so a
-writer can stream any number of points in bounded memory.
+checks it against the control box; :func:`axis_lines` builds each axis of
+it, exactly (comparisons and pictures take their axes from it too).
+:func:`sample` returns the whole grid of heights; :func:`iter_blocks`
+yields it a block of x-rows at a time, so a writer can stream any number of
+points in bounded memory.
 
 Points are ordered x-major, like the paper's ``p_ik``: row ``i * ny + j`` of a
 flattened sample is ``(xs[i], ys[j], F(xs[i], ys[j]))``.
@@ -32,6 +34,7 @@ __all__ = [
     "SampleGrid",
     "Sample",
     "Block",
+    "axis_lines",
     "sample_grid",
     "sample",
     "iter_blocks",
@@ -63,12 +66,25 @@ class Box:
         return float(self.x0), float(self.x1), float(self.y0), float(self.y1)
 
 
-def _lines(a: Fraction, b: Fraction, n: int) -> np.ndarray:
-    """``n`` evenly spaced values from ``a`` to ``b``, each the float nearest the exact value.
+def axis_lines(a: Fraction, b: Fraction, n: int) -> np.ndarray:
+    """``n`` evenly spaced values from ``a`` to ``b``, ends included, each the float nearest the exact value.
+
+    This is the one builder of sample axes (sample grids, comparisons and
+    pictures all use it).  Each line ``a + (b - a) k / (n - 1)`` is computed
+    exactly and rounded once, so the end points are ``float(a)`` and
+    ``float(b)`` to the last bit, and a line that falls on a control node is
+    that node.  The array is read-only.
+
+    Parameters
+    ----------
+    a, b : Fraction
+        The exact ends.
+    n : int
+        Number of lines, at least 1 (one line is ``a`` alone).
 
     Examples
     --------
-    >>> _lines(Fraction(0), Fraction(3, 10), 4).tolist()
+    >>> axis_lines(Fraction(0), Fraction(3, 10), 4).tolist()
     [0.0, 0.1, 0.2, 0.3]
     """
     if n == 1:
@@ -119,12 +135,12 @@ class SampleGrid:
     @cached_property
     def xs(self) -> np.ndarray:
         """The x grid lines, read-only, each correctly rounded."""
-        return _lines(self.box.x0, self.box.x1, self.nx)
+        return axis_lines(self.box.x0, self.box.x1, self.nx)
 
     @cached_property
     def ys(self) -> np.ndarray:
         """The y grid lines, read-only, each correctly rounded."""
-        return _lines(self.box.y0, self.box.y1, self.ny)
+        return axis_lines(self.box.y0, self.box.y1, self.ny)
 
 
 class Sample(NamedTuple):

@@ -29,6 +29,8 @@ from lagsym.errors import InputError
 from lagsym.evaluate import evaluate_grid
 from lagsym.io import read_curve_points, read_points
 from lagsym.lagrange import lagrange_curve, lagrange_surface
+from lagsym.plot.surface import sampled_surface
+from lagsym.sampling import sample_grid
 
 REFERENCE = Path(__file__).resolve().parent / "reference_images"
 UPDATE = os.environ.get("LAGSYM_UPDATE_REFERENCE_IMAGES") == "1"
@@ -287,7 +289,7 @@ def test_rendering_backend_is_known():
 def test_xvfb_fallback_renders():
     """The last resort where neither EGL nor OSMesa works: a private Xvfb server, gone with its process."""
     code = (
-        "import os; from lagsym.plot import _start_xvfb\n"
+        "import os; from lagsym.plot.backend import _start_xvfb\n"
         "os.environ['DISPLAY'] = _start_xvfb()\n"
         "os.environ['VTK_DEFAULT_OPENGL_WINDOW'] = 'vtkXOpenGLRenderWindow'\n"
         "import pyvista as pv\n"
@@ -299,6 +301,15 @@ def test_xvfb_fallback_renders():
     done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert int(done.stdout.split()[-1]) >= 5  # a red sphere fills part of the picture
+
+
+def test_figures_sample_on_the_exact_lines(surface4):
+    """The pictures take their axes from the one builder, so every node is a sample, to the last bit."""
+    xs, ys, z = sampled_surface(surface4, 41)
+    g = sample_grid(surface4, 41, 41)
+    assert xs.tolist() == g.xs.tolist() and ys.tolist() == g.ys.tolist()
+    assert xs[::10].tolist() == surface4.grid.x_array.tolist()
+    assert z[::10, ::10].tolist() == surface4.grid.z_array.tolist()
 
 
 # ----------------------------------------------------------------------------- errors name the value
