@@ -9,6 +9,8 @@ makes a plotter, so every figure renders wherever lagsym runs.
 
 from __future__ import annotations
 
+import importlib.util
+
 import functools
 import os
 import shutil
@@ -124,6 +126,13 @@ def rendering_backend() -> str:
     )
 
 
+def _has_ipython() -> bool:
+    try:
+        return importlib.util.find_spec("IPython") is not None
+    except (ImportError, ValueError):
+        return False
+
+
 def new_plotter(shape=(1, 1), window_size=DEFAULT_WINDOW_SIZE, off_screen: bool | None = None, col_weights=None):
     """A new :class:`pyvista.Plotter` with its own white theme, on the backend chosen here.
 
@@ -151,7 +160,10 @@ def new_plotter(shape=(1, 1), window_size=DEFAULT_WINDOW_SIZE, off_screen: bool 
     if rendering_backend() != "display":
         off_screen = True
     theme = pv.themes.DocumentTheme()
-    theme.jupyter_backend = "static"
+    if _has_ipython():
+        # Notebooks show a static image by default (the same picture -o writes); pyvista refuses to
+        # set a notebook backend at all where IPython is not installed, as after a plain install.
+        theme.jupyter_backend = "static"
     theme.font.color = "black"
     theme.font.family = "arial"
     return pv.Plotter(shape=shape, window_size=list(size), off_screen=off_screen, theme=theme,
