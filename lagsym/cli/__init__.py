@@ -10,12 +10,15 @@ directly.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import threading
 import traceback
 from typing import IO, Sequence
 
-from ..errors import ExitStatus, LagsymError
+from ..errors import ExitStatus, LagsymError, Terminated
 
 __all__ = ["main", "build_parser", "COMMANDS", "command_module"]
 
@@ -126,14 +129,18 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         parser.print_help(out)
         return ExitStatus.BAD_INPUT
     try:
-        return int(args._run(args, out, err))
+        with _signals_as_interrupts():
+            return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         err.write(f"lagsym: error: {e}\n")
         return int(e.exit_status)
+    except Terminated as e:
+        err.write(f"lagsym: stopped by {signal.Signals(e.signum).name}; no partial output file is left\n")
+        return 128 + e.signum
     except KeyboardInterrupt:
-        err.write("lagsym: interrupted\n")
+        err.write("lagsym: interrupted; no partial output file is left\n")
         return ExitStatus.INTERRUPTED
     except BrokenPipeError:
         return ExitStatus.OK
@@ -143,6 +150,25 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         else:
             err.write(f"lagsym: internal error: {type(e).__name__}: {e} (run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+@contextlib.contextmanager
+def _signals_as_interrupts():
+    """SIGTERM and SIGHUP (a closed terminal) stop a command the way Ctrl-C does: temporary files removed,
+    a transfer's resume block named, one line, exit 128 + the signal (143, 129)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated(signum)
+
+    old = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def run_console() -> None:
