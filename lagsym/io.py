@@ -85,16 +85,24 @@ def _short(v: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _raw(path: str | os.PathLike, what: str, limit: int | None = None) -> bytes:
-    """The bytes of ``path``; every way reading can fail becomes one InputError naming the file."""
-    p = Path(path)
+_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe (FIFO)"),
+          (stat.S_ISSOCK, "a socket"))
+STDIN_NAMES = ("-", "/dev/stdin")
+STDIN_SILENCE_S = 10.0  # standard input that sends nothing for this long is refused, not waited on forever
+
+
+def _raw(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
+    """The bytes of ``path`` (``-``: standard input), at most ``limit``; every failure is one InputError naming it.
+
+    Only a regular file or standard input is read: a device or a named pipe
+    could hand over endless bytes or none, so it is refused with a line that
+    says what it is.
+    """
     name = str(path)
+    if name in STDIN_NAMES:
+        return _read_stdin(what, limit)
     try:
-        if p.is_dir():
-            raise InputError(f"{name}: is a directory, not {what}")
-        if limit is not None and (size := p.stat().st_size) > limit:
-            raise InputError(f"{name}: {size} bytes is too large for {what}")
-        return p.read_bytes()
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
     except FileNotFoundError:
         raise InputError(f"{name}: no such file") from None
     except PermissionError:
@@ -103,11 +111,50 @@ def _raw(path: str | os.PathLike, what: str, limit: int | None = None) -> bytes:
         raise InputError(f"{name}: is a directory, not {what}") from None
     except OSError as e:
         raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    info = os.fstat(fd)
+    refusal = f"{name}: is a directory, not {what}" if stat.S_ISDIR(info.st_mode) else next(
+        (f"{name}: is {kind}, not {what}; give a regular file, or '-' for standard input"
+         for test, kind in _KINDS if test(info.st_mode)), None)
+    if refusal:
+        os.close(fd)
+        raise InputError(refusal)
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            if (size := info.st_size) > limit:
+                raise InputError(f"{name}: {size} bytes is too large for {what} (at most {limit} bytes)")
+            raw = fh.read(limit + 1)
+        except IsADirectoryError:
+            raise InputError(f"{name}: is a directory, not {what}") from None
+        except OSError as e:
+            raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    if len(raw) > limit:  # the file grew while it was read
+        raise InputError(f"{name}: more than {limit} bytes is too large for {what}")
+    return raw
+
+
+def _read_stdin(what: str, limit: int) -> bytes:
+    import select
+    import sys
+
+    stream = sys.stdin.buffer
+    chunks, total = [], 0
+    while True:
+        ready, _, _ = select.select([stream], [], [], STDIN_SILENCE_S)
+        if not ready:
+            raise InputError(f"standard input: nothing arrived for {STDIN_SILENCE_S:g} s; "
+                             f"pipe {what} in, or give a file name")
+        chunk = os.read(stream.fileno(), 1 << 16)
+        if not chunk:
+            return b"".join(chunks)
+        total += len(chunk)
+        if total > limit:
+            raise InputError(f"standard input: more than {limit} bytes is too large for {what}")
+        chunks.append(chunk)
 
 
 def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
     name = str(path)
-    raw = _raw(path, "a points file", MAX_BYTES)
+    raw = _raw(path, "a points file")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
