@@ -123,8 +123,6 @@ def _raw(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
             if (size := info.st_size) > limit:
                 raise InputError(f"{name}: {size} bytes is too large for {what} (at most {limit} bytes)")
             raw = fh.read(limit + 1)
-        except IsADirectoryError:
-            raise InputError(f"{name}: is a directory, not {what}") from None
         except OSError as e:
             raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
     if len(raw) > limit:  # the file grew while it was read
