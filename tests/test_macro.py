@@ -357,6 +357,25 @@ def test_unknown_dialect_names_the_choices():
         macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
 
 
+def test_unknown_precision_and_form_name_the_choices():
+    with pytest.raises(InputError, match="precision 9 is not one of 8, 15"):
+        macro_program(surface("paper-example-1"), machine(), RasterSpec(), FLAT, precision=9)
+    with pytest.raises(InputError, match="horner, lagrange"):
+        macro_program(surface("paper-example-1"), machine(), RasterSpec(), FLAT, form="monomial")
+
+
+def test_the_macro_modules_import_one_way():
+    """No module of lagsym.macro imports one above it, not even inside a function."""
+    import grimp
+
+    graph = grimp.build_graph("lagsym")
+    order = ["model", "_placement", "raster", "form", "ballend", "points", "loops", "accuracy", "program"]
+    for low, module in enumerate(order):
+        for high in order[low + 1:]:
+            assert not graph.direct_import_exists(importer=f"lagsym.macro.{module}",
+                                                  imported=f"lagsym.macro.{high}"), (module, high)
+
+
 # ---------------------------------------------------------------- command line
 
 def test_cli_macro_then_simulate(run_cli, tmp_path):
