@@ -134,3 +134,12 @@ def test_the_interpreter_check_catches_a_bad_program(rs274):
         interpret(rs274, "G21 G90\nG1 X1. F100.\nG1 X2. Q5.\nM2\n")
     with pytest.raises(AssertionError, match="no percent sign or program end"):
         interpret(rs274, "G21 G90\nG1 X1. F100.\n")
+
+
+def test_the_dialect_modules_do_not_import_the_writer_table():
+    """lagsym.post.program imports the dialects for WRITERS; nothing below it imports it back."""
+    import grimp
+
+    graph = grimp.build_graph("lagsym")
+    for module in ("fanuc", "linuxcnc", "grbl", "model", "moves", "numbers"):
+        assert not graph.find_shortest_chain(importer=f"lagsym.post.{module}", imported="lagsym.post.program")
