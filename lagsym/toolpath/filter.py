@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..values import finite
+
 __all__ = ["filter_rows"]
 
 
@@ -21,6 +23,7 @@ def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.nd
     >>> filter_rows(np.arange(5.0), np.array([0.0, 1.0, 2.0, 2.0, 2.0]), 0.01).tolist()
     [0, 2, 4]
     """
+    tolerance = finite(tolerance, "chordal tolerance", low=0.0)
     n = len(along)
     if extra is None:
         extra = np.zeros(n)

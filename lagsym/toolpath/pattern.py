@@ -12,6 +12,8 @@ import math
 import numpy as np
 
 from ..errors import ToolpathError
+from ..machine import DIRECTIONS
+from ..values import choice, finite, positive
 
 __all__ = ["raster_pattern", "levels", "scallop_stepover"]
 
@@ -26,7 +28,7 @@ def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
     >>> round(scallop_stepover(3.0, 0.01), 4)
     0.4895
     """
-    r, h = float(radius_mm), float(scallop_mm)
+    r, h = finite(radius_mm, "tool radius"), positive(scallop_mm, "scallop height")
     if r <= 0:
         raise ToolpathError("a scallop height needs a ball-end cutter with a diameter above 0")
     if h >= r:
@@ -59,6 +61,8 @@ def raster_pattern(bounds, direction: str, stepover: float, step: float):
     along : ndarray
         Positions along a row (forwards).
     """
+    choice(direction, DIRECTIONS, "raster direction")
+    stepover, step = positive(stepover, "side step"), positive(step, "forward step")
     x0, x1, y0, y1 = (float(v) for v in bounds)
     if direction == "x":
         return levels(y0, y1, stepover), levels(x0, x1, step)
