@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import functools
 import math
+import weakref
 
 import numpy as np
 from numpy.polynomial import chebyshev as C
@@ -118,17 +119,27 @@ def _inside_box(cx, cy, box):
     return np.clip(cx, x0, x1), np.clip(cy, y0, y1)
 
 
+_HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator, float] = weakref.WeakKeyDictionary()
+
+
 def _height_scale(ev: SurfaceEvaluator) -> float:
     """Spread of the surface's coefficients in the power basis of the normalized coordinates.
 
     The scale :data:`CL_MARGIN` and the search's settling threshold were set
     against; the Chebyshev coefficients are converted back (in floats) only
-    to measure it.
+    to measure it, once per evaluator.
     """
-    n, m = ev.shape
+    found = _HEIGHT_SCALES.get(ev)
+    if found is None:
+        found = _HEIGHT_SCALES[ev] = _power_spread(ev.coefficients)
+    return found
+
+
+def _power_spread(coefficients: np.ndarray) -> float:
+    n, m = coefficients.shape
     to_power_x = np.array([np.pad(C.cheb2poly(np.eye(n)[k]), (0, n))[:n] for k in range(n)]).T
     to_power_y = np.array([np.pad(C.cheb2poly(np.eye(m)[k]), (0, m))[:m] for k in range(m)]).T
-    return float(np.ptp(to_power_x @ ev.coefficients @ to_power_y.T))
+    return float(np.ptp(to_power_x @ coefficients @ to_power_y.T))
 
 
 @functools.lru_cache(maxsize=16)
