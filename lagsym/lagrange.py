@@ -140,12 +140,6 @@ class LagrangeCurve:
             acc = acc * x + c
         return acc
 
-    def evaluate(self, x):
-        """``F(x)`` in floating point, stable (barycentric form), on NumPy arrays."""
-        from .evaluate import evaluate_curve
-
-        return evaluate_curve(self, x)
-
 
 @dataclass(frozen=True)
 class LagrangeSurface:
@@ -201,24 +195,6 @@ class LagrangeSurface:
     def derivative(self, dx: int = 1, dy: int = 0) -> sympy.Poly:
         """The exact partial derivative ``d^(dx+dy) F / dx^dx dy^dy`` as a Poly."""
         return self.poly.diff(*([(X, dx)] if dx else []), *([(Y, dy)] if dy else [])) if (dx or dy) else self.poly
-
-    def evaluate(self, x, y):
-        """``F(x, y)`` in floating point on NumPy arrays with broadcasting, stable (barycentric form)."""
-        from .evaluate import evaluate_points
-
-        return evaluate_points(self, x, y)
-
-    def sample(self, nx: int | None = None, ny: int | None = None, **kwargs):
-        """Sample on a regular grid: ``X, Y, Z = surface.sample(nx, ny)``; see :func:`lagsym.sampling.sample`."""
-        from .sampling import sample
-
-        return sample(self, nx, ny, **kwargs)
-
-    def lambdify(self):
-        """The NumPy function ``f(x, y)`` of the exact expression; see :func:`lagsym.evaluate.lambdify_surface`."""
-        from .evaluate import lambdify_surface
-
-        return lambdify_surface(self)
 
 
 def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
