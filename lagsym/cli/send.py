@@ -6,8 +6,19 @@ import argparse
 import contextlib
 from pathlib import Path
 
-from ..dncplan import parse_program
+from ..dnc import (
+    FLOW_CONTROLS,
+    MODES,
+    PARITIES,
+    PROFILES,
+    LineSettings,
+    parse_filler,
+    parse_program,
+    profile,
+    send_program,
+)
 from ..io import event_log, read_program
+from ..machine import LINE_ENDINGS
 
 NAME = "send"
 ORDER = 80
@@ -36,8 +47,6 @@ examples:
 
 def add_line_arguments(p) -> None:
     """The serial line options ``send`` and ``receive`` share."""
-    from ..dnc import FLOW_CONTROLS, LINE_ENDINGS, PARITIES, PROFILES
-
     p.add_argument("--port", required=True, help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port)")
     g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
     g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
@@ -58,11 +67,9 @@ def add_line_arguments(p) -> None:
 
 def line_settings(args):
     """The :class:`~lagsym.dnc.LineSettings` the options ask for."""
-    from ..dnc import LineSettings, parse_filler, profile
-
     overrides = {}
     for option, field in (("baud", "baud"), ("bytesize", "bytesize"), ("parity", "parity"), ("stopbits", "stopbits"),
-                          ("flow", "flow"), ("eol", "eol"), ("percent", "percent"), ("dtr", "dtr")):
+                          ("flow", "flow"), ("eol", "line_ending"), ("percent", "percent"), ("dtr", "dtr")):
         value = getattr(args, option, None)
         if value is not None:
             overrides[field] = value
@@ -104,8 +111,6 @@ def progress_bar(err, quiet: bool, what: str):
 
 
 def add_arguments(p) -> None:
-    from ..dnc import MODES
-
     p.add_argument("file", help="the program (G-code or Heidenhain text)")
     add_line_arguments(p)
     t = p.add_argument_group("transfer")
@@ -123,8 +128,6 @@ def add_arguments(p) -> None:
 
 
 def run(args, out, err) -> int:
-    from ..dnc import send_program
-
     program = parse_program(read_program(args.file), source=args.file)
     settings = line_settings(args)
     with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:
