@@ -46,16 +46,17 @@ examples:
 
 
 def add_line_arguments(p) -> None:
-    """The serial line options ``send`` and ``receive`` share."""
+    """The serial line options ``send`` and ``receive`` share; the defaults they print are :class:`LineSettings`'s."""
+    d = LineSettings()
     p.add_argument("--port", required=True, help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port)")
     g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
     g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
-    g.add_argument("--baud", type=int, help="bits per second (default 9600)")
-    g.add_argument("--bytesize", type=int, choices=(5, 6, 7, 8), help="data bits (default 7)")
-    g.add_argument("--parity", choices=tuple(PARITIES), help="parity (default even)")
-    g.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help="stop bits (default 2)")
-    g.add_argument("--flow", choices=FLOW_CONTROLS, help="flow control (default xonxoff)")
-    g.add_argument("--eol", choices=tuple(LINE_ENDINGS), help="end of block (default lf)")
+    g.add_argument("--baud", type=int, help=f"bits per second (default {d.baud})")
+    g.add_argument("--bytesize", type=int, choices=(5, 6, 7, 8), help=f"data bits (default {d.bytesize})")
+    g.add_argument("--parity", choices=tuple(PARITIES), help=f"parity (default {d.parity})")
+    g.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help=f"stop bits (default {d.stopbits:g})")
+    g.add_argument("--flow", choices=FLOW_CONTROLS, help=f"flow control (default {d.flow})")
+    g.add_argument("--eol", choices=tuple(LINE_ENDINGS), help=f"end of block (default {d.line_ending})")
     g.add_argument("--leader", metavar="SPEC", help="characters before the program: a count of NULs or e.g. 50*NUL")
     g.add_argument("--trailer", metavar="SPEC", help="characters after the program, e.g. 20, ETX or 10*NUL,ETX")
     g.add_argument("--percent", action=argparse.BooleanOptionalAction, default=None,
@@ -113,6 +114,7 @@ def progress_bar(err, quiet: bool, what: str):
 def add_arguments(p) -> None:
     p.add_argument("file", help="the program (G-code or Heidenhain text)")
     add_line_arguments(p)
+    d = LineSettings()
     t = p.add_argument_group("transfer")
     t.add_argument("--mode", choices=MODES, default="upload",
                    help="upload: store in the control's memory (needed for macro programs); drip: feed while it runs")
@@ -121,9 +123,10 @@ def add_arguments(p) -> None:
     t.add_argument("--safe-z", metavar="Z", help="retract height for a resume, in program units "
                                                   "(default: the highest rapid Z before block N)")
     t.add_argument("--stall-timeout", type=float, metavar="SECONDS",
-                   help="give up when XOFF or CTS low lasts longer (default 120)")
+                   help=f"give up when XOFF or CTS low lasts longer (default {d.stall_timeout_s:g})")
     t.add_argument("--overrun-chars", type=int, metavar="N",
-                   help="most characters in flight, so at most N arrive after XOFF (default 8; Fanuc tolerates ~10)")
+                   help=f"most characters in flight, so at most N arrive after XOFF (default {d.overrun_chars}; "
+                        "Fanuc tolerates ~10)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
 
 
