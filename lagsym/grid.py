@@ -314,9 +314,9 @@ class SnapReport:
     def text(self, source: str) -> str:
         """One line saying it."""
         if not self.moved:
-            return f"{source}: --snap {_fmt(self.tolerance)}: no point needed moving"
+            return f"{source}: --snap {float(self.tolerance):g}: no point needed moving"
         axes = " x ".join(str(n) for n in self.nodes)
-        return (f"{source}: --snap {_fmt(self.tolerance)}: moved {self.moved} point(s) onto {axes} nodes, "
+        return (f"{source}: --snap {float(self.tolerance):g}: moved {self.moved} point(s) onto {axes} nodes, "
                 f"the largest move {float(self.largest):.3g}")
 
 
