@@ -150,3 +150,16 @@ def test_notebook_1_overshoot_sentence_matches_its_table():
     nb = json.loads((ROOT / "notebooks" / "01-lagrange-curves.ipynb").read_text())
     text = " ".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "markdown")
     assert "drops from degree 4 to 6 and from 8 to 10" in text
+
+
+def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_cli):
+    text = (DOCS / "macros.md").read_text()
+    block = text.split("$ lagsym macro examples/paper-example-4.json", 1)[1].split("```", 1)[0]
+    argv = ("macro " + block.split("\n", 2)[0] + " " + block.split("\n", 2)[1]).replace("\\", " ").split()
+    quoted = block.split("\n", 2)[2].split("\n$ ", 1)[0].strip()
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run_cli(argv[0], "examples/paper-example-4.json", *argv[1:])
+    assert status == 0, err
+    assert quoted == (out + err).strip()
+    assert f"takes {quoted.split('macro program:')[1].split()[0]} bytes on a Fanuc" in text
