@@ -99,8 +99,8 @@ def lebesgue_constant(nodes, samples: int = 17, rounds: int = 12) -> float:
 
     Examples
     --------
-    >>> round(lebesgue_constant([0, 1]), 12), round(lebesgue_constant(range(20)), 1)
-    (1.0, 5890.0)
+    >>> round(lebesgue_constant([0, 1]), 12), round(lebesgue_constant(range(20)))
+    (1.0, 5890)
     """
     s = np.sort(np.asarray([float(v) for v in nodes]))
     if len(s) < 2:
