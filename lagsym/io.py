@@ -8,9 +8,7 @@ the nearest binary float, and strings may hold exact decimals or rationals
 from __future__ import annotations
 
 import contextlib
-import csv
 import errno
-import io
 import json
 import os
 import re
@@ -19,16 +17,20 @@ import stat
 import tempfile
 import time
 from collections.abc import Iterator
+from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 from typing import IO, Any
 
 from .errors import InputError, OutputError
-from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
-from .values import MAX_EXPONENT, NotANumber, exact_number
+from .grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
+from .pointtable import UNIT_NAMES, parse_columns, read_table
+from .values import MAX_EXPONENT, NotANumber, choice, exact_number
 
 __all__ = [
     "read_points",
+    "read_point_file",
+    "PointsFile",
     "read_curve_points",
     "read_any_points",
     "read_program",
@@ -156,7 +158,8 @@ def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
-        raise InputError(f"{name}: not a text file (byte 0x{raw[e.start]:02x} at offset {e.start})") from None
+        hint = "" if b"\x00" in raw[:4096] else "; if it is text, save it as UTF-8 (Excel: 'CSV UTF-8')"
+        raise InputError(f"{name}: not a text file (byte 0x{raw[e.start]:02x} at offset {e.start}){hint}") from None
     if "\x00" in text:
         raise InputError(f"{name}: not a text file (NUL byte at offset {text.index(chr(0))})")
     if not text.strip():
@@ -164,10 +167,15 @@ def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
     return name, text
 
 
+TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".xyz", ".dat", ".asc")
+
+
 def _kind(name: str, text: str) -> str:
     suffix = Path(name).suffix.lower()
-    if suffix in (".json", ".csv"):
-        return suffix[1:]
+    if suffix == ".json":
+        return "json"
+    if suffix in TABLE_SUFFIXES:
+        return "csv"
     return "json" if text.lstrip()[:1] in "[{" else "csv"
 
 
@@ -182,58 +190,128 @@ def _load_json(name: str, text: str) -> Any:
         raise InputError(f"{name}: the JSON is nested too deeply to be a points file") from None
 
 
+def _point(name: str, idx: int, p: Any, arity: int) -> tuple[Fraction, ...]:
+    want = "[x, y, z]" if arity == 3 else "[x, y]"
+    if isinstance(p, dict):
+        keys = {str(k).lower(): v for k, v in p.items()}
+        if not all(c in keys for c in "xyz"[:arity]):
+            raise InputError(f"{name}: point {idx + 1} {_short(p)} should have keys {', '.join('xyz'[:arity])}")
+        return tuple(_value(keys[c], f"{name}: point {idx + 1} {c}") for c in "xyz"[:arity])
+    if not isinstance(p, list):
+        raise InputError(f"{name}: point {idx + 1} is {_short(p)}, not a list {want}")
+    if len(p) != arity:
+        raise InputError(f"{name}: point {idx + 1} {_short(p)} has {len(p)} values, expected {want}")
+    return tuple(_value(v, f"{name}: point {idx + 1}") for v in p)
+
+
 def _point_list(name: str, data: Any, arity: int) -> list[tuple[Fraction, ...]]:
     if not isinstance(data, list):
         raise InputError(f"{name}: expected a list of points, found {_short(data)}")
     if not data:
         raise InputError(f"{name}: the list of points is empty")
-    points = []
-    want = "[x, y, z]" if arity == 3 else "[x, y]"
-    for idx, p in enumerate(data):
-        if not isinstance(p, list):
-            raise InputError(f"{name}: point {idx + 1} is {_short(p)}, not a list {want}")
-        if len(p) != arity:
-            raise InputError(f"{name}: point {idx + 1} {_short(p)} has {len(p)} values, expected {want}")
-        points.append(tuple(_value(v, f"{name}: point {idx + 1}") for v in p))
-    return points
+    return [_point(name, idx, p, arity) for idx, p in enumerate(data)]
 
 
-def _csv_rows(name: str, text: str, arity: int) -> list[tuple[Fraction, ...]]:
-    columns = "xyz"[:arity]
-    rows = list(csv.reader(io.StringIO(text)))
-    order = list(range(arity))
-    body: list[tuple[int, list[str]]] = []
-    header_seen = False
-    for lineno, row in enumerate(rows, start=1):
-        cells = [c.strip() for c in row]
-        if not any(cells) or cells[0].startswith("#"):
-            continue
-        if not header_seen and not body and all(c.lower() in "xyz" and c for c in cells):
-            names = [c.lower() for c in cells]
-            if sorted(names) != sorted(columns):
-                raise InputError(f"{name}: line {lineno}: header {','.join(cells)} should name the columns {','.join(columns)}")
-            order = [names.index(c) for c in columns]
-            header_seen = True
-            continue
-        body.append((lineno, cells))
-    if not body:
-        raise InputError(f"{name}: no points in the file")
-    points = []
-    for lineno, cells in body:
-        if len(cells) != arity:
-            raise InputError(f"{name}: line {lineno} has {len(cells)} columns, expected {','.join(columns)}")
-        values = []
-        for c in (cells[j] for j in order):
-            try:
-                values.append(exact_number(c))
-            except NotANumber as e:
-                raise InputError(f"{name}: line {lineno}: {e}") from None
-        points.append(tuple(values))
-    return points
+def _units(name: str, data: Any) -> str | None:
+    if not isinstance(data, dict) or "units" not in data:
+        return None
+    unit = data["units"]
+    if not isinstance(unit, str) or unit.strip().lower() not in UNIT_NAMES:
+        raise InputError(f"{name}: \"units\": {_short(unit)} is not one lagsym knows (\"mm\" or \"inch\")")
+    return UNIT_NAMES[unit.strip().lower()]
+
+
+@dataclass(frozen=True)
+class PointsFile:
+    """A points file as read: the points, how they were laid out, and what ``snap`` moved.
+
+    Attributes
+    ----------
+    points : ControlGrid or CurvePoints
+        The points, with the file's units where it says them.
+    layout : str
+        How the file was read, in words (separator, decimal mark, header, columns, units).
+    plain : bool
+        True for the layouts that need no saying: JSON, or a comma-separated x,y,z table.
+    snapped : SnapReport or None
+        What ``snap`` moved, when it was given.
+    """
+
+    points: ControlGrid | CurvePoints
+    layout: str
+    plain: bool = True
+    snapped: SnapReport | None = None
+
+
+def _json_points(name: str, text: str, arity: int | None):
+    """(points or table, arity, layout, units) from JSON text."""
+    data = _load_json(name, text)
+    units = _units(name, data)
+    if isinstance(data, dict):
+        if "points" in data:
+            data = data["points"]
+        elif {"x", "y", "z"} <= data.keys() and arity != 2:
+            return _grid_table(name, data), 3, "JSON x, y, z table", units
+        elif {"x", "y"} <= data.keys() and "z" not in data and arity != 3:
+            xs, ys = data["x"], data["y"]
+            if not isinstance(xs, list) or not isinstance(ys, list) or len(xs) != len(ys):
+                raise InputError(f"{name}: \"x\" and \"y\" should be lists of the same length")
+            data = [[a, b] for a, b in zip(xs, ys)]
+        else:
+            keys = "\"x\", \"y\", \"z\"" if arity != 2 else "\"x\", \"y\""
+            raise InputError(f"{name}: expected a \"points\" list or {keys} keys, found keys {sorted(data)}")
+    if arity is None:
+        first = data[0] if isinstance(data, list) and data else None
+        arity = (3 if "z" in {str(k).lower() for k in first} else 2) if isinstance(first, dict) else (
+            len(first) if isinstance(first, list) and len(first) in (2, 3) else 3)
+    points = _point_list(name, data, arity)
+    objects = isinstance(data[0], dict)
+    layout = f"JSON list of {{{', '.join('xyz'[:arity])}}} objects" if objects else "JSON list of points"
+    return points, arity, layout, units
+
+
+def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None, snap=None) -> PointsFile:
+    """Read a points file of any accepted layout; say how it was read and what ``snap`` moved.
+
+    Parameters
+    ----------
+    path : str or path-like
+        JSON (see :func:`read_points`) or a table: comma-, semicolon-, tab- or
+        whitespace-separated, decimal points or commas, with or without a header.
+    what : {"surface", "curve", "any"}
+        What the file should hold; ``"any"`` tells a curve from a surface by its columns.
+    columns : str, optional
+        Which columns of a table are x, y (z): names of every column in order
+        (``"id,x,y,z"``) or 1-based numbers (``"2,3,4"``); see
+        :func:`lagsym.pointtable.parse_columns`.
+    snap : number or str, optional
+        Take node coordinates that differ by at most this as one node
+        (measured grids); see :func:`lagsym.grid.snap_points`.
+    """
+    choice(what, ("surface", "curve", "any"), "what")
+    arity = {"surface": 3, "curve": 2, "any": None}[what]
+    name, text = _read_bytes(path)
+    cols = parse_columns(columns, arity) if columns else None
+    if _kind(name, text) == "json":
+        if cols:
+            raise InputError(f"{name}: --columns is for tables (CSV, TSV, .xyz); a JSON file names its values")
+        points, arity, layout, units = _json_points(name, text, arity)
+        plain = True
+    else:
+        points, table = read_table(name, text, arity, cols)
+        arity, layout, units, plain = len(table.columns), table.describe(), table.units, table.plain
+    if isinstance(points, ControlGrid):
+        report = snap_points([], snap, source=name)[1] if snap is not None else None
+        return PointsFile(points, layout, plain, report)
+    report = None
+    if snap is not None:
+        points, report = snap_points(points, snap, axes=arity - 1, source=name)
+    build = grid_from_points if arity == 3 else curve_from_points
+    return PointsFile(build(points, source=name, units=units), layout, plain, report)
 
 
 def parse_points(text: str, source: str = "<points>", kind: str = "json") -> ControlGrid:
-    """Read surface control points from JSON or CSV text.
+    """Read surface control points from JSON or table text.
 
     Examples
     --------
@@ -241,15 +319,10 @@ def parse_points(text: str, source: str = "<points>", kind: str = "json") -> Con
     Fraction(37, 2)
     """
     if kind == "csv":
-        return grid_from_points(_csv_rows(source, text, 3), source=source)
-    data = _load_json(source, text)
-    if isinstance(data, dict):
-        if "points" in data:
-            return grid_from_points(_point_list(source, data["points"], 3), source=source)
-        if {"x", "y", "z"} <= data.keys():
-            return _grid_table(source, data)
-        raise InputError(f"{source}: expected a \"points\" list or \"x\", \"y\", \"z\" keys, found keys {sorted(data)}")
-    return grid_from_points(_point_list(source, data, 3), source=source)
+        points, table = read_table(source, text, 3)
+        return grid_from_points(points, source=source, units=table.units)
+    points, _, _, units = _json_points(source, text, 3)
+    return points if isinstance(points, ControlGrid) else grid_from_points(points, source=source, units=units)
 
 
 def _grid_table(name: str, data: dict) -> ControlGrid:
@@ -263,36 +336,32 @@ def _grid_table(name: str, data: dict) -> ControlGrid:
         if not isinstance(row, list):
             raise InputError(f"{name}: z[{i}] is {_short(row)}, not a list of heights")
         z.append([_value(v, f"{name}: z[{i}][{k}]") for k, v in enumerate(row)])
-    return grid_from_table(xs, ys, z, source=name)
+    return grid_from_table(xs, ys, z, source=name, units=_units(name, data))
 
 
 def parse_curve_points(text: str, source: str = "<points>", kind: str = "json") -> CurvePoints:
-    """Read 1-D curve points ``(x, y)`` from JSON or CSV text."""
+    """Read 1-D curve points ``(x, y)`` from JSON or table text."""
     if kind == "csv":
-        return curve_from_points(_csv_rows(source, text, 2), source=source)
-    data = _load_json(source, text)
-    if isinstance(data, dict):
-        if "points" in data:
-            data = data["points"]
-        elif {"x", "y"} <= data.keys() and "z" not in data:
-            xs, ys = data["x"], data["y"]
-            if not isinstance(xs, list) or not isinstance(ys, list) or len(xs) != len(ys):
-                raise InputError(f"{source}: \"x\" and \"y\" should be lists of the same length")
-            data = [[a, b] for a, b in zip(xs, ys)]
-        else:
-            raise InputError(f"{source}: expected a \"points\" list, found keys {sorted(data)}")
-    return curve_from_points(_point_list(source, data, 2), source=source)
+        points, table = read_table(source, text, 2)
+        return curve_from_points(points, source=source, units=table.units)
+    points, _, _, units = _json_points(source, text, 2)
+    return curve_from_points(points, source=source, units=units)
 
 
-def read_points(path: str | os.PathLike) -> ControlGrid:
-    """Read a surface's control points from a JSON or CSV file.
+def read_points(path: str | os.PathLike, columns=None, snap=None) -> ControlGrid:
+    """Read a surface's control points from a JSON file or a table.
 
     Parameters
     ----------
     path : str or path-like
-        A ``.json`` file (a list of ``[x, y, z]``, ``{"points": [...]}``, or
-        ``{"x": [...], "y": [...], "z": [[...]]}``) or a ``.csv`` file with
-        columns x,y,z (header optional).
+        A ``.json`` file (a list of ``[x, y, z]`` or of ``{"x": .., "y": ..,
+        "z": ..}`` objects, ``{"points": [...]}``, or ``{"x": [...], "y": [...],
+        "z": [[...]]}``, each with an optional ``"units"``: ``"mm"`` or
+        ``"inch"``), or a table (``.csv``, ``.tsv``, ``.txt``, ``.xyz``):
+        comma-, semicolon-, tab- or whitespace-separated, with or without a
+        header such as ``X (mm),Y (mm),Z (mm)``, decimal points or commas.
+    columns, snap
+        As for :func:`read_point_file`.
 
     Returns
     -------
@@ -304,41 +373,17 @@ def read_points(path: str | os.PathLike) -> ControlGrid:
     InputError
         With a one-line message naming the file and the bad value.
     """
-    name, text = _read_bytes(path)
-    return parse_points(text, source=name, kind=_kind(name, text))
+    return read_point_file(path, "surface", columns, snap).points
 
 
-def read_curve_points(path: str | os.PathLike) -> CurvePoints:
-    """Read a 1-D curve's points ``[[x, y], ...]`` from a JSON or CSV file."""
-    name, text = _read_bytes(path)
-    return parse_curve_points(text, source=name, kind=_kind(name, text))
+def read_curve_points(path: str | os.PathLike, columns=None, snap=None) -> CurvePoints:
+    """Read a 1-D curve's points ``[[x, y], ...]`` from a JSON file or a table (as :func:`read_points`)."""
+    return read_point_file(path, "curve", columns, snap).points
 
 
-def read_any_points(path: str | os.PathLike) -> ControlGrid | CurvePoints:
+def read_any_points(path: str | os.PathLike, columns=None, snap=None) -> ControlGrid | CurvePoints:
     """Read a points file that may hold a surface or a curve, telling them apart by arity."""
-    name, text = _read_bytes(path)
-    kind = _kind(name, text)
-    if _arity(name, text, kind) == 2:
-        return parse_curve_points(text, source=name, kind=kind)
-    return parse_points(text, source=name, kind=kind)
-
-
-def _arity(name: str, text: str, kind: str) -> int:
-    if kind == "csv":
-        for row in csv.reader(io.StringIO(text)):
-            cells = [c for c in row if c.strip()]
-            if cells and not cells[0].strip().startswith("#"):
-                return len(cells)
-        return 3
-    data = _load_json(name, text)
-    if isinstance(data, dict):
-        if "points" in data:
-            data = data["points"]
-        else:
-            return 3 if "z" in data else 2
-    if isinstance(data, list) and data and isinstance(data[0], list):
-        return len(data[0])
-    return 3
+    return read_point_file(path, "any", columns, snap).points
 
 
 def read_program(path: str | os.PathLike) -> str:
