@@ -25,8 +25,8 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .errors import InputError
-from .values import NotANumber, exact_number
+from ..errors import InputError
+from ..values import NotANumber, exact_number
 
 __all__ = ["Layout", "read_table", "parse_columns", "UNIT_NAMES"]
 

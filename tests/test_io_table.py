@@ -12,7 +12,7 @@ import pytest
 from lagsym import lagrange_surface, read_points
 from lagsym.errors import GridError, InputError
 from lagsym.io import read_point_file
-from lagsym.pointtable import parse_columns
+from lagsym.io.table import parse_columns
 
 POINTS = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
           (5, 2, 31), (5, 3, 34), (5, 4, 37.5)]

@@ -1,49 +1,26 @@
-"""Reading point files and writing results: every path lagsym touches passes here.
+"""Point files: JSON in several layouts and tables (CSV, TSV, ``.xyz``), read into exact control grids.
 
-Numbers in input files are exact: the JSON number text ``1.06`` is 53/50, never
-the nearest binary float, and strings may hold exact decimals or rationals
-(``"1/3"``).  Writers are atomic: a file appears complete or not at all.
+Numbers are exact: the JSON number text ``1.06`` is 53/50, never the nearest
+binary float, and strings may hold exact decimals or rationals (``"1/3"``).
 """
 
 from __future__ import annotations
 
-import contextlib
-import errno
 import json
 import os
-import re
-import shutil
-import stat
-import tempfile
-import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
-from .errors import InputError, OutputError
-from .grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
-from .pointtable import UNIT_NAMES, parse_columns, read_table
-from .values import MAX_EXPONENT, NotANumber, choice, exact_number
+from ..errors import InputError
+from ..grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
+from ..values import MAX_EXPONENT, NotANumber, choice, exact_number
+from .files import read_text
+from .table import UNIT_NAMES, parse_columns, read_table
 
-__all__ = [
-    "read_points",
-    "read_point_file",
-    "PointsFile",
-    "read_curve_points",
-    "read_any_points",
-    "read_program",
-    "event_log",
-    "parse_points",
-    "exact_number",
-    "atomic_path",
-    "atomic_write",
-    "write_text",
-]
-
-MAX_BYTES = 64 * 1024 * 1024
-
+__all__ = ["PointsFile", "read_point_file", "read_points", "read_curve_points", "read_any_points", "parse_points",
+           "parse_curve_points", "TABLE_SUFFIXES"]
 
 def _json_float(text: str) -> Fraction:
     try:
@@ -86,85 +63,6 @@ def _short(v: Any) -> str:
         text = type(v).__name__
     return text if len(text) <= 40 else text[:37] + "..."
 
-
-_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe (FIFO)"),
-          (stat.S_ISSOCK, "a socket"))
-STDIN_NAMES = ("-", "/dev/stdin")
-STDIN_SILENCE_S = 10.0  # standard input that sends nothing for this long is refused, not waited on forever
-
-
-def _raw(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
-    """The bytes of ``path`` (``-``: standard input), at most ``limit``; every failure is one InputError naming it.
-
-    Only a regular file or standard input is read: a device or a named pipe
-    could hand over endless bytes or none, so it is refused with a line that
-    says what it is.
-    """
-    name = str(path)
-    if name in STDIN_NAMES:
-        return _read_stdin(what, limit)
-    try:
-        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
-    except FileNotFoundError:
-        raise InputError(f"{name}: no such file") from None
-    except PermissionError:
-        raise InputError(f"{name}: permission denied") from None
-    except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, not {what}") from None
-    except OSError as e:
-        raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
-    info = os.fstat(fd)
-    refusal = f"{name}: is a directory, not {what}" if stat.S_ISDIR(info.st_mode) else next(
-        (f"{name}: is {kind}, not {what}; give a regular file, or '-' for standard input"
-         for test, kind in _KINDS if test(info.st_mode)), None)
-    if refusal:
-        os.close(fd)
-        raise InputError(refusal)
-    with os.fdopen(fd, "rb") as fh:
-        try:
-            if (size := info.st_size) > limit:
-                raise InputError(f"{name}: {size} bytes is too large for {what} (at most {limit} bytes)")
-            raw = fh.read(limit + 1)
-        except OSError as e:
-            raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
-    if len(raw) > limit:  # the file grew while it was read
-        raise InputError(f"{name}: more than {limit} bytes is too large for {what}")
-    return raw
-
-
-def _read_stdin(what: str, limit: int) -> bytes:
-    import select
-    import sys
-
-    stream = sys.stdin.buffer
-    chunks, total = [], 0
-    while True:
-        ready, _, _ = select.select([stream], [], [], STDIN_SILENCE_S)
-        if not ready:
-            raise InputError(f"standard input: nothing arrived for {STDIN_SILENCE_S:g} s; "
-                             f"pipe {what} in, or give a file name")
-        chunk = os.read(stream.fileno(), 1 << 16)
-        if not chunk:
-            return b"".join(chunks)
-        total += len(chunk)
-        if total > limit:
-            raise InputError(f"standard input: more than {limit} bytes is too large for {what}")
-        chunks.append(chunk)
-
-
-def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
-    name = str(path)
-    raw = _raw(path, "a points file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        hint = "" if b"\x00" in raw[:4096] else "; if it is text, save it as UTF-8 (Excel: 'CSV UTF-8')"
-        raise InputError(f"{name}: not a text file (byte 0x{raw[e.start]:02x} at offset {e.start}){hint}") from None
-    if "\x00" in text:
-        raise InputError(f"{name}: not a text file (NUL byte at offset {text.index(chr(0))})")
-    if not text.strip():
-        raise InputError(f"{name}: the file is empty")
-    return name, text
 
 
 TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".xyz", ".dat", ".asc")
@@ -283,14 +181,14 @@ def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None
     columns : str, optional
         Which columns of a table are x, y (z): names of every column in order
         (``"id,x,y,z"``) or 1-based numbers (``"2,3,4"``); see
-        :func:`lagsym.pointtable.parse_columns`.
+        :func:`lagsym.io.table.parse_columns`.
     snap : number or str, optional
         Take node coordinates that differ by at most this as one node
         (measured grids); see :func:`lagsym.grid.snap_points`.
     """
     choice(what, ("surface", "curve", "any"), "what")
     arity = {"surface": 3, "curve": 2, "any": None}[what]
-    name, text = _read_bytes(path)
+    name, text = read_text(path)
     cols = parse_columns(columns, arity) if columns else None
     if _kind(name, text) == "json":
         if cols:
@@ -384,144 +282,3 @@ def read_curve_points(path: str | os.PathLike, columns=None, snap=None) -> Curve
 def read_any_points(path: str | os.PathLike, columns=None, snap=None) -> ControlGrid | CurvePoints:
     """Read a points file that may hold a surface or a curve, telling them apart by arity."""
     return read_point_file(path, "any", columns, snap).points
-
-
-def read_program(path: str | os.PathLike) -> str:
-    """Read a part program as a control reads it: ASCII text, line endings kept as they are.
-
-    Raises
-    ------
-    InputError
-        For a missing or unreadable file, a directory, or a byte that is not ASCII.
-    """
-    name = str(path)
-    raw = _raw(path, "a program")
-    try:
-        return raw.decode("ascii")
-    except UnicodeDecodeError as e:
-        raise InputError(f"{name}: byte 0x{raw[e.start]:02x} at offset {e.start} is not ASCII; "
-                         f"a control reads ASCII programs") from None
-
-
-@contextlib.contextmanager
-def event_log(path: str | os.PathLike | None) -> Iterator:
-    """A function that appends a time-stamped line to the log file ``path``, or None without a path."""
-    if not path:
-        yield None
-        return
-    try:
-        fh = open(path, "a", encoding="utf-8")
-    except OSError as e:
-        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
-    with fh:
-        def log(message: str) -> None:
-            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
-            fh.flush()
-
-        yield log
-
-
-def _write_error(path, e: OSError) -> OutputError:
-    reason = (e.strerror or str(e)).lower()
-    if e.errno == errno.ENOSPC:
-        reason = "no space left on the device"
-    return OutputError(f"{path}: cannot write ({reason}); any earlier file there is untouched")
-
-
-def _is_stream(given: Path, real: Path) -> bool:
-    """A target written through rather than replaced: a device, pipe or socket, or a /dev or /proc name."""
-    if str(given).startswith(("/dev/", "/proc/")):
-        return True
-    try:
-        return not stat.S_ISREG(real.stat().st_mode)
-    except FileNotFoundError:
-        return False
-
-
-@contextlib.contextmanager
-def atomic_path(path: str | os.PathLike) -> Iterator[str]:
-    """Yield a temporary file name; once the block succeeds its content becomes ``path``'s.
-
-    For libraries that write a file by name (meshio, VTK) as much as for
-    :func:`atomic_write`.  How the content arrives depends on what ``path`` is:
-
-    - a regular file, or a new name: the temporary file sits beside it and
-      replaces it in one rename, keeping an existing file's permissions (a new
-      file gets ``0o666`` less the umask); a file with other hard links is
-      rewritten in place instead, so the links stay one file;
-    - a symbolic link: the same, for the file it points to (the link stays);
-    - a device, pipe or socket (``/dev/null``, ``/dev/stdout``, a FIFO): written
-      through, after the content is complete.
-
-    A failure part-way, a full disk included, leaves any earlier file
-    untouched and no partial file behind, and is one :class:`OutputError`.
-    """
-    given = Path(path)
-    real = Path(os.path.realpath(given))
-    if real.is_dir():
-        raise InputError(f"{path}: is a directory")
-    stream = _is_stream(given, real)
-    directory = Path(tempfile.gettempdir()) if stream else real.parent
-    if not directory.is_dir():
-        raise InputError(f"{path}: the folder {directory} does not exist")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".part" + real.suffix, dir=directory)
-    except OSError as e:
-        raise _write_error(path, e) from None
-    os.close(fd)
-    try:
-        yield tmp
-        if stream:
-            _copy_into(tmp, given)
-        else:
-            _commit(tmp, real)
-    except OSError as e:
-        raise _write_error(path, e) from None
-    finally:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-
-
-def _copy_into(tmp: str, target: Path) -> None:
-    with open(tmp, "rb") as src, open(target, "wb") as dst:
-        shutil.copyfileobj(src, dst, 1 << 20)
-
-
-def _commit(tmp: str, target: Path) -> None:
-    try:
-        old = target.stat()
-    except FileNotFoundError:
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, target)
-        return
-    if old.st_nlink > 1:
-        with open(tmp, "rb") as src, open(target, "r+b") as dst:
-            shutil.copyfileobj(src, dst, 1 << 20)
-            dst.truncate()
-            dst.flush()
-            os.fsync(dst.fileno())
-        return
-    os.chmod(tmp, stat.S_IMODE(old.st_mode))
-    os.replace(tmp, target)
-
-
-@contextlib.contextmanager
-def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None = None) -> Iterator[IO]:
-    """Open a temporary file whose content becomes ``path``'s only if the block succeeds (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp:
-        kwargs = {} if "b" in mode else {"encoding": "utf-8", "newline": newline}
-        try:
-            with open(tmp, mode, **kwargs) as fh:
-                yield fh
-                fh.flush()
-                os.fsync(fh.fileno())
-        except OSError as e:
-            raise _write_error(path, e) from None
-
-
-def write_text(path: str | os.PathLike, text: str, newline: str | None = "") -> None:
-    """Write ``text`` to ``path`` atomically (no newline translation by default)."""
-    with atomic_write(path, "w", newline=newline) as fh:
-        fh.write(text)
