@@ -3,7 +3,7 @@
 These are plain frozen values: nothing in lagsym keeps machine settings in
 module state.  Units are in the names (``feed_mm_min``, ``safe_z_mm``); lengths
 in surface units (the control points' units) are turned into millimetres by
-``scale``.
+the one :class:`Placement` (``mm_per_unit`` and ``origin_mm``).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class Placement:
     origin_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "mm_per_unit", positive(self.mm_per_unit, "millimetres per surface unit"))
+        object.__setattr__(self, "mm_per_unit", positive(self.mm_per_unit, "scale (millimetres per surface unit)"))
         if len(self.origin_mm) != 3:
             raise ToolpathError(f"origin {self.origin_mm!r} must be X,Y,Z")
         object.__setattr__(self, "origin_mm", tuple(finite(v, "origin") for v in self.origin_mm))
@@ -68,11 +68,13 @@ class Placement:
         zm = np.asarray(z) * s + oz
         return (*xy, zm.item() if zm.ndim == 0 else zm)
 
-    def to_surface(self, x_mm, y_mm):
-        """Machine millimetres to surface coordinates ``(x, y)``."""
-        s, (ox, oy, _) = self.mm_per_unit, self.origin_mm
-        x, y = (np.asarray(x_mm) - ox) / s, (np.asarray(y_mm) - oy) / s
-        return tuple(v.item() if v.ndim == 0 else v for v in (x, y))
+    def to_surface(self, x_mm, y_mm, z_mm=None):
+        """Machine millimetres to surface coordinates: ``(x, y)``, or ``(x, y, z)`` given ``z_mm``."""
+        s, (ox, oy, oz) = self.mm_per_unit, self.origin_mm
+        out = [(np.asarray(x_mm) - ox) / s, (np.asarray(y_mm) - oy) / s]
+        if z_mm is not None:
+            out.append((np.asarray(z_mm) - oz) / s)
+        return tuple(v.item() if v.ndim == 0 else v for v in out)
 
     def height_mm(self, z):
         """A surface height in machine millimetres (the origin's Z added)."""
@@ -122,16 +124,17 @@ class MachineSettings:
     dialect : str
         ``fanuc`` (also Haas and ISO-reading Bridgeport controls), ``linuxcnc``,
         ``heidenhain`` or ``grbl``.
-    scale : float
-        Millimetres per surface unit.
+    mm_per_unit : float
+        Millimetres per surface unit (the CLI's ``--scale``).
     origin_mm : tuple of float
-        Work offset added to every programmed point (X, Y, Z).
+        Work offset added to every programmed point (X, Y, Z); with
+        ``mm_per_unit`` it is the :attr:`placement`.
     units : str
         ``mm`` (G21) or ``inch`` (G20) in the program; internal values stay in mm.
     """
 
     dialect: str = "fanuc"
-    scale: float = 1.0
+    mm_per_unit: float = 1.0
     origin_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     units: str = "mm"
     feed_mm_min: float = 600.0
@@ -149,18 +152,22 @@ class MachineSettings:
         choice(self.dialect, DIALECTS, "dialect")
         choice(self.units, UNITS, "units")
         choice(self.line_ending, tuple(LINE_ENDINGS), "line ending")
-        positive(self.scale, "scale")
         positive(self.feed_mm_min, "feed")
         positive(self.plunge_feed_mm_min, "plunge feed")
         positive(self.spindle_rpm, "spindle speed", allow_zero=True)
         positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
-        if len(self.origin_mm) != 3:
-            raise ToolpathError(f"origin {self.origin_mm!r} must be X,Y,Z")
-        object.__setattr__(self, "origin_mm", tuple(float(v) for v in self.origin_mm))
+        place = Placement(self.mm_per_unit, self.origin_mm)  # checks both, once
+        object.__setattr__(self, "mm_per_unit", place.mm_per_unit)
+        object.__setattr__(self, "origin_mm", place.origin_mm)
         if not (1 <= int(self.program_number) <= 9999):
             raise ToolpathError(f"program number {self.program_number} must be 1 to 9999")
         if self.decimals is not None and not (0 <= self.decimals <= 6):
             raise ToolpathError(f"decimals {self.decimals} must be 0 to 6")
+
+    @property
+    def placement(self) -> Placement:
+        """Where the surface sits on this machine."""
+        return Placement(self.mm_per_unit, self.origin_mm)
 
     @property
     def eol(self) -> str:

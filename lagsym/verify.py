@@ -33,7 +33,7 @@ from ._arrays import freeze_fields
 from .errors import ToolpathError
 from .evaluate import evaluate_grid
 from .gcode import Moves
-from .machine import Tool
+from .machine import Placement, Tool
 
 __all__ = ["CutReport", "simulate_cut"]
 
@@ -121,7 +121,7 @@ def _samples(a: np.ndarray, b: np.ndarray, ds: float, dz: float) -> np.ndarray:
     return np.vstack([pts, b[-1:]])
 
 
-def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_mm=(0.0, 0.0, 0.0),
+def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Placement(),
                  cell_mm: float | None = None, dz_mm: float = 0.01, program_resolution_mm: float = 0.0005,
                  gouge_limit_mm: float | None = None) -> CutReport:
     """Simulate the moves with the tool on a height map over the surface's box and compare with the surface.
@@ -129,7 +129,9 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
     Parameters
     ----------
     surface : LagrangeSurface
-        The exact surface; ``scale`` and ``origin_mm`` place it on the machine.
+        The exact surface.
+    placement : Placement
+        Where it sits on the machine (``MachineSettings.placement``).
     moves : Moves
         The program's moves (:func:`lagsym.gcode.parse_moves`).
     tool : Tool
@@ -144,9 +146,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
         Depth from which a cut counts as a gouge; by default the program
         resolution plus the simulation's.
     """
-    ox, oy, oz = (float(v) for v in origin_mm)
-    x0, x1, y0, y1 = (float(v) * scale for v in surface.grid.bounds)
-    x0, x1, y0, y1 = x0 + ox, x1 + ox, y0 + oy, y1 + oy
+    x0, x1, y0, y1 = placement.box_mm(surface.grid.bounds)
     if cell_mm is None:
         cell_mm = max(x1 - x0, y1 - y0) / 400.0
     if not cell_mm > 0:
@@ -155,7 +155,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
     ny = max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
     xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
-    surf = evaluate_grid(surface, (xs - ox) / scale, (ys - oy) / scale) * scale + oz
+    sx, sy = placement.to_surface(xs, ys)
+    surf = placement.height_mm(evaluate_grid(surface, sx, sy))
     ball = tool.shape == "ball" and tool.radius_mm > 0
     r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
     ds = 0.5 * min(hx, hy)

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.toolpath import drop_cutter, plan_toolpath
 
 from conftest import EXAMPLES
@@ -17,7 +17,7 @@ from cutters import surfaces
 
 
 def plan(surf, tool=Tool("ball", 6.0), raster=RasterSpec("x", 2.0, 1.0), **kw):
-    settings = MachineSettings(scale=kw.pop("scale", 20.0), **kw)
+    settings = MachineSettings(mm_per_unit=kw.pop("scale", 20.0), **kw)
     return plan_toolpath(surf, tool, raster, settings)
 
 
@@ -80,8 +80,8 @@ def test_example1_program_does_not_gouge_at_the_corner(example1_corner):
     from lagsym.verify import simulate_cut
 
     surf, tp = example1_corner
-    s = MachineSettings(dialect="linuxcnc", scale=10.0, safe_z_mm=400.0)
-    report = simulate_cut(surf, parse_moves(write_program(point_program(tp, s))), tp.tool, scale=10.0, cell_mm=0.25)
+    s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=400.0)
+    report = simulate_cut(surf, parse_moves(write_program(point_program(tp, s))), tp.tool, Placement(10.0), cell_mm=0.25)
     assert not report.gouges, report.summary()
     assert report.gouge_mm <= report.gouge_limit_mm
 

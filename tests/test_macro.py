@@ -56,10 +56,10 @@ def rough_grid(n: int, seed: int = 0, span: int = 60, zmax: int = 50):
 
 
 CASES = [
-    ("paper-example-1", dict(scale=5.0), RasterSpec("x", 1.5, 0.7)),
-    ("paper-example-2", dict(scale=2.0, origin_mm=(-10.0, 5.0, -3.0)), RasterSpec("y", 2.5, 1.1)),
-    ("paper-example-3", dict(scale=7.5), RasterSpec("x", 3.0, 1.3)),
-    ("paper-example-4", dict(scale=20.0, origin_mm=(1.5, -2.25, 10.0)), RasterSpec("y", 5.0, 2.0)),
+    ("paper-example-1", dict(mm_per_unit=5.0), RasterSpec("x", 1.5, 0.7)),
+    ("paper-example-2", dict(mm_per_unit=2.0, origin_mm=(-10.0, 5.0, -3.0)), RasterSpec("y", 2.5, 1.1)),
+    ("paper-example-3", dict(mm_per_unit=7.5), RasterSpec("x", 3.0, 1.3)),
+    ("paper-example-4", dict(mm_per_unit=20.0, origin_mm=(1.5, -2.25, 10.0)), RasterSpec("y", 5.0, 2.0)),
 ]
 
 
@@ -127,7 +127,7 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
                                                                          direction, dialect):
     x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
     raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
-    settings = machine(dialect=dialect, scale=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=1e6)
+    settings = machine(dialect=dialect, mm_per_unit=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=1e6)
     program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
     if dialect == "linuxcnc":
         path = tmp_path_factory.mktemp("any") / "any.ngc"
@@ -200,7 +200,7 @@ def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
 
 def test_stats_compare_with_the_point_list():
     s = surface("paper-example-4")
-    settings = machine(dialect="fanuc", scale=20.0)
+    settings = machine(dialect="fanuc", mm_per_unit=20.0)
     raster = RasterSpec("x", 0.5, 0.2)
     program = macro_program(s, settings, raster, FLAT)
     pts = planned_points(s, settings, raster, FLAT)
@@ -216,7 +216,7 @@ def test_stats_from_a_sample_are_close_to_the_full_count():
     from lagsym.macro import points_at, sample_positions
 
     s = surface("paper-example-4")
-    settings = machine(dialect="fanuc", scale=20.0)
+    settings = machine(dialect="fanuc", mm_per_unit=20.0)
     raster = RasterSpec("x", 0.5, 0.2)
     program = macro_program(s, settings, raster, FLAT)
     full = program_stats(program, planned_points(s, settings, raster, FLAT), settings)
@@ -239,7 +239,7 @@ def test_point_list_size_counts_what_fixed_would_write():
 
 def test_raster_is_counted_and_clamped_to_the_box():
     s = surface("paper-example-1")  # x 1..5, y 2..4
-    counted = macro_raster(s, machine(scale=10.0), RasterSpec("x", 7.0, 3.0))
+    counted = macro_raster(s, machine(mm_per_unit=10.0), RasterSpec("x", 7.0, 3.0))
     assert (counted.points.count, counted.rows.count) == (14, 3)  # 40 mm / 3 -> 14 steps, 20 mm / 7 -> 3
     assert counted.points.clamped and counted.rows.clamped
     x, y = raster_positions(counted)
@@ -249,7 +249,7 @@ def test_raster_is_counted_and_clamped_to_the_box():
 
 def test_no_drift_over_many_points(rs274, tmp_path):
     s = surface("paper-example-1")
-    settings = machine(dialect="linuxcnc", scale=10.0)
+    settings = machine(dialect="linuxcnc", mm_per_unit=10.0)
     raster = RasterSpec("x", 10.0, 0.1)  # 400 points a row
     path = tmp_path / "fine.ngc"
     path.write_text(macro_program(s, settings, raster, FLAT).text)
@@ -261,7 +261,7 @@ def test_no_drift_over_many_points(rs274, tmp_path):
 
 def test_row_form_is_exact():
     s = surface("paper-example-3")
-    settings = machine(scale=3.0, origin_mm=(1.0, 2.0, 3.0))
+    settings = machine(mm_per_unit=3.0, origin_mm=(1.0, 2.0, 3.0))
     for direction in ("x", "y"):
         f = row_form(s, settings, direction)
         for xi, yk, z in s.grid.points()[::3]:
@@ -330,7 +330,7 @@ def test_heidenhain_program_shape():
 
 def test_safe_z_below_the_path_is_refused():
     with pytest.raises(ToolpathError, match=r"safe Z 50 mm is not above the highest point of the path, 71.38\d mm"):
-        macro_program(surface("paper-example-4"), MachineSettings(scale=20.0), RasterSpec("x", 5.0, 5.0), FLAT)
+        macro_program(surface("paper-example-4"), MachineSettings(mm_per_unit=20.0), RasterSpec("x", 5.0, 5.0), FLAT)
 
 
 def test_program_is_immutable_and_uses_line_ending():
@@ -343,7 +343,7 @@ def test_program_is_immutable_and_uses_line_ending():
 
 def test_inch_programs_are_in_inches():
     s = surface("paper-example-1")
-    settings = machine(dialect="linuxcnc", units="inch", scale=25.4)
+    settings = machine(dialect="linuxcnc", units="inch", mm_per_unit=25.4)
     raster = RasterSpec("x", 12.7, 6.35)
     program = macro_program(s, settings, raster, FLAT)
     assert "G20" in program.text
@@ -420,7 +420,7 @@ BALL = Tool("ball", 4.0)
 @pytest.mark.parametrize("direction", ["x", "y"])
 def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, direction):
     s = surface("paper-example-4")
-    settings = machine(dialect="linuxcnc", scale=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
+    settings = machine(dialect="linuxcnc", mm_per_unit=20.0, stock_to_leave_mm=0.2, origin_mm=(1.0, 2.0, 3.0))
     raster = RasterSpec(direction, 5.0, 2.0)
     path = tmp_path / "ball.ngc"
     path.write_text(macro_program(s, settings, raster, BALL).text)
@@ -433,7 +433,7 @@ def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, dire
 @pytest.mark.parametrize("dialect", ["fanuc", "heidenhain"])
 def test_ball_end_macro_through_the_simulator(dialect, form):
     s = surface("paper-example-3")
-    settings = machine(dialect=dialect, scale=25.0)
+    settings = machine(dialect=dialect, mm_per_unit=25.0)
     raster = RasterSpec("y", 12.0, 5.0)
     program = macro_program(s, settings, raster, BALL, form=form)
     got = simulate(program.text, dialect, 8).feed_points()[1:]
@@ -460,7 +460,7 @@ def test_cli_simulate_missing_file(run_cli, tmp_path):
 
 def test_ball_end_tip_is_one_radius_off_the_surface():
     s = surface("paper-example-4")
-    settings = machine(scale=20.0)
+    settings = machine(mm_per_unit=20.0)
     tips = planned_points(s, settings, RasterSpec("x", 10.0, 4.0), BALL)
     centres = tips + [0.0, 0.0, 2.0]
     xs = np.linspace(20.0, 100.0, 401)
@@ -479,7 +479,7 @@ def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
     from lagsym.lagrange import X, Y
 
     s = surface("paper-example-3")
-    loops = macro_loops(s, machine(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
+    loops = macro_loops(s, machine(mm_per_unit=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
     ctx = decimal_context(30)
     env = run(loops.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
     env["p"] = ctx.create_decimal("1.75")
@@ -494,7 +494,7 @@ def test_ball_end_gouge_is_refused_with_a_suggestion():
     s = surface("paper-example-4")
     expected = r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"
     with pytest.raises(ToolpathError, match=expected):
-        macro_program(s, machine(dialect="fanuc", scale=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
+        macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
 
 
 def test_flat_tool_and_zero_diameter_program_the_surface():

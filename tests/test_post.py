@@ -28,11 +28,11 @@ NUMBER_WORD = re.compile(r"([XYZF])(-?[0-9.]+)")
 @pytest.fixture(scope="module")
 def path4():
     surf = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
-    return plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), MachineSettings(scale=20.0))
+    return plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), MachineSettings(mm_per_unit=20.0))
 
 
 def program_text(tp, **kw):
-    s = MachineSettings(**{"safe_z_mm": 80.0, "scale": 20.0, **kw})
+    s = MachineSettings(**{"safe_z_mm": 80.0, "mm_per_unit": 20.0, **kw})
     return write_program(point_program(tp, s, title="Paper example 4")), s
 
 
@@ -120,7 +120,7 @@ def small_surfaces(draw):
 @given(small_surfaces(), st.sampled_from(POINT_DIALECTS), st.sampled_from(["mm", "inch"]),
        st.floats(0.0, 12.0), st.sampled_from(["ball", "flat"]), st.floats(-50.0, 50.0), st.integers(1, 9999))
 def test_every_emitted_program_passes_rs274(rs274, surf, dialect, units, diameter, shape, oz, number):
-    s = MachineSettings(dialect=dialect, units=units, scale=10.0, origin_mm=(1.5, -2.25, oz), safe_z_mm=200.0,
+    s = MachineSettings(dialect=dialect, units=units, mm_per_unit=10.0, origin_mm=(1.5, -2.25, oz), safe_z_mm=200.0,
                         program_number=number)
     tp = plan_toolpath(surf, Tool(shape, diameter), RasterSpec("y", 4.0, None, None, 0.05), s)
     text = write_program(point_program(tp, s, title="hypothesis"))

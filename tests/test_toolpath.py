@@ -27,7 +27,7 @@ def example4():
 
 
 def plan(surf, tool=Tool("ball", 6.0), raster=RasterSpec("x", 2.0, 1.0), **kw):
-    settings = MachineSettings(scale=kw.pop("scale", 20.0), **kw)
+    settings = MachineSettings(mm_per_unit=kw.pop("scale", 20.0), **kw)
     return plan_toolpath(surf, tool, raster, settings)
 
 

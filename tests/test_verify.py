@@ -12,7 +12,7 @@ from lagsym.gcode import parse_moves
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.post.program import PointProgram, point_program, write_program
 from lagsym.toolpath import plan_toolpath
 from lagsym.verify import simulate_cut
@@ -32,14 +32,14 @@ def valley():
 @pytest.fixture(scope="module")
 def ex2_program():
     surf = lagrange_surface(read_points(EX2))
-    s = MachineSettings(dialect="linuxcnc", scale=10.0, safe_z_mm=60.0)
+    s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0)
     tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s)
     return surf, tp, s, write_program(point_program(tp, s))
 
 
 def test_lagsyms_program_does_not_gouge(ex2_program):
     surf, tp, _, text = ex2_program
-    report = simulate_cut(surf, parse_moves(text), tp.tool, scale=10.0, cell_mm=0.25)
+    report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.25)
     assert not report.gouges
     assert report.gouge_mm <= 1e-4
     assert report.unreached_mm2 == 0.0
@@ -54,7 +54,7 @@ def test_a_lowered_point_is_found(ex2_program):
     k = len(p) // 2
     p[k, 2] -= 0.3
     moves = parse_moves(write_program(PointProgram(p, s)))
-    report = simulate_cut(surf, moves, tp.tool, scale=10.0, cell_mm=0.25)
+    report = simulate_cut(surf, moves, tp.tool, Placement(10.0), cell_mm=0.25)
     assert report.gouges
     assert 0.2 <= report.gouge_mm <= 0.3 + 1e-9
     assert np.hypot(report.gouge_at[0] - p[k, 0], report.gouge_at[1] - p[k, 1]) <= 3.0
@@ -75,19 +75,19 @@ def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
     centre = np.stack([x * scale, y * scale, z * scale]) + r * n
     offset = np.stack([centre[0], centre[1], centre[2] - r], axis=1)
     inside = (offset[:, 0] >= 0) & (offset[:, 0] <= 40.0)
-    s = MachineSettings(scale=scale, safe_z_mm=200.0)
+    s = MachineSettings(mm_per_unit=scale, safe_z_mm=200.0)
     bad = parse_moves(write_program(PointProgram(offset[inside], s)))
     tool = Tool("ball", 2 * r)
-    assert simulate_cut(surf, bad, tool, scale=scale, cell_mm=0.25).gouge_mm > 1.0
+    assert simulate_cut(surf, bad, tool, Placement(scale), cell_mm=0.25).gouge_mm > 1.0
     tp = plan_toolpath(surf, tool, RasterSpec("x", 20.0, 0.25), s)
     good = parse_moves(write_program(point_program(tp, s)))
-    assert not simulate_cut(surf, good, tool, scale=scale, cell_mm=0.25).gouges
+    assert not simulate_cut(surf, good, tool, Placement(scale), cell_mm=0.25).gouges
 
 
 def test_moves_before_the_first_z_do_not_cut():
     surf = lagrange_surface(read_points(EX2))
     moves = parse_moves("G00 X10. Y10.\nG00 Z30.\nG01 X40. Y40. F100.\n")
-    report = simulate_cut(surf, moves, Tool("ball", 6.0), scale=10.0, cell_mm=0.5)
+    report = simulate_cut(surf, moves, Tool("ball", 6.0), Placement(10.0), cell_mm=0.5)
     assert report.gouge_mm == 0.0 and report.unreached_mm2 > 0.0
 
 

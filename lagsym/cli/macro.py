@@ -75,7 +75,7 @@ def add_arguments(p) -> None:
 def settings_from(args) -> tuple[MachineSettings, RasterSpec, Tool]:
     """The machine, raster and tool the arguments describe."""
     settings = MachineSettings(
-        dialect=args.dialect, scale=args.scale, origin_mm=origin(args.origin), units=args.units,
+        dialect=args.dialect, mm_per_unit=args.scale, origin_mm=origin(args.origin), units=args.units,
         feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
         safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock, program_number=args.program,
         work_offset=args.work_offset, line_ending=args.line_ending, decimals=args.decimals,

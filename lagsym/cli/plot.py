@@ -133,11 +133,13 @@ def _toolpath_figure(plot, grid, program, args, opts):
 
     from ..gcode import move_points
     from ..io import read_program
+    from ..machine import Placement
     from ._common import origin
 
     points_mm, rapid = move_points(read_program(program), source=program)
     if not len(points_mm):
         raise InputError(f"{program}: no move with a Z position to draw")
-    tips = (points_mm - np.array(origin(args.origin))) / args.scale  # machine mm to surface units
+    place = Placement(args.scale, origin(args.origin))
+    tips = np.column_stack(place.to_surface(*points_mm.T))  # machine mm to surface units
     ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
     return plot.toolpath_figure(lagrange_surface(grid), tips, rapid=ends_rapid, **opts)

@@ -63,7 +63,7 @@ def add_arguments(p) -> None:
 def settings_from(args, dialect: str) -> MachineSettings:
     """The machine settings the arguments describe."""
     return MachineSettings(
-        dialect=dialect, scale=args.scale, origin_mm=origin(args.origin), units=args.units,
+        dialect=dialect, mm_per_unit=args.scale, origin_mm=origin(args.origin), units=args.units,
         feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
         safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock_to_leave, program_number=args.program,
         line_ending=args.line_ending, decimals=args.decimals, tool_number=args.tool_number)

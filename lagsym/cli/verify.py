@@ -6,7 +6,7 @@ from ..errors import ExitStatus, InputError
 from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
-from ..machine import TOOL_SHAPES, Tool
+from ..machine import TOOL_SHAPES, Placement, Tool
 from ._common import origin
 
 NAME = "verify"
@@ -42,12 +42,10 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     from ..verify import simulate_cut
 
-    if not args.scale > 0:
-        raise InputError(f"--scale {args.scale!r} must be a positive number")
+    place = Placement(args.scale, origin(args.origin))
     surface = lagrange_surface(read_points(args.surface))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
-    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), scale=args.scale,
-                          origin_mm=origin(args.origin), cell_mm=args.cell, gouge_limit_mm=args.gouge_limit)
+    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), place, cell_mm=args.cell, gouge_limit_mm=args.gouge_limit)
     out.write("\n".join(report.summary()) + "\n")
     return ExitStatus.WARNING if report.gouges else ExitStatus.OK

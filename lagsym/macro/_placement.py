@@ -12,20 +12,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from ..machine import MachineSettings
+from ..machine import MachineSettings, program_units_per_mm
 from ..values import as_exact
 
-__all__ = ["Placement", "placement"]
+__all__ = ["ProgramPlacement", "placement"]
 
 
 @dataclass(frozen=True)
-class Placement:
-    """The surface's placement in program units, exact.
+class ProgramPlacement:
+    """The machine's :class:`~lagsym.machine.Placement` in program units, exact, with the stock to leave.
 
     Attributes
     ----------
     per_mm : Fraction
-        Program units per millimetre (1, or 1/25.4 as the float prints it).
+        Program units per millimetre (1, or exactly 5/127 for inches).
     scale : Fraction
         Program units per surface unit.
     origin : tuple of Fraction
@@ -40,16 +40,16 @@ class Placement:
     stock: Fraction
 
 
-def placement(settings: MachineSettings) -> Placement:
+def placement(settings: MachineSettings) -> ProgramPlacement:
     """The placement ``settings`` describe.
 
     Examples
     --------
-    >>> p = placement(MachineSettings(scale=2.5, origin_mm=(1.0, 0.0, -0.1)))
+    >>> p = placement(MachineSettings(mm_per_unit=2.5, origin_mm=(1.0, 0.0, -0.1)))
     >>> p.scale, p.origin[2]
     (Fraction(5, 2), Fraction(-1, 10))
     """
-    per_mm = as_exact(settings.unit_factor, "program units per mm")
-    origin = tuple(as_exact(v, "origin") * per_mm for v in settings.origin_mm)
-    return Placement(per_mm=per_mm, scale=as_exact(settings.scale, "scale") * per_mm, origin=origin,
-                     stock=as_exact(settings.stock_to_leave_mm, "stock to leave") * per_mm)
+    per_mm = program_units_per_mm(settings.units)
+    scale, origin = settings.placement.exact(settings.units)
+    return ProgramPlacement(per_mm=per_mm, scale=scale, origin=origin,
+                            stock=as_exact(settings.stock_to_leave_mm, "stock to leave") * per_mm)

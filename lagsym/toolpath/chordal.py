@@ -51,11 +51,11 @@ _CHECK_ZOOM = 6  # rounds of local refinement around the worst sample
 _CHECK_SPLITS = 40  # at most this many rounds of splitting
 
 
-def tolerance_step(ev: SurfaceEvaluator, tol: float, scale: float) -> float:
+def tolerance_step(ev: SurfaceEvaluator, tol: float, mm_per_unit: float) -> float:
     """A sampling step whose own chordal error on the surface is a quarter of ``tol`` (mm)."""
-    kappa = ev.curvature_bound() / scale  # 1/mm
+    kappa = ev.curvature_bound() / mm_per_unit  # 1/mm
     x0, x1, y0, y1 = ev.bounds
-    longest = max(x1 - x0, y1 - y0) * scale
+    longest = max(x1 - x0, y1 - y0) * mm_per_unit
     if kappa <= 0:
         return longest / 4
     return float(min(math.sqrt(2.0 * tol / kappa), longest / 4))

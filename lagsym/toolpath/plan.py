@@ -79,7 +79,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     Parameters
     ----------
     surface : LagrangeSurface
-        The exact surface; lengths in its units become mm by ``settings.scale``.
+        The exact surface; lengths in its units become mm by ``settings.mm_per_unit``.
     tool : Tool
         Cutter shape and diameter (mm).
     raster : RasterSpec
@@ -98,23 +98,23 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     >>> from lagsym.grid import grid_from_points
     >>> from lagsym.lagrange import lagrange_surface
     >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 1, 1), (1, 0, 1), (1, 1, 1)]))
-    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(scale=1.0))
+    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(mm_per_unit=1.0))
     >>> tp.points_mm[:, :2].tolist()  # zig-zag: along x, up the edge, back
     [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5], [0.0, 1.0], [0.5, 1.0], [1.0, 1.0]]
     >>> bool((tp.points_mm[:, 2] == 1.0).all()), tp.rows.tolist()
     (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
     """
     ev = evaluator or surface_evaluator(surface)
-    scale = settings.scale
+    mm_per_unit = settings.mm_per_unit
     tol = raster.tolerance_mm
     stepover = _side_step(tool, raster)
-    step, fine = _forward_steps(raster, ev, scale)
-    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / scale, fine / scale)
+    step, fine = _forward_steps(raster, ev, mm_per_unit)
+    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
     if tol is None:
-        along = _fixed_step_samples(along, step / scale)
+        along = _fixed_step_samples(along, step / mm_per_unit)
     cl = _Cutter.of(surface, ev, tool, settings)
     path = _fine_path(cl, levels, along, raster.direction, fine)
-    kappa = ev.curvature_bound() / scale
+    kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)))
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
@@ -129,20 +129,21 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         exact_mm=_place(settings, vx, vy, vz)[2],
         tool=tool,
         raster=raster,
-        stepover_mm=float((levels[1] - levels[0]) * scale) if len(levels) > 1 else float(stepover),
+        stepover_mm=float((levels[1] - levels[0]) * mm_per_unit) if len(levels) > 1 else float(stepover),
         step_mm=float(step),
         bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
     )
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
-    """Surface positions ``x, y`` (surface units) and tip heights ``z_mm`` (mm) on the machine: scale and work offset.
+    """Surface positions ``x, y`` (surface units) and tip heights ``z_mm`` (mm) on the machine.
 
     The heights are already in mm because the chordal tolerances apply to
     them; only the work offset is added.
     """
-    ox, oy, oz = settings.origin_mm
-    return np.asarray(x) * settings.scale + ox, np.asarray(y) * settings.scale + oy, np.asarray(z_mm) + oz
+    place = settings.placement
+    x_mm, y_mm = place.to_machine(x, y)
+    return x_mm, y_mm, np.asarray(z_mm) + place.origin_mm[2]
 
 
 def _side_step(tool: Tool, raster: RasterSpec) -> float:
@@ -154,7 +155,7 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
     return scallop_stepover(tool.radius_mm, raster.scallop_mm)
 
 
-def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, scale: float) -> tuple[float, float]:
+def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float) -> tuple[float, float]:
     """The forward step (mm) and the finer sampling step it is checked at (mm).
 
     A fixed step is sampled four times finer; a chordal tolerance chooses a
@@ -162,10 +163,10 @@ def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, scale: float) -> tu
     """
     tol = raster.tolerance_mm
     if raster.step_mm is None:
-        fine = chordal.tolerance_step(ev, tol, scale)
+        fine = chordal.tolerance_step(ev, tol, mm_per_unit)
         return fine, fine
     step = raster.step_mm
-    return step, step / 4.0 if tol is None else min(step, chordal.tolerance_step(ev, tol, scale))
+    return step, step / 4.0 if tol is None else min(step, chordal.tolerance_step(ev, tol, mm_per_unit))
 
 
 _EMIT_EVERY = 2  # with a fixed forward step, a fine sample halfway along each move measures its sag
@@ -190,18 +191,18 @@ class _Cutter:
     radius: float
     shape: str
     lift_tip: float
-    scale: float
+    mm_per_unit: float
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
-        r_mm, stock, scale = tool.radius_mm, settings.stock_to_leave_mm, settings.scale
-        r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / scale
-        lift_tip = r - r_mm / scale if tool.shape == "ball" else stock / scale
-        return cls(surface, ev, r, tool.shape, lift_tip, scale)
+        r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
+        r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / mm_per_unit
+        lift_tip = r - r_mm / mm_per_unit if tool.shape == "ball" else stock / mm_per_unit
+        return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit)
 
     def __call__(self, x, y, **search) -> np.ndarray:
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
-        return (z + self.lift_tip) * self.scale
+        return (z + self.lift_tip) * self.mm_per_unit
 
 
 @dataclass(frozen=True)
@@ -227,7 +228,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
     a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
     z_rows = cl(*((a_grid, l_grid) if direction == "x" else (l_grid, a_grid)))
     gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
-    link_n = max(2, 2 * int(math.ceil(gap * cl.scale / fine / 2)))
+    link_n = max(2, 2 * int(math.ceil(gap * cl.mm_per_unit / fine / 2)))
     u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
     ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
     link_a = np.repeat(ends, len(u))
@@ -255,7 +256,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
         count = row_end + len(u) + 1 if i + 1 < len(levels) else row_end + 1
     fa, fl, fz, frow = (np.concatenate(v) for v in (fa, fl, fz, frow))
     fx, fy = (fa, fl) if direction == "x" else (fl, fa)
-    s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.scale
+    s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
 
