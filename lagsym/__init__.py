@@ -37,9 +37,8 @@ _EXPORTS = {
     "post.program": ("PointProgram", "point_program", "write_program"),
     "macro": ("MacroProgram", "macro_program", "planned_points", "predicted_error", "program_stats"),
     "simulate": ("ControlAlarm", "Simulation", "simulate"),
-    "dncplan": ("Program", "parse_program", "resume_setup"),
-    "dnc": ("PROFILES", "LineSettings", "profile", "LineFault", "TransferProgress", "TransferResult",
-            "plan_transfer", "send_program", "receive_program"),
+    "dnc": ("Program", "parse_program", "resume_setup", "PROFILES", "LineSettings", "profile", "LineFault",
+            "TransferProgress", "TransferResult", "transfer_segments", "send_program", "receive_program"),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
@@ -61,9 +60,8 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly
     from .compare import Comparison, DeviationMeasures, compare_surfaces, deviation_measures, render_table
-    from .dnc import (PROFILES, LineFault, LineSettings, TransferProgress, TransferResult, plan_transfer, profile,
-                      receive_program, send_program)
-    from .dncplan import Program, parse_program, resume_setup
+    from .dnc import (PROFILES, LineFault, LineSettings, Program, TransferProgress, TransferResult, parse_program,
+                      profile, receive_program, resume_setup, send_program, transfer_segments)
     from .errors import (ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
     from .evaluate import (SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,

@@ -26,6 +26,19 @@ DIRECTIONS = ("x", "y")
 MM_PER_INCH = Fraction(254, 10)
 
 
+def bits_per_char(bytesize: int, parity: str, stopbits: float) -> float:
+    """Bits on a serial line for one character: start bit, data bits, parity bit (unless ``none``), stop bits.
+
+    The one figure behind every transfer time (DNC transfers and program statistics).
+
+    Examples
+    --------
+    >>> bits_per_char(7, "even", 2)
+    11.0
+    """
+    return 1 + bytesize + (0 if parity == "none" else 1) + float(stopbits)
+
+
 def program_units_per_mm(units: str) -> Fraction:
     """Program units per millimetre: 1 for ``mm``, 1/25.4 for ``inch`` (exact)."""
     return Fraction(1) if choice(units, UNITS, "units") == "mm" else 1 / MM_PER_INCH

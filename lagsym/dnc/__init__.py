@@ -45,5 +45,3 @@ __all__ = [
     "send_program",
     "receive_program",
 ]
-
-plan_transfer = transfer_segments  # the former name of transfer_segments

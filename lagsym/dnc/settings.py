@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import InputError
-from ..machine import LINE_ENDINGS
+from ..machine import LINE_ENDINGS, bits_per_char
 from ..values import choice, positive
 from .blocks import DC1, DC2, DC3, DC4
 
@@ -112,7 +112,7 @@ class LineSettings:
         >>> LineSettings(bytesize=7, parity="even", stopbits=2).bits_per_char
         11.0
         """
-        return 1 + self.bytesize + (0 if self.parity == "none" else 1) + self.stopbits
+        return bits_per_char(self.bytesize, self.parity, self.stopbits)
 
     @property
     def chars_per_s(self) -> float:

@@ -15,9 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..machine import bits_per_char
+
 __all__ = ["ProgramStats", "point_list_size", "transfer_seconds", "program_stats", "frame_bytes", "BITS_PER_CHAR_7E2"]
 
-BITS_PER_CHAR_7E2 = 11  # start bit, 7 data bits, even parity, 2 stop bits
+BITS_PER_CHAR_7E2 = bits_per_char(7, "even", 2)  # start bit, 7 data bits, even parity, 2 stop bits
 
 
 def transfer_seconds(size_bytes: int, baud: int = 9600, bits_per_char: int = BITS_PER_CHAR_7E2) -> float:
