@@ -1,0 +1,58 @@
+"""What the STEP and IGES writers share: numbers as text, units, the faces of a solid.
+
+Exact coordinates become the nearest binary double (``float(Fraction)`` rounds
+correctly) written with the 17 significant digits that read back to the same
+double; CAD kernels store doubles, so this is as exact as the files can be.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from ..errors import InputError
+
+__all__ = ["UNITS", "check_units", "real", "multiplicities"]
+
+UNITS = ("mm", "inch")
+
+
+def check_units(units: str) -> str:
+    """``units`` if it is one lagsym can write, else an InputError naming the choices."""
+    if units not in UNITS:
+        raise InputError(f"units {units!r} is not one of {', '.join(UNITS)}")
+    return units
+
+
+def real(v) -> str:
+    """A number as a STEP/IGES real: always with a decimal point, exponent in upper case.
+
+    Examples
+    --------
+    >>> real(Fraction(53, 50)), real(2), real(Fraction(1, 10**9))
+    ('1.06', '2.', '1.E-09')
+    """
+    text = repr(float(v)).upper()
+    mantissa, _, exponent = text.partition("E")
+    if "." not in mantissa:
+        mantissa += "."
+    elif mantissa.endswith(".0"):
+        mantissa = mantissa[:-1]
+    return mantissa + (f"E{int(exponent):+03d}" if exponent else "")
+
+
+def multiplicities(knots) -> tuple[list[Fraction], list[int]]:
+    """Distinct knots and how often each repeats.
+
+    Examples
+    --------
+    >>> multiplicities([0, 0, 1, 2, 2])
+    ([0, 1, 2], [2, 1, 2])
+    """
+    values, counts = [], []
+    for k in knots:
+        if values and values[-1] == k:
+            counts[-1] += 1
+        else:
+            values.append(k)
+            counts.append(1)
+    return values, counts
