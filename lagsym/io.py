@@ -28,6 +28,7 @@ __all__ = [
     "read_points",
     "read_curve_points",
     "read_any_points",
+    "read_units",
     "read_program",
     "event_log",
     "parse_points",
@@ -289,6 +290,30 @@ def read_points(path: str | os.PathLike) -> ControlGrid:
     """
     name, text = _read_bytes(path)
     return parse_points(text, source=name, kind=_kind(name, text))
+
+
+UNITS = ("mm", "inch")
+
+
+def read_units(path: str | os.PathLike, default: str = "mm") -> str:
+    """The length unit a points file states (``"units": "mm"`` or ``"inch"`` in JSON), else ``default``.
+
+    CSV files state none.
+
+    Raises
+    ------
+    InputError
+        For a unit other than those in :data:`UNITS`.
+    """
+    name, text = _read_bytes(path)
+    if _kind(name, text) != "json":
+        return default
+    data = _load_json(name, text)
+    if not isinstance(data, dict) or "units" not in data:
+        return default
+    if data["units"] not in UNITS:
+        raise InputError(f"{name}: \"units\": {_short(data['units'])} is not one of {', '.join(UNITS)}")
+    return data["units"]
 
 
 def read_curve_points(path: str | os.PathLike) -> CurvePoints:

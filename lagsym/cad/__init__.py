@@ -8,7 +8,7 @@ volume above a base.  File formats are in :mod:`lagsym.export.step`,
 
 from .convert import METHODS, bernstein_transform, bezier_patch, cad_patch
 from .patch import BezierPatch, BSplinePatch, de_casteljau, insert_knot, split_half
-from .solid import HeightBounds, check_base, lowest_height, polynomial_volume, volume
+from .solid import HeightBounds, check_base, exact_height, lowest_height, polynomial_volume, volume
 
 __all__ = [
     "METHODS",
@@ -20,6 +20,7 @@ __all__ = [
     "cad_patch",
     "check_base",
     "de_casteljau",
+    "exact_height",
     "insert_knot",
     "lowest_height",
     "polynomial_volume",

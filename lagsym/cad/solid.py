@@ -24,7 +24,7 @@ from math import comb
 from ..errors import InputError
 from .patch import BezierPatch, BSplinePatch, split_half
 
-__all__ = ["HeightBounds", "lowest_height", "check_base", "volume", "polynomial_volume"]
+__all__ = ["HeightBounds", "lowest_height", "check_base", "exact_height", "volume", "polynomial_volume"]
 
 RELATIVE_TOLERANCE = Fraction(1, 2**40)  # of the control heights' range: far below any machining use
 MAX_PIECES = 20_000  # a safety net; near a single minimum the search needs a few hundred
@@ -111,7 +111,7 @@ def check_base(patch: BSplinePatch | BezierPatch, base_z, source: str = "<surfac
 
     The error names the base and the surface's lowest height.
     """
-    base = Fraction(base_z)
+    base = exact_height(base_z, "--base-z", source)
     pieces = _pieces(patch)
     tol = _tolerance(pieces)
     decided = _search([p.heights() for p in pieces], tol, base)
@@ -120,6 +120,25 @@ def check_base(patch: BSplinePatch | BezierPatch, base_z, source: str = "<surfac
     low = _search([p.heights() for p in pieces], tol, None)
     raise InputError(f"{source}: --base-z {_show(base)} is not below the surface, whose lowest height is "
                      f"{float(low.upper):.10g}; a solid needs its base below the whole surface")
+
+
+def exact_height(value, name: str = "base_z", source: str = "<surface>") -> Fraction:
+    """A height as an exact number: ints, Fractions, and text as in points files (``"1.06"``, ``"-1/3"``).
+
+    A float is read as the shortest decimal that prints it (``0.1`` is 1/10).
+    """
+    from ..io import _Bad, exact_number
+
+    if isinstance(value, bool) or not isinstance(value, (int, Fraction, float, str)):
+        raise InputError(f"{source}: {name} {value!r} is not a number")
+    if isinstance(value, float):
+        value = repr(value)
+    if isinstance(value, str):
+        try:
+            return exact_number(value)
+        except _Bad as e:
+            raise InputError(f"{source}: {name} {e}") from None
+    return Fraction(value)
 
 
 def _show(v: Fraction) -> str:

@@ -1,4 +1,4 @@
-"""What the STEP and IGES writers share: numbers as text, units, the faces of a solid.
+"""What the STEP and IGES writers share: numbers as text, units, knot multiplicities.
 
 Exact coordinates become the nearest binary double (``float(Fraction)`` rounds
 correctly) written with the 17 significant digits that read back to the same
@@ -10,10 +10,9 @@ from __future__ import annotations
 from fractions import Fraction
 
 from ..errors import InputError
+from ..io import UNITS
 
 __all__ = ["UNITS", "check_units", "real", "multiplicities"]
-
-UNITS = ("mm", "inch")
 
 
 def check_units(units: str) -> str:

@@ -22,6 +22,7 @@ from fractions import Fraction
 from typing import IO
 
 from ..cad.patch import BSplinePatch
+from ..cad.solid import check_base
 from .cadtext import check_units, multiplicities, real
 
 __all__ = ["write_step"]
@@ -156,7 +157,7 @@ def _solid_faces(data: _Data, patch: BSplinePatch, corner, top_edges, base_z: Fr
 
 
 def write_step(stream: IO[str], patch: BSplinePatch, *, base_z: Fraction | None = None, units: str = "mm",
-               name: str = "surface", timestamp: str | None = None) -> None:
+               name: str = "surface", timestamp: str | None = None, source: str = "<surface>") -> None:
     """Write ``patch`` to ``stream`` as a STEP AP214 file: a face, or a solid down to ``base_z``.
 
     Parameters
@@ -166,17 +167,21 @@ def write_step(stream: IO[str], patch: BSplinePatch, *, base_z: Fraction | None 
         The exact patch (:func:`lagsym.cad.cad_patch`); its coordinates are lengths in ``units``.
     base_z : Fraction, optional
         The height of the base plane for a solid; it must lie below the whole
-        surface (check with :func:`lagsym.cad.check_base` first).
+        surface (:func:`lagsym.cad.check_base`), else an InputError naming ``source``.
     units : {"mm", "inch"}
         The length unit the file declares.
     name : str
         The product's name in the file.
     timestamp : str, optional
         ISO 8601 time for the header (default: now, UTC).
+    source : str
+        The points file, for messages.
     """
     from .. import __version__
 
     check_units(units)
+    if base_z is not None:
+        base_z = check_base(patch, base_z, source)
     name = "".join(c for c in name if c.isprintable() and c not in "'\\") or "surface"
     data = _Data()
     context = _units(data, units)
