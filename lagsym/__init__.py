@@ -5,6 +5,7 @@ tensor-product Lagrange polynomial ``z = F(x, y)``, samples it, compares it
 with other surfaces, plans toolpaths and writes programs for CNC controls.
 """
 
+from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
 from .compare import Comparison, DeviationMeasures, compare_surfaces, deviation_measures, render_table
 from .dnc import (
     PROFILES,
@@ -31,6 +32,7 @@ from .errors import (
 )
 from .evaluate import SurfaceEvaluator, surface_evaluator
 from .export import write_sample
+from .export.cad import write_cad
 from .formula import Formula, parse_formula
 from .gcode import Moves, move_points, parse_moves
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
@@ -47,6 +49,11 @@ from .verify import CutReport, simulate_cut
 __version__ = "0.1.0"
 
 __all__ = [
+    "BezierPatch",
+    "BSplinePatch",
+    "bezier_patch",
+    "cad_patch",
+    "write_cad",
     "Comparison",
     "DeviationMeasures",
     "Formula",

@@ -27,6 +27,7 @@ from conftest import EXAMPLES
 PAPER = [EXAMPLES / f"paper-example-{k}.json" for k in range(1, 5)]
 SAMPLES = 60  # 60 x 60 = 3600 parameter points a surface
 TOLERANCE = 1e-12  # of the data range
+MEASURED = 3e-15  # what docs/export.md reports for the paper's examples
 VOLUME_RTOL = 1e-9
 
 OCP = pytest.importorskip("OCP", reason="the CAD read-back tests need cadquery-ocp (pip install '.[test]')")
@@ -51,9 +52,9 @@ def subshapes(shape, kind):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    kinds = {"face": (TopAbs_FACE, TopoDS.Face), "shell": (TopAbs_SHELL, TopoDS.Shell),
-             "solid": (TopAbs_SOLID, TopoDS.Solid)}
-    flag, cast = kinds[kind]
+    kinds = {"face": (TopAbs_FACE, "Face"), "shell": (TopAbs_SHELL, "Shell"), "solid": (TopAbs_SOLID, "Solid")}
+    flag, name = kinds[kind]
+    cast = getattr(TopoDS, name + "_s", None) or getattr(TopoDS, name)  # OCP 7 names static methods with _s
     out, ex = [], TopExp_Explorer(shape, flag)
     while ex.More():
         out.append(cast(ex.Current()))
@@ -136,7 +137,7 @@ def test_paper_surface_read_back(path, suffix, tmp_path):
     surface = faces[0][1]
     assert (surface.UDegree(), surface.VDegree()) == s.degree
     assert surface.Bounds() == tuple(float(b) for b in s.grid.bounds)
-    assert deviation(surface, s) <= TOLERANCE
+    assert deviation(surface, s) <= min(TOLERANCE, MEASURED)
 
 
 def _base(s) -> Fraction:
