@@ -84,3 +84,19 @@ def test_read_back_figures_are_those_the_tests_require():
     assert f"within {TOLERANCE:g} of the data range" in text
     assert VOLUME_RTOL == 1e-9 and "to 1e-9 relative" in text
     assert f"(measured: at most {MEASURED:g}, for all four of the paper's examples, STEP and IGES)" in text
+
+
+def test_high_degree_figures():
+    """'a smooth 16 x 16 grid of heights 10 to 30 has coefficients near 8e6' (the grid of test_cad_files)."""
+    import math
+
+    from lagsym.grid import grid_from_table
+
+    xs = [Fraction(i * 60, 15) for i in range(16)]
+    z = [[Fraction(round(1000 * (20 + 10 * math.sin(x / 15) * math.cos(y / 20))), 1000) for y in xs] for x in xs]
+    s = lagrange_surface(grid_from_table(xs, xs, z))
+    lo, hi = s.grid.z_range()
+    assert 10 <= lo and hi <= 30
+    largest = max(abs(v) for row in bezier_patch(s).heights() for v in row)
+    assert f"{float(largest):.0e}" == "8e+06"
+    assert "a smooth 16 x 16 grid of heights 10 to 30 has coefficients near 8e6" in " ".join(DOC.split())

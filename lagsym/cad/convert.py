@@ -30,9 +30,10 @@ from ..errors import InputError
 from ..lagrange import LagrangeSurface, lagrange_surface
 from .patch import BezierPatch, BSplinePatch
 
-__all__ = ["METHODS", "bernstein_transform", "bezier_patch", "cad_patch"]
+__all__ = ["METHODS", "KERNEL_MAX_DEGREE", "bernstein_transform", "bezier_patch", "cad_patch", "double_error_bound"]
 
 METHODS = ("lagrange", "bezier", "bspline")
+KERNEL_MAX_DEGREE = 25  # OpenCascade's Geom_BSplineSurface::MaxDegree(); several CAD kernels stop there too
 
 
 def _fmpq(v: Fraction) -> flint.fmpq:
@@ -123,3 +124,24 @@ def cad_patch(surface, method: str = "lagrange", *, degree: int = 3) -> BSplineP
         raise InputError(f"B-spline degree {degree!r} should be an integer >= 1")
     pu, pv = min(degree, n - 1), min(degree, m - 1)
     return BSplinePatch("B-spline", pu, pv, clamped_uniform_knots(n, pu), clamped_uniform_knots(m, pv), net)
+
+
+def double_error_bound(patch: BSplinePatch, data_range) -> float:
+    """A bound on how far the surface a CAD kernel evaluates from the file may lie from the exact one.
+
+    Relative to ``data_range``.  Rounding each control point to the nearest
+    double moves the surface by at most half a unit in the last place of the
+    largest coordinate (the basis is non-negative and sums to one), and a
+    stable evaluation (de Boor) adds about one such rounding per degree.  The
+    Bernstein coefficients of a high-degree interpolant can be far larger than
+    the surface, which is what makes this grow.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_table
+    >>> g = grid_from_table([0, 1, 2], [0, 1], [[0, 0], [1, 1], [4, 4]])
+    >>> double_error_bound(cad_patch(g), 4) < 1e-15
+    True
+    """
+    largest = max(abs(float(p[2])) for row in patch.control_points for p in row)
+    return (1 + patch.degree_u + patch.degree_v) * 2.0**-53 * largest / (float(data_range) or 1.0)

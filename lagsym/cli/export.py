@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from ..cad import METHODS, cad_patch, exact_height, lowest_height, volume
+from ..cad import KERNEL_MAX_DEGREE, METHODS, cad_patch, double_error_bound, exact_height, lowest_height, volume
+from ..conditioning import FLOAT_ERROR_LIMIT
 from ..errors import InputError
 from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..io import UNITS, read_points, read_units
@@ -22,6 +23,10 @@ knots and control points.  --solid --base-z Z closes the surface down to the
 plane z = Z into a solid (STEP: a B-rep solid; IGES: five more surfaces to sew);
 Z must lie below the whole surface.  Lengths are in the units FILE states
 ("units": "mm" or "inch"), else in --units.
+
+Files store doubles: a warning goes to standard error when rounding the
+control points could move the surface by more than 1e-12 of the data range
+(high degrees), or when the degree passes 25, the most OpenCascade reads.
 
 examples:
   lagsym export examples/paper-example-4.json -o surface.step
@@ -55,6 +60,16 @@ def run(args, out, err) -> int:
         raise InputError(f"{args.file}: the file states \"units\": \"{units}\", not --units {args.units}")
     patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
+    lo, hi = grid.z_range()
+    rel = double_error_bound(patch, hi - lo)
+    if rel > FLOAT_ERROR_LIMIT:
+        err.write(f"lagsym: warning: rounding the control points to doubles may move the surface by up to "
+                  f"{rel:.1e} of the data range (trusted limit {FLOAT_ERROR_LIMIT:g}): at degree "
+                  f"({patch.degree_u}, {patch.degree_v}) the Bernstein coefficients are much larger than the "
+                  f"surface; use fewer control points, or the exact values in a .json file\n")
+    if max(patch.degree_u, patch.degree_v) > KERNEL_MAX_DEGREE:
+        err.write(f"lagsym: warning: degree ({patch.degree_u}, {patch.degree_v}) is above {KERNEL_MAX_DEGREE}, "
+                  f"the largest B-spline degree OpenCascade and several CAD systems read\n")
     n, m = patch.shape
     out.write(f"{args.output}: {patch.name} surface, degree ({patch.degree_u}, {patch.degree_v}), "
               f"{n} x {m} exact control points, {units}\n")
