@@ -292,3 +292,26 @@ def test_import_lagsym_loads_no_cad_kernel():
             "bad = [m for m in ('OCP', 'pyvista', 'vtk') if m in sys.modules]; print(bad)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+@given(grids(), st.randoms(use_true_random=False))
+def test_lowest_height_of_any_grid(g, rnd):
+    s = lagrange_surface(g)
+    b = lowest_height(cad_patch(s))
+    values = [s.exact_value(x, y) for x, y in rational_points(g.bounds, 20, rnd.randint(0, 10**6))]
+    assert b.lower <= b.upper and b.lower <= min(values)
+    assert check_base(cad_patch(s), b.lower - Fraction(1, 10**9)) < min(values)
+    with pytest.raises(InputError):
+        check_base(cad_patch(s), b.upper)
+
+
+@pytest.mark.parametrize("height", [lambda x, y: (y - 1) ** 2, lambda x, y: (x - y) ** 2], ids=["axis", "diagonal"])
+def test_valley_at_a_height_the_search_cannot_reach(height):
+    """A minimum along a whole line at non-dyadic parameters: the bounds stay safe and the answer comes quickly."""
+    xs, ys = [0, 1, 3], [0, 1, 3]
+    p = cad_patch(lagrange_surface(grid_from_table(xs, ys, [[height(x, y) for y in ys] for x in xs])))
+    b = lowest_height(p)
+    assert b.lower <= 0 <= b.upper
+    with pytest.raises(InputError, match="--base-z 0 is not below the surface, whose lowest height is (0|between)"):
+        check_base(p, 0)
+    assert check_base(p, Fraction(-1, 10**4)) == Fraction(-1, 10**4)

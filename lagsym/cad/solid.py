@@ -5,9 +5,9 @@ The solid is the region between the patch (the top face) and the plane
 
 * The lowest height: every Bernstein coefficient bounds the patch from
   below by its minimum (the convex hull property), and the heights at the
-  corners are attained.  Halving the patch (de Casteljau) narrows the two
-  bounds; a best-first search halves only the pieces that may hold the
-  minimum.  A base is accepted only when it lies strictly below a proven
+  corners are attained.  Halving the patch (de Casteljau, across the
+  direction in which its net varies most) narrows the two bounds; a
+  best-first search halves only the pieces that may hold the minimum.  A base is accepted only when it lies strictly below a proven
   lower bound, so an accepted solid never touches its base.
 * The volume: with ``x`` a polynomial in ``u`` alone and ``y`` in ``v`` alone,
   ``V = int int (z - base_z) x'(u) y'(v) du dv``, and the integral of a
@@ -26,8 +26,8 @@ from .patch import BezierPatch, BSplinePatch, split_half
 
 __all__ = ["HeightBounds", "lowest_height", "check_base", "exact_height", "volume", "polynomial_volume"]
 
-RELATIVE_TOLERANCE = Fraction(1, 2**40)  # of the control heights' range: far below any machining use
-MAX_PIECES = 20_000  # a safety net; near a single minimum the search needs a few hundred
+RELATIVE_TOLERANCE = Fraction(1, 2**40)  # of the Bernstein coefficients' range: far below any machining use
+MAX_PIECES = 4_000  # a safety net (a second or two); near a single minimum the search needs a few hundred
 
 
 @dataclass(frozen=True)
@@ -39,13 +39,18 @@ class HeightBounds:
 
 
 def _halves(z: list[list[Fraction]]) -> list[list[list[Fraction]]]:
-    """The four quarters of a Bezier net of heights."""
-    left, right = zip(*(split_half(row) for row in z))  # along v, row by row
-    out = []
-    for half in (left, right):
-        a, b = zip(*(split_half(col) for col in zip(*half)))  # along u, column by column
-        out += [[list(r) for r in zip(*a)], [list(r) for r in zip(*b)]]
-    return out
+    """The two halves of a Bezier net of heights, cut across the direction in which it varies most.
+
+    Cutting one way only keeps a valley along one axis from multiplying the
+    pieces: along the valley nothing is learnt by cutting.
+    """
+    along_u = max(abs(a - b) for col in zip(*z) for a, b in zip(col, col[1:])) if len(z) > 1 else 0
+    along_v = max(abs(a - b) for row in z for a, b in zip(row, row[1:])) if len(z[0]) > 1 else 0
+    if along_v >= along_u:
+        left, right = zip(*(split_half(row) for row in z))
+        return [[list(r) for r in left], [list(r) for r in right]]
+    a, b = zip(*(split_half(list(col)) for col in zip(*z)))
+    return [[list(r) for r in zip(*a)], [list(r) for r in zip(*b)]]
 
 
 def _corners(z) -> Fraction:
@@ -59,18 +64,19 @@ def _search(pieces: list[list[list[Fraction]]], tolerance: Fraction, below: Frac
         heapq.heappush(heap, (min(min(r) for r in z), j, z))
     count = len(pieces)
     while True:
-        lower, _, z = heap[0]
+        lower = min(heap[0][0], upper)  # pieces kept before upper last fell may lie wholly above it
+        z = heap[0][2]
         if upper - lower <= tolerance or count > MAX_PIECES:
             return HeightBounds(lower, upper)
         if below is not None and (lower > below or upper <= below):
             return HeightBounds(lower, upper)  # decided: no need for the exact height
         heapq.heappop(heap)
-        for quarter in _halves(z):
-            upper = min(upper, _corners(quarter))
-            low = min(min(r) for r in quarter)
+        for half in _halves(z):
+            upper = min(upper, _corners(half))
+            low = min(min(r) for r in half)
             if low < upper:
                 count += 1
-                heapq.heappush(heap, (low, count, quarter))
+                heapq.heappush(heap, (low, count, half))
         if not heap:
             return HeightBounds(upper, upper)
 
@@ -91,7 +97,7 @@ def lowest_height(patch: BSplinePatch | BezierPatch, tolerance: Fraction | None 
     ----------
     patch : BSplinePatch or BezierPatch
     tolerance : Fraction, optional
-        Width of the bounds (default ``2**-40`` of the control heights' range).
+        Width of the bounds (default ``2**-40`` of the range of the Bernstein coefficients).
 
     Examples
     --------
@@ -102,8 +108,9 @@ def lowest_height(patch: BSplinePatch | BezierPatch, tolerance: Fraction | None 
     >>> b.lower <= 0 <= b.upper, float(b.upper)
     (True, 0.0)
     """
-    pieces = [p.heights() for p in _pieces(patch)]
-    return _search(pieces, Fraction(tolerance) if tolerance is not None else _tolerance(_pieces(patch)), None)
+    pieces = _pieces(patch)
+    return _search([p.heights() for p in pieces], Fraction(tolerance) if tolerance is not None else _tolerance(pieces),
+                   None)
 
 
 def check_base(patch: BSplinePatch | BezierPatch, base_z, source: str = "<surface>") -> Fraction:
@@ -117,9 +124,13 @@ def check_base(patch: BSplinePatch | BezierPatch, base_z, source: str = "<surfac
     decided = _search([p.heights() for p in pieces], tol, base)
     if decided.lower > base:
         return base
-    low = _search([p.heights() for p in pieces], tol, None)
+    # Refused early on a height the surface reaches: find how low it goes, for the message.
+    low = _search([p.heights() for p in pieces], tol, None) if decided.upper <= base else decided
+    lowest = _height(low.upper, tol)
+    if low.upper - low.lower > tol:  # the search stopped short (a valley at a height it cannot reach)
+        lowest = f"between {_height(low.lower, tol)} and {lowest}"
     raise InputError(f"{source}: --base-z {_show(base)} is not below the surface, whose lowest height is "
-                     f"{float(low.upper):.10g}; a solid needs its base below the whole surface")
+                     f"{lowest}; a solid needs its base below the whole surface")
 
 
 def exact_height(value, name: str = "base_z", source: str = "<surface>") -> Fraction:
@@ -139,6 +150,11 @@ def exact_height(value, name: str = "base_z", source: str = "<surface>") -> Frac
         except _Bad as e:
             raise InputError(f"{source}: {name} {e}") from None
     return Fraction(value)
+
+
+def _height(v: Fraction, tol: Fraction) -> str:
+    """``v`` to ten digits, or 0 when it is within the search's tolerance of 0."""
+    return "0" if abs(v) <= tol else f"{float(v):.10g}"
 
 
 def _show(v: Fraction) -> str:
