@@ -35,7 +35,7 @@ def help_text(argv: list[str]) -> str:
 
 def page() -> str:
     """The whole CLI reference page."""
-    from lagsym.cli import _commands
+    from lagsym.cli import COMMANDS
 
     parts = [
         "# CLI reference\n",
@@ -50,8 +50,8 @@ def page() -> str:
         help_text([]).rstrip(),
         "```\n",
     ]
-    for mod in _commands():
-        parts += [f"## lagsym {mod.NAME}\n", "```", help_text([mod.NAME]).rstrip(), "```\n"]
+    for name in COMMANDS:
+        parts += [f"## lagsym {name}\n", "```", help_text([name]).rstrip(), "```\n"]
     return "\n".join(parts)
 
 

@@ -42,14 +42,15 @@ import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from fractions import Fraction
 
 import numpy as np
 
 from ._arrays import readonly as _readonly
 from .errors import InputError
 from .grid import ControlGrid, _fmt
+from .sampling import axis_lines
 from .surfaces import HERMITE_KINDS, METHODS, make_surface
+from .values import choice
 
 __all__ = [
     "DEFAULT_SAMPLES",
@@ -227,8 +228,9 @@ class Comparison:
 def sample_axes(grid: ControlGrid, samples: tuple[int, int] = DEFAULT_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
     """Evenly spaced sample positions over the control box, ends included.
 
-    Positions are computed exactly and rounded once, so a sample that falls on
-    a control node is that node, to the last bit.
+    Positions come from :func:`lagsym.sampling.axis_lines`: computed exactly
+    and rounded once, so a sample that falls on a control node is that node,
+    to the last bit.
 
     Examples
     --------
@@ -244,11 +246,8 @@ def sample_axes(grid: ControlGrid, samples: tuple[int, int] = DEFAULT_SAMPLES) -
             raise InputError(f"{count!r} samples in {name}: need an integer >= 2")
     if samples[0] * samples[1] > MAX_SAMPLES:
         raise InputError(f"{samples[0]} x {samples[1]} samples is more than the limit of {MAX_SAMPLES}")
-    axes = []
-    for count, nodes in ((samples[0], grid.x), (samples[1], grid.y)):
-        lo, hi = nodes[0], nodes[-1]
-        axes.append(_readonly([float(lo + (hi - lo) * Fraction(k, count - 1)) for k in range(count)]))
-    return axes[0], axes[1]
+    x0, x1, y0, y1 = grid.bounds
+    return axis_lines(x0, x1, int(samples[0])), axis_lines(y0, y1, int(samples[1]))
 
 
 def _reference_heights(reference, grid: ControlGrid, samples):
@@ -327,10 +326,8 @@ def compare_surfaces(
     if not methods:
         raise InputError(f"no methods to compare; choose from {', '.join(METHODS)}")
     for m in methods:
-        if m not in METHODS:
-            raise InputError(f"method {m!r} is not one of {', '.join(METHODS)}")
-    if hermite not in HERMITE_KINDS:
-        raise InputError(f"Hermite kind {hermite!r} is not one of {', '.join(HERMITE_KINDS)}")
+        choice(m, METHODS, "method")
+    choice(hermite, HERMITE_KINDS, "Hermite kind")
     label, xs, ys, z_f = _reference_heights(reference, grid, samples)
     z_f = _readonly(z_f)
     bad = np.argwhere(~np.isfinite(z_f))
@@ -406,8 +403,7 @@ def render_table(c: Comparison, fmt: str = "text") -> str:
         ``text`` and ``markdown`` round to 4 decimals as the paper does;
         ``csv`` and ``json`` carry full precision.
     """
-    if fmt not in TABLE_FORMATS:
-        raise InputError(f"table format {fmt!r} is not one of {', '.join(TABLE_FORMATS)}")
+    choice(fmt, TABLE_FORMATS, "table format")
     names = [m.name for m in c.methods]
     if fmt == "json":
         doc = {

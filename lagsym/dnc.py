@@ -28,6 +28,7 @@ import serial
 
 from .dncplan import DC1, DC2, DC3, DC4, Program, frame, resume_setup
 from .errors import InputError, TransferError
+from .values import choice
 
 __all__ = [
     "LineSettings",
@@ -58,12 +59,6 @@ _PROGRESS_S = 0.1
 # serial server, which holds what it has not yet put on its line.
 _SETTLE_S = 0.05
 _SETTLE_NETWORK_S = 0.25
-
-
-def _check(value, options, what: str):
-    if value not in options:
-        raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -121,12 +116,12 @@ class LineSettings:
     def __post_init__(self):
         if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
             raise InputError(f"baud rate {self.baud!r} must be a whole number from 50 to 4000000")
-        _check(self.bytesize, (5, 6, 7, 8), "data bits")
-        _check(self.parity, tuple(PARITIES), "parity")
+        choice(self.bytesize, (5, 6, 7, 8), "data bits")
+        choice(self.parity, tuple(PARITIES), "parity")
         object.__setattr__(self, "stopbits", float(self.stopbits))
-        _check(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
-        _check(self.flow, FLOW_CONTROLS, "flow control")
-        _check(self.eol, tuple(LINE_ENDINGS), "end of block")
+        choice(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
+        choice(self.flow, FLOW_CONTROLS, "flow control")
+        choice(self.eol, tuple(LINE_ENDINGS), "end of block")
         for name in ("leader", "trailer"):
             text = getattr(self, name)
             if any(ord(c) in (DC1, DC2, DC3, DC4) or ord(c) > 127 for c in text):
@@ -172,7 +167,7 @@ def profile(name: str, **overrides) -> LineSettings:
     >>> profile("haas", baud=19200).eol
     'crlf'
     """
-    _check(name, tuple(PROFILES), "profile")
+    choice(name, tuple(PROFILES), "profile")
     return replace(PROFILES[name], **overrides)
 
 
@@ -275,7 +270,7 @@ def plan_transfer(program: Program, settings: LineSettings, mode: str = "upload"
     >>> b"".join(b for _, b in plan_transfer(p, LineSettings(eol="crlf")))
     b'%\\r\\nO1\\r\\nM30\\r\\n%\\r\\n'
     """
-    _check(mode, MODES, "mode")
+    choice(mode, MODES, "mode")
     if not isinstance(start_block, int) or start_block < 1:
         raise InputError(f"--start-block {start_block!r} must be a block number from 1")
     blocks: list[tuple[int | None, str]] = []

@@ -31,6 +31,10 @@ class InputError(LagsymError, ValueError):
     """A file or value given to lagsym is unusable; the message names it."""
 
 
+class OutputError(LagsymError, OSError):
+    """A result cannot be written where it was asked for (a full disk, a folder without write permission)."""
+
+
 class GridError(InputError):
     """Control points that do not form the rectangular grid the method needs."""
 
@@ -49,6 +53,14 @@ class ProgramError(LagsymError, ValueError):
 
 class RenderError(LagsymError, RuntimeError):
     """Pictures cannot be drawn here (no display and no offscreen renderer); the message says what to install."""
+
+
+class Terminated(KeyboardInterrupt):
+    """The process was asked to stop by a signal (SIGTERM, SIGHUP): handled as Ctrl-C is, then exit 128 + signal."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
 
 
 class TransferError(LagsymError, OSError):

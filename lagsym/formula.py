@@ -142,11 +142,11 @@ class _Parser:
     def atom(self):
         kind, text, col = self.take()
         if kind == "number":
-            from .io import _Bad, exact_number
+            from .values import NotANumber, exact_number
 
             try:
                 return ("num", exact_number(text))
-            except _Bad as e:
+            except NotANumber as e:
                 raise self.error(str(e), col) from None
         if kind == "name":
             if text in ("x", "y"):

@@ -9,20 +9,23 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import errno
 import io
 import json
 import os
 import re
+import shutil
+import stat
 import tempfile
 import time
 from collections.abc import Iterator
-from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 from typing import IO, Any
 
-from .errors import InputError
+from .errors import InputError, OutputError
 from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
+from .values import MAX_EXPONENT, NotANumber, exact_number
 
 __all__ = [
     "read_points",
@@ -39,48 +42,17 @@ __all__ = [
 ]
 
 MAX_BYTES = 64 * 1024 * 1024
-_MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
-_RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
-_DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
-
-
-class _Bad(Exception):
-    """A value that is not an exact number, with a reason."""
-
-
-def exact_number(text: str) -> Fraction:
-    """Read an exact decimal or rational from text.
-
-    Examples
-    --------
-    >>> exact_number("1.06"), exact_number("-1/3"), exact_number("2e3")
-    (Fraction(53, 50), Fraction(-1, 3), Fraction(2000, 1))
-    """
-    m = _RATIONAL.match(text)
-    if m:
-        num, den = m.groups()
-        if len(num) > _MAX_EXPONENT or len(den) > _MAX_EXPONENT:
-            raise _Bad(f"{text!r} is too large")
-        if int(den) == 0:
-            raise _Bad(f"{text!r} divides by zero")
-        return Fraction(int(num), int(den))
-    if not _DECIMAL.match(text):
-        raise _Bad(f"{text.strip()!r} is not a number")
-    d = Decimal(text.strip())
-    if len(d.as_tuple().digits) > _MAX_EXPONENT or abs(d.adjusted()) > _MAX_EXPONENT:
-        raise _Bad(f"{text.strip()!r} is out of range (overflow)")
-    return Fraction(d)
 
 
 def _json_float(text: str) -> Fraction:
     try:
         return exact_number(text)
-    except _Bad as e:
+    except NotANumber as e:
         raise _JsonValueError(str(e)) from None
 
 
 def _json_int(text: str) -> int:
-    if len(text.lstrip("-")) > _MAX_EXPONENT:
+    if len(text.lstrip("-")) > MAX_EXPONENT:
         raise _JsonValueError(f"{text[:20]}... is out of range (overflow)")
     return int(text)
 
@@ -101,7 +73,7 @@ def _value(v: Any, where: str) -> Fraction:
     if isinstance(v, str):
         try:
             return exact_number(v)
-        except _Bad as e:
+        except NotANumber as e:
             raise InputError(f"{where}: {e}") from None
     raise InputError(f"{where}: {_short(v)} is not a number")
 
@@ -114,16 +86,24 @@ def _short(v: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _raw(path: str | os.PathLike, what: str, limit: int | None = None) -> bytes:
-    """The bytes of ``path``; every way reading can fail becomes one InputError naming the file."""
-    p = Path(path)
+_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe (FIFO)"),
+          (stat.S_ISSOCK, "a socket"))
+STDIN_NAMES = ("-", "/dev/stdin")
+STDIN_SILENCE_S = 10.0  # standard input that sends nothing for this long is refused, not waited on forever
+
+
+def _raw(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
+    """The bytes of ``path`` (``-``: standard input), at most ``limit``; every failure is one InputError naming it.
+
+    Only a regular file or standard input is read: a device or a named pipe
+    could hand over endless bytes or none, so it is refused with a line that
+    says what it is.
+    """
     name = str(path)
+    if name in STDIN_NAMES:
+        return _read_stdin(what, limit)
     try:
-        if p.is_dir():
-            raise InputError(f"{name}: is a directory, not {what}")
-        if limit is not None and (size := p.stat().st_size) > limit:
-            raise InputError(f"{name}: {size} bytes is too large for {what}")
-        return p.read_bytes()
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
     except FileNotFoundError:
         raise InputError(f"{name}: no such file") from None
     except PermissionError:
@@ -132,11 +112,48 @@ def _raw(path: str | os.PathLike, what: str, limit: int | None = None) -> bytes:
         raise InputError(f"{name}: is a directory, not {what}") from None
     except OSError as e:
         raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    info = os.fstat(fd)
+    refusal = f"{name}: is a directory, not {what}" if stat.S_ISDIR(info.st_mode) else next(
+        (f"{name}: is {kind}, not {what}; give a regular file, or '-' for standard input"
+         for test, kind in _KINDS if test(info.st_mode)), None)
+    if refusal:
+        os.close(fd)
+        raise InputError(refusal)
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            if (size := info.st_size) > limit:
+                raise InputError(f"{name}: {size} bytes is too large for {what} (at most {limit} bytes)")
+            raw = fh.read(limit + 1)
+        except OSError as e:
+            raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    if len(raw) > limit:  # the file grew while it was read
+        raise InputError(f"{name}: more than {limit} bytes is too large for {what}")
+    return raw
+
+
+def _read_stdin(what: str, limit: int) -> bytes:
+    import select
+    import sys
+
+    stream = sys.stdin.buffer
+    chunks, total = [], 0
+    while True:
+        ready, _, _ = select.select([stream], [], [], STDIN_SILENCE_S)
+        if not ready:
+            raise InputError(f"standard input: nothing arrived for {STDIN_SILENCE_S:g} s; "
+                             f"pipe {what} in, or give a file name")
+        chunk = os.read(stream.fileno(), 1 << 16)
+        if not chunk:
+            return b"".join(chunks)
+        total += len(chunk)
+        if total > limit:
+            raise InputError(f"standard input: more than {limit} bytes is too large for {what}")
+        chunks.append(chunk)
 
 
 def _read_bytes(path: str | os.PathLike) -> tuple[str, str]:
     name = str(path)
-    raw = _raw(path, "a points file", MAX_BYTES)
+    raw = _raw(path, "a points file")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -210,7 +227,7 @@ def _csv_rows(name: str, text: str, arity: int) -> list[tuple[Fraction, ...]]:
         for c in (cells[j] for j in order):
             try:
                 values.append(exact_number(c))
-            except _Bad as e:
+            except NotANumber as e:
                 raise InputError(f"{name}: line {lineno}: {e}") from None
         points.append(tuple(values))
     return points
@@ -384,48 +401,104 @@ def event_log(path: str | os.PathLike | None) -> Iterator:
         yield log
 
 
+def _write_error(path, e: OSError) -> OutputError:
+    reason = (e.strerror or str(e)).lower()
+    if e.errno == errno.ENOSPC:
+        reason = "no space left on the device"
+    return OutputError(f"{path}: cannot write ({reason}); any earlier file there is untouched")
+
+
+def _is_stream(given: Path, real: Path) -> bool:
+    """A target written through rather than replaced: a device, pipe or socket, or a /dev or /proc name."""
+    if str(given).startswith(("/dev/", "/proc/")):
+        return True
+    try:
+        return not stat.S_ISREG(real.stat().st_mode)
+    except FileNotFoundError:
+        return False
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[str]:
-    """Yield a temporary file name beside ``path``; it replaces ``path`` only if the block succeeds.
+    """Yield a temporary file name; once the block succeeds its content becomes ``path``'s.
 
     For libraries that write a file by name (meshio, VTK) as much as for
-    :func:`atomic_write`: a failure part-way leaves any earlier file at
-    ``path`` untouched and no partial file behind.  The finished file gets the
-    permissions a newly created file would (``0o666`` less the umask).
+    :func:`atomic_write`.  How the content arrives depends on what ``path`` is:
+
+    - a regular file, or a new name: the temporary file sits beside it and
+      replaces it in one rename, keeping an existing file's permissions (a new
+      file gets ``0o666`` less the umask); a file with other hard links is
+      rewritten in place instead, so the links stay one file;
+    - a symbolic link: the same, for the file it points to (the link stays);
+    - a device, pipe or socket (``/dev/null``, ``/dev/stdout``, a FIFO): written
+      through, after the content is complete.
+
+    A failure part-way, a full disk included, leaves any earlier file
+    untouched and no partial file behind, and is one :class:`OutputError`.
     """
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
+    given = Path(path)
+    real = Path(os.path.realpath(given))
+    if real.is_dir():
+        raise InputError(f"{path}: is a directory")
+    stream = _is_stream(given, real)
+    directory = Path(tempfile.gettempdir()) if stream else real.parent
     if not directory.is_dir():
         raise InputError(f"{path}: the folder {directory} does not exist")
-    if target.is_dir():
-        raise InputError(f"{path}: is a directory")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part" + target.suffix, dir=directory)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".part" + real.suffix, dir=directory)
+    except OSError as e:
+        raise _write_error(path, e) from None
     os.close(fd)
     try:
         yield tmp
+        if stream:
+            _copy_into(tmp, given)
+        else:
+            _commit(tmp, real)
+    except OSError as e:
+        raise _write_error(path, e) from None
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+
+
+def _copy_into(tmp: str, target: Path) -> None:
+    with open(tmp, "rb") as src, open(target, "wb") as dst:
+        shutil.copyfileobj(src, dst, 1 << 20)
+
+
+def _commit(tmp: str, target: Path) -> None:
+    try:
+        old = target.stat()
+    except FileNotFoundError:
         mask = os.umask(0)
         os.umask(mask)
         os.chmod(tmp, 0o666 & ~mask)
         os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+        return
+    if old.st_nlink > 1:
+        with open(tmp, "rb") as src, open(target, "r+b") as dst:
+            shutil.copyfileobj(src, dst, 1 << 20)
+            dst.truncate()
+            dst.flush()
+            os.fsync(dst.fileno())
+        return
+    os.chmod(tmp, stat.S_IMODE(old.st_mode))
+    os.replace(tmp, target)
 
 
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None = None) -> Iterator[IO]:
-    """Open a temporary file beside ``path``; it replaces ``path`` only if the block succeeds.
-
-    A failure part-way leaves any earlier file at ``path`` untouched and no
-    partial file behind.
-    """
+    """Open a temporary file whose content becomes ``path``'s only if the block succeeds (see :func:`atomic_path`)."""
     with atomic_path(path) as tmp:
         kwargs = {} if "b" in mode else {"encoding": "utf-8", "newline": newline}
-        with open(tmp, mode, **kwargs) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+        try:
+            with open(tmp, mode, **kwargs) as fh:
+                yield fh
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as e:
+            raise _write_error(path, e) from None
 
 
 def write_text(path: str | os.PathLike, text: str, newline: str | None = "") -> None:

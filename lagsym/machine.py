@@ -9,30 +9,91 @@ in surface units (the control points' units) are turned into millimetres by
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
 
 from .errors import ToolpathError
+from .values import as_exact, choice, finite, positive
 
-__all__ = ["Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "choice"]
+__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "UNITS", "DIRECTIONS"]
 
 DIALECTS = ("fanuc", "linuxcnc", "heidenhain", "grbl")
 TOOL_SHAPES = ("ball", "flat")
 LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
 UNITS = ("mm", "inch")
 DIRECTIONS = ("x", "y")
+MM_PER_INCH = Fraction(254, 10)
 
 
-def choice(value: str, options, what: str) -> str:
-    """Check a string option against its list; the message names the valid choices."""
-    if value not in options:
-        raise ToolpathError(f"{what} {value!r} is not one of {', '.join(options)}")
-    return value
+def program_units_per_mm(units: str) -> Fraction:
+    """Program units per millimetre: 1 for ``mm``, 1/25.4 for ``inch`` (exact)."""
+    return Fraction(1) if choice(units, UNITS, "units") == "mm" else 1 / MM_PER_INCH
 
 
-def _positive(value: float, what: str, allow_zero: bool = False) -> float:
-    v = float(value)
-    if not (v > 0 or (allow_zero and v == 0)) or v != v or v in (float("inf"),):
-        raise ToolpathError(f"{what} {value!r} must be {'zero or ' if allow_zero else ''}a positive number")
-    return v
+@dataclass(frozen=True)
+class Placement:
+    """Where the surface sits on the machine: the one map between surface units and machine millimetres.
+
+    A surface point ``(x, y, z)`` (in the control points' units) is at
+    ``(x * mm_per_unit + X0, y * mm_per_unit + Y0, z * mm_per_unit + Z0)`` on the
+    machine, ``(X0, Y0, Z0) = origin_mm``.  Every toolpath, program, simulated
+    cut and picture goes through this one map.
+
+    Examples
+    --------
+    >>> p = Placement(20.0, (100.0, 0.0, -5.0))
+    >>> p.to_machine(1.0, 2.0, 3.0)
+    (120.0, 40.0, 55.0)
+    >>> p.to_surface(120.0, 40.0)
+    (1.0, 2.0)
+    """
+
+    mm_per_unit: float = 1.0
+    origin_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "mm_per_unit", positive(self.mm_per_unit, "millimetres per surface unit"))
+        if len(self.origin_mm) != 3:
+            raise ToolpathError(f"origin {self.origin_mm!r} must be X,Y,Z")
+        object.__setattr__(self, "origin_mm", tuple(finite(v, "origin") for v in self.origin_mm))
+
+    def to_machine(self, x, y, z=None):
+        """Surface coordinates to machine millimetres: ``(x_mm, y_mm)``, or ``(x_mm, y_mm, z_mm)`` given ``z``."""
+        s, (ox, oy, oz) = self.mm_per_unit, self.origin_mm
+        xy = (np.asarray(x) * s + ox, np.asarray(y) * s + oy)
+        xy = tuple(v.item() if v.ndim == 0 else v for v in xy)
+        if z is None:
+            return xy
+        zm = np.asarray(z) * s + oz
+        return (*xy, zm.item() if zm.ndim == 0 else zm)
+
+    def to_surface(self, x_mm, y_mm):
+        """Machine millimetres to surface coordinates ``(x, y)``."""
+        s, (ox, oy, _) = self.mm_per_unit, self.origin_mm
+        x, y = (np.asarray(x_mm) - ox) / s, (np.asarray(y_mm) - oy) / s
+        return tuple(v.item() if v.ndim == 0 else v for v in (x, y))
+
+    def height_mm(self, z):
+        """A surface height in machine millimetres (the origin's Z added)."""
+        return np.asarray(z) * self.mm_per_unit + self.origin_mm[2]
+
+    def box_mm(self, bounds) -> tuple[float, float, float, float]:
+        """The surface's box ``(x0, x1, y0, y1)`` on the machine, in millimetres."""
+        x0, x1, y0, y1 = (float(v) for v in bounds)
+        (a, c), (b, d) = self.to_machine(x0, y0), self.to_machine(x1, y1)
+        return (a, b, c, d)
+
+    def exact(self, units: str = "mm") -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
+        """Program units per surface unit and the origin in program units, as exact numbers.
+
+        A float is read as the decimal it prints (see :func:`lagsym.values.as_exact`),
+        so a macro program's constants are the numbers the user typed.
+        """
+        k = program_units_per_mm(units)
+        scale = as_exact(self.mm_per_unit, "millimetres per surface unit") * k
+        origin = tuple(as_exact(v, "origin") * k for v in self.origin_mm)
+        return scale, origin
 
 
 @dataclass(frozen=True)
@@ -44,7 +105,7 @@ class Tool:
 
     def __post_init__(self):
         choice(self.shape, TOOL_SHAPES, "tool shape")
-        object.__setattr__(self, "diameter_mm", _positive(self.diameter_mm, "tool diameter", allow_zero=True))
+        object.__setattr__(self, "diameter_mm", positive(self.diameter_mm, "tool diameter", allow_zero=True))
 
     @property
     def radius_mm(self) -> float:
@@ -88,11 +149,11 @@ class MachineSettings:
         choice(self.dialect, DIALECTS, "dialect")
         choice(self.units, UNITS, "units")
         choice(self.line_ending, tuple(LINE_ENDINGS), "line ending")
-        _positive(self.scale, "scale")
-        _positive(self.feed_mm_min, "feed")
-        _positive(self.plunge_feed_mm_min, "plunge feed")
-        _positive(self.spindle_rpm, "spindle speed", allow_zero=True)
-        _positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
+        positive(self.scale, "scale")
+        positive(self.feed_mm_min, "feed")
+        positive(self.plunge_feed_mm_min, "plunge feed")
+        positive(self.spindle_rpm, "spindle speed", allow_zero=True)
+        positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
         if len(self.origin_mm) != 3:
             raise ToolpathError(f"origin {self.origin_mm!r} must be X,Y,Z")
         object.__setattr__(self, "origin_mm", tuple(float(v) for v in self.origin_mm))
@@ -143,4 +204,4 @@ class RasterSpec:
         for name in ("stepover_mm", "step_mm", "scallop_mm", "tolerance_mm"):
             v = getattr(self, name)
             if v is not None:
-                _positive(v, name.replace("_mm", "").replace("_", " "))
+                positive(v, name.replace("_mm", "").replace("_", " "))

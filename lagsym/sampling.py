@@ -2,9 +2,11 @@
 
 A :class:`SampleGrid` is a regular ``nx`` x ``ny`` grid over a box, with exact
 box corners; :func:`sample_grid` builds one from counts or from a spacing and
-checks it against the control box.  :func:`sample` returns the whole grid of
-heights; :func:`iter_blocks` yields it a block of x-rows at a time, so a
-writer can stream any number of points in bounded memory.
+checks it against the control box; :func:`axis_lines` builds each axis of
+it, exactly (comparisons and pictures take their axes from it too).
+:func:`sample` returns the whole grid of heights; :func:`iter_blocks`
+yields it a block of x-rows at a time, so a writer can stream any number of
+points in bounded memory.
 
 Points are ordered x-major, like the paper's ``p_ik``: row ``i * ny + j`` of a
 flattened sample is ``(xs[i], ys[j], F(xs[i], ys[j]))``.
@@ -23,6 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
+from .values import as_exact
 
 __all__ = [
     "MAX_AXIS_POINTS",
@@ -31,6 +34,7 @@ __all__ = [
     "SampleGrid",
     "Sample",
     "Block",
+    "axis_lines",
     "sample_grid",
     "sample",
     "iter_blocks",
@@ -62,12 +66,25 @@ class Box:
         return float(self.x0), float(self.x1), float(self.y0), float(self.y1)
 
 
-def _lines(a: Fraction, b: Fraction, n: int) -> np.ndarray:
-    """``n`` evenly spaced values from ``a`` to ``b``, each the float nearest the exact value.
+def axis_lines(a: Fraction, b: Fraction, n: int) -> np.ndarray:
+    """``n`` evenly spaced values from ``a`` to ``b``, ends included, each the float nearest the exact value.
+
+    This is the one builder of sample axes (sample grids, comparisons and
+    pictures all use it).  Each line ``a + (b - a) k / (n - 1)`` is computed
+    exactly and rounded once, so the end points are ``float(a)`` and
+    ``float(b)`` to the last bit, and a line that falls on a control node is
+    that node.  The array is read-only.
+
+    Parameters
+    ----------
+    a, b : Fraction
+        The exact ends.
+    n : int
+        Number of lines, at least 1 (one line is ``a`` alone).
 
     Examples
     --------
-    >>> _lines(Fraction(0), Fraction(3, 10), 4).tolist()
+    >>> axis_lines(Fraction(0), Fraction(3, 10), 4).tolist()
     [0.0, 0.1, 0.2, 0.3]
     """
     if n == 1:
@@ -118,12 +135,12 @@ class SampleGrid:
     @cached_property
     def xs(self) -> np.ndarray:
         """The x grid lines, read-only, each correctly rounded."""
-        return _lines(self.box.x0, self.box.x1, self.nx)
+        return axis_lines(self.box.x0, self.box.x1, self.nx)
 
     @cached_property
     def ys(self) -> np.ndarray:
         """The y grid lines, read-only, each correctly rounded."""
-        return _lines(self.box.y0, self.box.y1, self.ny)
+        return axis_lines(self.box.y0, self.box.y1, self.ny)
 
 
 class Sample(NamedTuple):
@@ -146,26 +163,6 @@ class Block(NamedTuple):
     xs: np.ndarray
     ys: np.ndarray
     z: np.ndarray
-
-
-def _exact(v, name: str) -> Fraction:
-    if isinstance(v, bool):
-        raise InputError(f"{name} = {v!r} is not a number")
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            raise InputError(f"{name} = {v!r} is not a finite number")
-        return Fraction(v)
-    if isinstance(v, str):
-        from .io import _Bad, exact_number
-
-        try:
-            return exact_number(v)
-        except _Bad as e:
-            raise InputError(f"{name}: {e}") from None
-    try:
-        return Fraction(v)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {v!r} is not a number") from None
 
 
 def _count(v, name: str) -> int:
@@ -239,7 +236,7 @@ def sample_grid(
     if len(given) != 4:
         raise InputError(f"box = {box!r} should be (x0, x1, y0, y1)")
     names = ("x0", "x1", "y0", "y1")
-    x0, x1, y0, y1 = (c if v is None else _exact(v, name) for v, c, name in zip(given, (cx0, cx1, cy0, cy1), names))
+    x0, x1, y0, y1 = (c if v is None else as_exact(v, name) for v, c, name in zip(given, (cx0, cx1, cy0, cy1), names))
     if not x0 < x1:
         raise InputError(f"x0 = {_show(x0)} should be less than x1 = {_show(x1)}")
     if not y0 < y1:
@@ -262,8 +259,8 @@ def sample_grid(
         if step is None and (dx is None or dy is None):
             raise InputError("give both dx and dy, or step for both directions")
         nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
-        sx = _exact(step if step is not None else dx, nxname)
-        sy = _exact(step if step is not None else dy, nyname)
+        sx = as_exact(step if step is not None else dx, nxname)
+        sy = as_exact(step if step is not None else dy, nyname)
         return SampleGrid(region, _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname))
     if nx is None or ny is None:
         raise InputError("give both nx and ny (or a spacing)")

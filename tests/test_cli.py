@@ -122,3 +122,14 @@ def test_console_entry_point_runs_as_a_process(tmp_path):
 def test_help_lists_the_commands(run_cli):
     status, out, _ = run_cli("--help")
     assert status == 0 and "equation" in out and "curve" in out and "check" in out
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_traceback_before_or_after_the_command(run_cli, tmp_path, where):
+    missing = tmp_path / "missing.json"
+    argv = ["--traceback", "equation", missing] if where == "before" else ["equation", "--traceback", missing]
+    status, _, err = run_cli(*argv)
+    assert status == 2
+    assert err.startswith("Traceback (most recent call last):") and err.endswith(f"{missing}: no such file\n")
+    status, _, err = run_cli("equation", missing)
+    assert err == f"lagsym: error: {missing}: no such file\n"

@@ -18,14 +18,14 @@ EX4 = str(EXAMPLES / "paper-example-4.json")
     ([EX4, "-o", "out"], "out: unknown CAD format '(no extension)'"),
     ([EX4, "--solid", "-o", "out.step"], "--solid needs --base-z Z"),
     ([EX4, "--base-z", "0", "-o", "out.step"], "--base-z 0 is for a solid: add --solid"),
-    ([EX4, "--solid", "--base-z", "nan", "-o", "out.step"], "--base-z 'nan' is not a number"),
+    ([EX4, "--solid", "--base-z", "nan", "-o", "out.step"], "--base-z: 'nan' is not a number"),
     ([EX4, "--solid", "--base-z", "1", "-o", "out.igs"],
      "--base-z 1 is not below the surface, whose lowest height is 0.1507663366"),
     ([EX4, "--solid", "--base-z", "0.1507663366", "-o", "out.json"], "is not below the surface"),
     ([EX4, "--units", "inch", "-o", "out.step"], "the file states \"units\": \"mm\", not --units inch"),
     ([EX4, "--method", "bspline", "--degree", "0", "-o", "out.step"], "B-spline degree 0 should be an integer >= 1"),
     (["missing.json", "-o", "out.step"], "missing.json: no such file"),
-    ([EX4, "-o", "no/such/folder/out.step"], "the folder no/such/folder does not exist"),
+    ([EX4, "-o", "no/such/folder/out.step"], "no/such/folder does not exist"),
 ])
 def test_bad_input_one_line_exit_2_nothing_written(run_cli, tmp_path, monkeypatch, argv, message):
     monkeypatch.chdir(tmp_path)

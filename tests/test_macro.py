@@ -13,13 +13,13 @@ import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
 from conftest import EXAMPLES
-from lagsym.errors import ProgramError, ToolpathError
+from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
 from lagsym.machine import MachineSettings, RasterSpec, Tool
 from lagsym.macro import (
-    macro_plan,
+    macro_loops,
     macro_program,
     macro_raster,
     planned_points,
@@ -143,14 +143,14 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
 
 @pytest.mark.parametrize("n", [3, 4, 5, 6, 7])
 def test_eight_digits_stay_within_a_micrometre_up_to_7x7(n):
-    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="lagrange")
-    assert predicted_error(plan, 8, rows=7, points=11) <= 1e-3
+    loops = macro_loops(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="lagrange")
+    assert predicted_error(loops, 8, rows=7, points=11) <= 1e-3
 
 
 @pytest.mark.parametrize("n", [8, 10, 12])
 def test_fifteen_digits_stay_within_a_micrometre_up_to_12x12(n):
-    plan = macro_plan(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="horner")
-    assert predicted_error(plan, 15, rows=5, points=9) <= 1e-3
+    loops = macro_loops(rough_grid(n, seed=n), machine(), RasterSpec("x", 1.0, 1.0), FLAT, form="horner")
+    assert predicted_error(loops, 15, rows=5, points=9) <= 1e-3
 
 
 def test_simulated_error_at_eight_digits_matches_the_prediction():
@@ -161,14 +161,14 @@ def test_simulated_error_at_eight_digits_matches_the_prediction():
     got = simulate(program.text, "fanuc", 8).feed_points()[1:]
     err = np.abs(got - planned_points(s, settings, raster, FLAT)).max()
     assert err <= 1e-3
-    assert err <= 3 * program.predicted_error + 2e-6
+    assert err <= 3 * program.predicted_error_mm + 2e-6
 
 
 def test_the_expanded_horner_form_fails_where_the_basis_form_holds():
     s = rough_grid(8, seed=8)
     raster = RasterSpec("x", 1.0, 1.0)
-    horner = predicted_error(macro_plan(s, machine(), raster, FLAT, "horner"), 8, 7, 11)
-    basis = predicted_error(macro_plan(s, machine(), raster, FLAT, "lagrange"), 8, 7, 11)
+    horner = predicted_error(macro_loops(s, machine(), raster, FLAT, "horner"), 8, 7, 11)
+    basis = predicted_error(macro_loops(s, machine(), raster, FLAT, "lagrange"), 8, 7, 11)
     assert horner > 1e-3 > basis
 
 
@@ -212,14 +212,14 @@ def test_stats_compare_with_the_point_list():
 
 
 def test_stats_from_a_sample_are_close_to_the_full_count():
-    from lagsym.macro.plan import points_at, sample_positions
+    from lagsym.macro import points_at, sample_positions
 
     s = surface("paper-example-4")
     settings = machine(dialect="fanuc", scale=20.0)
     raster = RasterSpec("x", 0.5, 0.2)
     program = macro_program(s, settings, raster, FLAT)
     full = program_stats(program, planned_points(s, settings, raster, FLAT), settings)
-    sample = points_at(s, settings, FLAT, *sample_positions(program.plan.raster, 101))
+    sample = points_at(s, settings, FLAT, *sample_positions(program.loops.raster, 101))
     estimate = program_stats(program, sample, settings, count=full.points)
     assert estimate.points == full.points
     assert estimate.point_list_bytes == pytest.approx(full.point_list_bytes, rel=0.01)
@@ -238,10 +238,10 @@ def test_point_list_size_counts_what_fixed_would_write():
 
 def test_raster_is_counted_and_clamped_to_the_box():
     s = surface("paper-example-1")  # x 1..5, y 2..4
-    plan = macro_raster(s, machine(scale=10.0), RasterSpec("x", 7.0, 3.0))
-    assert (plan.points.count, plan.rows.count) == (14, 3)  # 40 mm / 3 -> 14 steps, 20 mm / 7 -> 3
-    assert plan.points.clamped and plan.rows.clamped
-    x, y = raster_positions(plan)
+    counted = macro_raster(s, machine(scale=10.0), RasterSpec("x", 7.0, 3.0))
+    assert (counted.points.count, counted.rows.count) == (14, 3)  # 40 mm / 3 -> 14 steps, 20 mm / 7 -> 3
+    assert counted.points.clamped and counted.rows.clamped
+    x, y = raster_positions(counted)
     assert x[14] == 50.0 and x[13] == 49.0 and x[15] == 50.0  # clamped, then the reversed row starts there
     assert sorted(set(y)) == [20.0, 27.0, 34.0, 40.0]
 
@@ -353,8 +353,27 @@ def test_inch_programs_are_in_inches():
 
 
 def test_unknown_dialect_names_the_choices():
-    with pytest.raises(ToolpathError, match="fanuc, linuxcnc, heidenhain"):
+    with pytest.raises(InputError, match="fanuc, linuxcnc, heidenhain"):
         macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
+
+
+def test_unknown_precision_and_form_name_the_choices():
+    with pytest.raises(InputError, match="precision 9 is not one of 8, 15"):
+        macro_program(surface("paper-example-1"), machine(), RasterSpec(), FLAT, precision=9)
+    with pytest.raises(InputError, match="horner, lagrange"):
+        macro_program(surface("paper-example-1"), machine(), RasterSpec(), FLAT, form="monomial")
+
+
+def test_the_macro_modules_import_one_way():
+    """No module of lagsym.macro imports one above it, not even inside a function."""
+    import grimp
+
+    graph = grimp.build_graph("lagsym")
+    order = ["model", "_placement", "raster", "form", "ballend", "points", "loops", "accuracy", "program"]
+    for low, module in enumerate(order):
+        for high in order[low + 1:]:
+            assert not graph.direct_import_exists(importer=f"lagsym.macro.{module}",
+                                                  imported=f"lagsym.macro.{high}"), (module, high)
 
 
 # ---------------------------------------------------------------- command line
@@ -459,11 +478,11 @@ def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
     from lagsym.lagrange import X, Y
 
     s = surface("paper-example-3")
-    plan = macro_plan(s, machine(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
+    loops = macro_loops(s, machine(scale=1.0), RasterSpec("x", 1.0, 1.0), Tool("ball", 0.01), "horner")
     ctx = decimal_context(30)
-    env = run(plan.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
+    env = run(loops.row_code, {"r": ctx.create_decimal("2.5")}, ctx)
     env["p"] = ctx.create_decimal("1.75")
-    run(plan.point_code, env, ctx)
+    run(loops.point_code, env, ctx)
     fx = s.derivative(1, 0).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
     fy = s.derivative(0, 1).as_expr().subs({X: Fraction(7, 4), Y: Fraction(5, 2)})
     assert float(env["zp"]) == pytest.approx(float(fx), rel=1e-20, abs=1e-20)

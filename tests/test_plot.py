@@ -15,6 +15,7 @@ and look at every image in tests/reference_images/ before committing it.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -23,12 +24,24 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import EXAMPLES, ROOT
+from conftest import EXAMPLES, ROOT, missing_system_package
 from lagsym import plot
-from lagsym.errors import InputError
+from lagsym.errors import InputError, RenderError
 from lagsym.evaluate import evaluate_grid
 from lagsym.io import read_curve_points, read_points
 from lagsym.lagrange import lagrange_curve, lagrange_surface
+from lagsym.plot.surface import sampled_surface
+from lagsym.sampling import sample_grid
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _offscreen_opengl():
+    """Every test here draws: without an OpenGL to draw with, they skip naming the packages to install."""
+    try:
+        plot.rendering_backend()
+    except RenderError:
+        missing_system_package("libegl1 libegl-mesa0 libgl1-mesa-dri", "an offscreen OpenGL (EGL or OSMesa)")
+
 
 REFERENCE = Path(__file__).resolve().parent / "reference_images"
 UPDATE = os.environ.get("LAGSYM_UPDATE_REFERENCE_IMAGES") == "1"
@@ -286,8 +299,10 @@ def test_rendering_backend_is_known():
 @pytest.mark.skipif(sys.platform != "linux", reason="Xvfb is the Linux fallback")
 def test_xvfb_fallback_renders():
     """The last resort where neither EGL nor OSMesa works: a private Xvfb server, gone with its process."""
+    if shutil.which("Xvfb") is None:
+        missing_system_package("xvfb", "Xvfb")
     code = (
-        "import os; from lagsym.plot import _start_xvfb\n"
+        "import os; from lagsym.plot.backend import _start_xvfb\n"
         "os.environ['DISPLAY'] = _start_xvfb()\n"
         "os.environ['VTK_DEFAULT_OPENGL_WINDOW'] = 'vtkXOpenGLRenderWindow'\n"
         "import pyvista as pv\n"
@@ -299,6 +314,32 @@ def test_xvfb_fallback_renders():
     done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert int(done.stdout.split()[-1]) >= 5  # a red sphere fills part of the picture
+
+
+def test_pictures_without_ipython(tmp_path):
+    """A plain install has no IPython: pictures are drawn all the same (pyvista's notebook setting is skipped)."""
+    code = (
+        "import importlib.abc, sys\n"
+        "class NoIPython(importlib.abc.MetaPathFinder):\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name.split('.')[0] == 'IPython':\n"
+        "            raise ModuleNotFoundError(name)\n"
+        "sys.meta_path.insert(0, NoIPython())\n"
+        "from lagsym.cli import main\n"
+        f"sys.exit(main(['plot', {str(EXAMPLES / 'paper-example-1.json')!r}, '-o', {str(tmp_path / 'a.png')!r}]))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+
+
+def test_figures_sample_on_the_exact_lines(surface4):
+    """The pictures take their axes from the one builder, so every node is a sample, to the last bit."""
+    xs, ys, z = sampled_surface(surface4, 41)
+    g = sample_grid(surface4, 41, 41)
+    assert xs.tolist() == g.xs.tolist() and ys.tolist() == g.ys.tolist()
+    assert xs[::10].tolist() == surface4.grid.x_array.tolist()
+    assert z[::10, ::10].tolist() == surface4.grid.z_array.tolist()
 
 
 # ----------------------------------------------------------------------------- errors name the value

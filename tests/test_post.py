@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lagsym.errors import ProgramError, ToolpathError
+from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
@@ -95,7 +95,7 @@ def test_safe_z_must_clear_the_path(path4):
 
 
 def test_unknown_dialect_names_the_choices():
-    with pytest.raises(ToolpathError, match="fanuc"):
+    with pytest.raises(InputError, match="fanuc"):
         MachineSettings(dialect="sinumerik")
     with pytest.raises(ProgramError, match="point-list writer"):
         writer("heidenhain")
@@ -134,3 +134,12 @@ def test_the_interpreter_check_catches_a_bad_program(rs274):
         interpret(rs274, "G21 G90\nG1 X1. F100.\nG1 X2. Q5.\nM2\n")
     with pytest.raises(AssertionError, match="no percent sign or program end"):
         interpret(rs274, "G21 G90\nG1 X1. F100.\n")
+
+
+def test_the_dialect_modules_do_not_import_the_writer_table():
+    """lagsym.post.program imports the dialects for WRITERS; nothing below it imports it back."""
+    import grimp
+
+    graph = grimp.build_graph("lagsym")
+    for module in ("fanuc", "linuxcnc", "grbl", "model", "moves", "numbers"):
+        assert not graph.find_shortest_chain(importer=f"lagsym.post.{module}", imported="lagsym.post.program")

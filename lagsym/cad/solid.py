@@ -22,6 +22,7 @@ from fractions import Fraction
 from math import comb
 
 from ..errors import InputError
+from ..values import as_exact
 from .patch import BezierPatch, BSplinePatch, split_half
 
 __all__ = ["HeightBounds", "lowest_height", "check_base", "exact_height", "volume", "polynomial_volume"]
@@ -134,22 +135,16 @@ def check_base(patch: BSplinePatch | BezierPatch, base_z, source: str = "<surfac
 
 
 def exact_height(value, name: str = "base_z", source: str = "<surface>") -> Fraction:
-    """A height as an exact number: ints, Fractions, and text as in points files (``"1.06"``, ``"-1/3"``).
+    """A height as an exact number, by lagsym's one policy (:func:`lagsym.values.as_exact`).
 
-    A float is read as the shortest decimal that prints it (``0.1`` is 1/10).
+    Examples
+    --------
+    >>> exact_height("1.06"), exact_height(0.1)
+    (Fraction(53, 50), Fraction(1, 10))
     """
-    from ..io import _Bad, exact_number
-
-    if isinstance(value, bool) or not isinstance(value, (int, Fraction, float, str)):
+    if value is None or isinstance(value, (list, tuple, dict)):
         raise InputError(f"{source}: {name} {value!r} is not a number")
-    if isinstance(value, float):
-        value = repr(value)
-    if isinstance(value, str):
-        try:
-            return exact_number(value)
-        except _Bad as e:
-            raise InputError(f"{source}: {name} {e}") from None
-    return Fraction(value)
+    return as_exact(value, f"{source}: {name}")
 
 
 def _height(v: Fraction, tol: Fraction) -> str:

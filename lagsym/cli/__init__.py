@@ -1,22 +1,26 @@
 """The ``lagsym`` command: parse arguments, call the library, print, map errors to exit statuses.
 
-Each sub-command lives in its own module in this package and defines ``NAME``,
-``ORDER``, ``HELP``, ``add_arguments(parser)`` and ``run(args, out, err) -> int``.
-:func:`main` takes ``argv`` and the two streams so tests call it directly.
+Each sub-command lives in its own module in this package, named as the command,
+and defines ``DESCRIPTION``, ``add_arguments(parser)`` and
+``run(args, out, err) -> int``; :data:`COMMANDS` lists them with their help
+lines.  :func:`main` takes ``argv`` and the two streams so tests call it
+directly.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
-import pkgutil
+import signal
 import sys
+import threading
 import traceback
 from typing import IO, Sequence
 
-from ..errors import ExitStatus, LagsymError
+from ..errors import ExitStatus, LagsymError, Terminated
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "COMMANDS", "command_module"]
 
 INTERNAL_ERROR = 70
 
@@ -46,29 +50,52 @@ class _ParserExit(Exception):
         self.status = status
 
 
-def _commands():
-    from . import __name__ as pkg, __path__ as path
+# The commands in the order ``lagsym --help`` lists them (the order of the data flow), each with
+# its one-line help.  A command's module (lagsym/cli/<name>.py) is imported only when that command
+# runs or shows its own help, so ``lagsym --help`` and ``--version`` load no numeric library.
+COMMANDS = {
+    "equation": "print the exact Lagrange surface z = F(x, y) through a grid of control points",
+    "curve": "print the exact Lagrange curve y = F(x) through a set of points",
+    "check": "measure degree, spacing ratio, Lebesgue constants and overshoot of a surface or curve",
+    "sample": "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)",
+    "export": "write the exact surface as a CAD file: STEP or IGES B-spline surface or solid, exact JSON",
+    "compare": "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)",
+    "plot": "draw the surface, its basis functions or a curve (an image with -o, else a window)",
+    "toolpath": "plan a raster toolpath over the exact surface and write it as G-code",
+    "verify": "simulate a G-code program's cut on a height map and report gouge, scallop and area not reached",
+    "macro": "write a macro program that evaluates the surface on the control (Fanuc, LinuxCNC, Heidenhain)",
+    "simulate": "dry-run a macro program at the control's precision and write the moves it makes",
+    "send": "send a program to a CNC control over RS-232 (upload to memory or drip feed)",
+    "receive": "receive a program punched out by a CNC control over RS-232",
+}
 
-    mods = []
-    for info in pkgutil.iter_modules(path):
-        if info.name.startswith("_"):
-            continue
-        mod = importlib.import_module(f"{pkg}.{info.name}")
-        if hasattr(mod, "NAME") and hasattr(mod, "run"):
-            mods.append(mod)
-    return sorted(mods, key=lambda m: (getattr(m, "ORDER", 100), m.NAME))
+
+def command_module(name: str):
+    """The module of the command ``name`` (imported on first use)."""
+    return importlib.import_module(f"{__name__}.{name}")
 
 
-def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr) -> argparse.ArgumentParser:
-    """The argument parser with every sub-command registered."""
+def _chosen(argv: Sequence[str]) -> str | None:
+    """The command named on the command line: its first word that is not an option (global options take no value)."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
+
+
+def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None) -> argparse.ArgumentParser:
+    """The argument parser; the commands in ``load`` (default: all) get their full arguments."""
     from .. import __version__
 
     class Parser(_Parser):
         pass
 
     Parser.out, Parser.err = out, err
+    # --traceback is accepted before or after the command: no default, so the command's parser cannot
+    # undo a --traceback given before it (main reads it with getattr).
     common = Parser(add_help=False)
-    common.add_argument("--traceback", action="store_true", help="show the full traceback on an error")
+    common.add_argument("--traceback", action="store_true", default=argparse.SUPPRESS,
+                        help="show the full traceback on an error")
     parser = Parser(
         prog="lagsym",
         description="Exact Lagrange surfaces from a few control points, to the machine.",
@@ -76,9 +103,13 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr) -> argpar
     )
     parser.add_argument("--version", action="version", version=f"lagsym {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
-    for mod in _commands():
-        p = sub.add_parser(mod.NAME, help=mod.HELP, description=getattr(mod, "DESCRIPTION", mod.HELP), parents=[common],
-                           formatter_class=argparse.RawDescriptionHelpFormatter)
+    for name, help_line in COMMANDS.items():
+        if load is not None and name not in load:
+            sub.add_parser(name, help=help_line, parents=[common])
+            continue
+        mod = command_module(name)
+        p = sub.add_parser(name, help=help_line, description=getattr(mod, "DESCRIPTION", help_line),
+                           parents=[common], formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run)
     return parser
@@ -89,7 +120,8 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
     out = stdout if stdout is not None else sys.stdout
     err = stderr if stderr is not None else sys.stderr
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser(out, err)
+    chosen = _chosen(argv)
+    parser = build_parser(out, err, load=() if chosen is None else (chosen,))
     try:
         args = parser.parse_args(argv)
     except _ParserExit as e:
@@ -98,23 +130,46 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         parser.print_help(out)
         return ExitStatus.BAD_INPUT
     try:
-        return int(args._run(args, out, err))
+        with _signals_as_interrupts():
+            return int(args._run(args, out, err))
     except LagsymError as e:
-        if args.traceback:
+        if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         err.write(f"lagsym: error: {e}\n")
         return int(e.exit_status)
+    except Terminated as e:
+        err.write(f"lagsym: stopped by {signal.Signals(e.signum).name}; no partial output file is left\n")
+        return 128 + e.signum
     except KeyboardInterrupt:
-        err.write("lagsym: interrupted\n")
+        err.write("lagsym: interrupted; no partial output file is left\n")
         return ExitStatus.INTERRUPTED
     except BrokenPipeError:
         return ExitStatus.OK
     except Exception as e:  # a bug in lagsym: say so in one line unless the user asks for more
-        if args.traceback:
+        if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         else:
             err.write(f"lagsym: internal error: {type(e).__name__}: {e} (run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+@contextlib.contextmanager
+def _signals_as_interrupts():
+    """SIGTERM and SIGHUP (a closed terminal) stop a command the way Ctrl-C does: temporary files removed,
+    a transfer's resume block named, one line, exit 128 + the signal (143, 129)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated(signum)
+
+    old = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def run_console() -> None:

@@ -5,9 +5,8 @@ from __future__ import annotations
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
-from ..macro import MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, program_stats
-from ..macro.form import FORMS
-from ..macro.plan import points_at, sample_positions
+from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
+                     sample_positions)
 from ._common import emit, origin
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -92,13 +91,13 @@ def run(args, out, err) -> int:
                             tolerance_mm=args.tolerance, variable_base=args.variable_base, form=args.form)
     emit(program.text, args.output, out)
     if args.stats:
-        plan = program.plan.raster
-        if plan.size <= STATS_POINTS:
+        counted = program.loops.raster
+        if counted.size <= STATS_POINTS:
             stats = program_stats(program, planned_points(surface, settings, raster, tool), settings)
         else:  # a sample, scaled: a list of millions of points is not worth building to count it
-            sample = points_at(surface, settings, tool, *sample_positions(plan, 1001))
-            stats = program_stats(program, sample, settings, count=plan.size)
+            sample = points_at(surface, settings, tool, *sample_positions(counted, 1001))
+            stats = program_stats(program, sample, settings, count=counted.size)
         report = (stats.text() + f"\npredicted arithmetic error at {program.precision} digits: "
-                  f"{program.predicted_error:.2g} mm\n")
+                  f"{program.predicted_error_mm:.2g} mm\n")
         (out if args.output and args.output != "-" else err).write(report)
     return 0

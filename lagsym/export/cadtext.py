@@ -9,17 +9,15 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from ..errors import InputError
 from ..io import UNITS
+from ..values import choice
 
 __all__ = ["UNITS", "check_units", "real", "multiplicities"]
 
 
 def check_units(units: str) -> str:
     """``units`` if it is one lagsym can write, else an InputError naming the choices."""
-    if units not in UNITS:
-        raise InputError(f"units {units!r} is not one of {', '.join(UNITS)}")
-    return units
+    return choice(units, UNITS, "units")
 
 
 def real(v) -> str:

@@ -3,27 +3,29 @@
 A point-list program for a fine finish runs to hundreds of kilobytes; a macro
 program loops over integer-counted rows and points and computes each height on
 the control from a well-conditioned form of the exact polynomial, so its size
-does not depend on the step.  One module per dialect (:mod:`.fanuc`,
-:mod:`.linuxcnc`, :mod:`.heidenhain`) renders the shared loop plan
-(:mod:`.program`); :mod:`.form` holds the normalized Horner form, :mod:`.plan`
-the raster and the points a program should produce, :mod:`.ballend` the
-normal offset and gouge check of a ball-end cutter, :mod:`.stats` the size
-comparison with a point list.  :mod:`lagsym.simulate` dry-runs the result.
+does not depend on the step.  The modules, in the order data flows through them:
+
+- :mod:`.model`: statements and expressions, and the control's decimal arithmetic;
+- :mod:`.raster`: the raster counted on the control (:class:`MacroRaster`);
+- :mod:`.form`: the normalized Horner or Lagrange form and its statements;
+- :mod:`.ballend`: the normal offset and gouge check of a ball-end cutter;
+- :mod:`.points`: the points a program should produce, computed on the PC;
+- :mod:`.loops`: the counted loops every dialect renders (:class:`MacroLoops`);
+- :mod:`.accuracy`: the control's arithmetic error, predicted;
+- :mod:`.fanuc`, :mod:`.linuxcnc`, :mod:`.heidenhain`: one renderer a dialect;
+- :mod:`.program`: :func:`macro_program`, the one entry point;
+- :mod:`.stats`: the size comparison with a point list.
+
+:mod:`lagsym.simulate` dry-runs the result.
 """
 
+from .accuracy import predicted_error
 from .ballend import check_gouge, tip_points
 from .form import FORMS, RowForm, row_form
-from .plan import MacroRaster, macro_raster, planned_points, raster_positions
-from .program import (
-    DEFAULT_PRECISION,
-    MACRO_DIALECTS,
-    PRECISIONS,
-    MacroPlan,
-    MacroProgram,
-    macro_plan,
-    macro_program,
-    predicted_error,
-)
+from .loops import MacroLoops, macro_loops
+from .points import planned_points, points_at
+from .program import DEFAULT_PRECISION, MACRO_DIALECTS, PRECISIONS, MacroProgram, macro_program
+from .raster import MacroRaster, macro_raster, raster_positions, sample_positions
 from .stats import ProgramStats, point_list_size, program_stats, transfer_seconds
 
 __all__ = [
@@ -31,21 +33,23 @@ __all__ = [
     "FORMS",
     "MACRO_DIALECTS",
     "PRECISIONS",
-    "MacroPlan",
+    "MacroLoops",
     "MacroProgram",
     "MacroRaster",
     "ProgramStats",
     "RowForm",
     "check_gouge",
-    "macro_plan",
+    "macro_loops",
     "macro_program",
     "macro_raster",
     "planned_points",
     "point_list_size",
+    "points_at",
     "predicted_error",
     "program_stats",
     "raster_positions",
     "row_form",
+    "sample_positions",
     "tip_points",
     "transfer_seconds",
 ]

@@ -8,10 +8,12 @@ derivatives, the programmed tip is
     P' = P - q * Zp,   R' = R - q * Zr,   Z' = Z + q - rho,   q = (rho + stock) / w.
 
 The control computes ``Zp`` and ``Zr`` from the same well-conditioned form as
-``Z``.  Where the surface is concave with a radius of curvature below the
-ball's, the offset point is not the nearest and the ball cuts into the part;
-:func:`check_gouge` finds that off-line, over the raster (every position, or
-1001 x 1001 of them evenly spread for a finer one), and refuses.
+``Z`` (:func:`offset_statements`); the PC computes the same tip in floats
+(:func:`offset_points`).  Where the surface is concave with a radius of
+curvature below the ball's, the offset point is not the nearest and the ball
+cuts into the part: :func:`check_gouge` finds that off-line, over the raster
+(every position, or 1001 x 1001 of them evenly spread for a finer one), and
+refuses.
 """
 
 from __future__ import annotations
@@ -23,12 +25,33 @@ from numpy.polynomial import polynomial as P
 
 from ..errors import ToolpathError
 from ..lagrange import LagrangeSurface
-from ..machine import MachineSettings, RasterSpec, Tool
-from .form import RowForm, point_statements, row_form, row_statements
+from ..machine import MachineSettings, Tool
+from ..values import as_exact
+from .form import RowForm, row_form
 from .model import Assign, add, const, div, mul, sqrt, sub, var
-from .plan import exact, macro_raster, sample_positions
+from .raster import MacroRaster, sample_positions
 
-__all__ = ["ballend_plan", "offset_points", "tip_points", "check_gouge", "derivatives"]
+__all__ = ["is_ball", "ball_offsets", "contact_form", "offset_points", "offset_statements", "TIP_OUTPUTS",
+           "check_gouge", "check_gouge_over", "tip_points", "derivatives"]
+
+TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is computed into
+
+
+def is_ball(tool: Tool | None) -> bool:
+    """True for a ball-end cutter with a diameter: one that is offset along the normal."""
+    return tool is not None and tool.shape == "ball" and tool.diameter_mm > 0
+
+
+def ball_offsets(settings: MachineSettings, tool: Tool) -> tuple[float, float]:
+    """The ball's radius and its centre's distance from the surface (radius plus stock), in program units."""
+    uf = settings.unit_factor
+    return tool.radius_mm * uf, (tool.radius_mm + settings.stock_to_leave_mm) * uf
+
+
+def contact_form(surface: LagrangeSurface, settings: MachineSettings, direction: str = "x",
+                 kind: str = "horner") -> RowForm:
+    """The row form of the surface the ball touches: without the stock, which is in the offset."""
+    return row_form(surface, dataclasses.replace(settings, stock_to_leave_mm=0.0), direction, kind)
 
 
 def derivatives(form: RowForm, p, r) -> dict[str, np.ndarray]:
@@ -57,8 +80,18 @@ def offset_points(form: RowForm, radius: float, offset: float, p, r):
     return np.asarray(p) - q * f["zp"], np.asarray(r) - q * f["zr"], f["z"] + q - radius
 
 
-def _no_stock(settings: MachineSettings) -> MachineSettings:
-    return dataclasses.replace(settings, stock_to_leave_mm=0.0)
+def offset_statements(radius: float, offset: float) -> tuple:
+    """Statements run once per point after the height and slopes: the tip into :data:`TIP_OUTPUTS`."""
+    p, r, z = var("p"), var("r"), var("z")
+    zp, zr, q = var("zp"), var("zr"), var("q")
+    pt, rt, zt = (var(n) for n in TIP_OUTPUTS)
+    return (
+        Assign(q, add(add(mul(zp, zp), mul(zr, zr)), const(1))),
+        Assign(q, div(const(as_exact(offset, "ball offset")), sqrt(q))),
+        Assign(pt, sub(p, mul(q, zp))),
+        Assign(rt, sub(r, mul(q, zr))),
+        Assign(zt, sub(add(z, q), const(as_exact(radius, "ball radius")))),
+    )
 
 
 def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", unit: float = 1.0) -> None:
@@ -84,43 +117,15 @@ def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", u
             f"or the point-list toolpath (lagsym toolpath, drop-cutter)")
 
 
-def ballend_plan(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec, tool: Tool,
-                 form: str = "horner"):
-    """The loop plan for a ball-end cutter: height, exact slopes and the normal offset on the control."""
-    from .program import MacroPlan, loop_plan
-
-    plan = macro_raster(surface, settings, raster)
-    rf = row_form(surface, _no_stock(settings), plan.direction, form)
-    uf = settings.unit_factor
-    radius = tool.radius_mm * uf
-    offset = (tool.radius_mm + settings.stock_to_leave_mm) * uf
-    xs, ys = sample_positions(plan, 1001)
-    pr, rr = (xs, ys) if plan.direction == "x" else (ys, xs)
-    check_gouge(rf, pr, rr, offset, surface.grid.source, uf)
-    p, r, z = var("p"), var("r"), var("z")
-    zp, zr, q = var("zp"), var("zr"), var("q")
-    row_code = tuple(row_statements(rf, r, slopes=True))
-    point_code = tuple(point_statements(rf, p, z, slopes=True)) + (
-        Assign(q, add(add(mul(zp, zp), mul(zr, zr)), const(1))),
-        Assign(q, div(const(exact(offset)), sqrt(q))),
-        Assign(var("pt"), sub(p, mul(q, zp))),
-        Assign(var("rt"), sub(r, mul(q, zr))),
-        Assign(var("zt"), sub(add(z, q), const(exact(radius)))),
-    )
-    outputs = ("pt", "rt", "zt")
-    p0, r0, z0 = offset_points(rf, radius, offset, np.array([float(plan.points.start)]),
-                               np.array([float(plan.rows.start)]))
-    start = (float(p0[0]), float(r0[0]), float(z0[0]))
-    if plan.direction == "y":
-        start = (start[1], start[0], start[2])
-    return MacroPlan(body=loop_plan(plan, rf, row_code, point_code, outputs), raster=plan, form=rf, start=start,
-                     row_code=row_code, point_code=point_code, outputs=outputs,
-                     ball_radius=radius, ball_offset=offset)
+def check_gouge_over(form: RowForm, raster: MacroRaster, offset: float, source: str, unit: float) -> None:
+    """:func:`check_gouge` over the raster: every position, or 1001 x 1001 of them evenly spread."""
+    xs, ys = sample_positions(raster, 1001)
+    p, r = (xs, ys) if raster.direction == "x" else (ys, xs)
+    check_gouge(form, p, r, offset, source, unit)
 
 
 def tip_points(surface: LagrangeSurface, settings: MachineSettings, tool: Tool, x, y) -> np.ndarray:
     """The tool-tip points (N, 3) of a ball-end cutter in contact at raster positions (x, y), program units."""
-    rf = row_form(surface, _no_stock(settings), "x")
-    uf = settings.unit_factor
-    px, py, pz = offset_points(rf, tool.radius_mm * uf, (tool.radius_mm + settings.stock_to_leave_mm) * uf, x, y)
+    radius, offset = ball_offsets(settings, tool)
+    px, py, pz = offset_points(contact_form(surface, settings, "x"), radius, offset, x, y)
     return np.column_stack([px, py, pz])

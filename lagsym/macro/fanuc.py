@@ -1,7 +1,7 @@
 """Fanuc Custom Macro B (also Haas): ``#`` variables, ``WHILE [..] DOm .. ENDm``, ``[ ]`` brackets.
 
 Limits kept (see docs/macros.md): common variables ``#100-#199`` or
-``#500-#999``; at most 3 nested ``DO`` levels (the plan uses 2); at most 5
+``#500-#999``; at most 3 nested ``DO`` levels (the program uses 2); at most 5
 nested brackets (expressions here use at most 2); a decimal point on every
 constant, at most 8 significant digits on 8-digit controls, no exponent;
 ``O`` number 1-9999; ``%`` framing.
@@ -25,10 +25,10 @@ def _comment(text: str) -> str:
     return "(" + text.upper().replace("(", "").replace(")", "") + ")"
 
 
-def render(plan, settings, precision: int = 8, variable_base: int | None = None) -> str:
-    """The Fanuc macro program for ``plan`` as text with the settings' line endings."""
+def render(loops, settings, precision: int = 8, variable_base: int | None = None) -> str:
+    """The Fanuc macro program for ``loops`` (a :class:`~lagsym.macro.loops.MacroLoops`) as text with the settings' line endings."""
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
-    number = number_variables(plan.body, base, VARIABLE_RANGES)
+    number = number_variables(loops.body, base, VARIABLE_RANGES)
 
     def name(v):
         return f"#{number[v.name]}"
@@ -38,16 +38,16 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
 
     dp = settings.digits
     out = ["%", f"O{settings.program_number:04d} {_comment('lagsym surface macro')}"]
-    out.append(_comment(f"surface {plan.form.shape[0]}x{plan.form.shape[1]} normalized {plan.form.kind}, "
+    out.append(_comment(f"surface {loops.form.shape[0]}x{loops.form.shape[1]} normalized {loops.form.kind}, "
                         f"{precision} digit arithmetic"))
-    out.append(_comment(f"{plan.raster.size} points, rows along {plan.raster.direction}"))
+    out.append(_comment(f"{loops.raster.size} points, rows along {loops.raster.direction}"))
     out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90")
     out.append(settings.work_offset)
     out.append(f"T{settings.tool_number} M6")
     out.append(f"G43 H{settings.tool_number} G0 Z{fixed(settings.safe_z_mm * settings.unit_factor, dp)}")
     if settings.spindle_rpm:
         out.append(f"S{int(round(settings.spindle_rpm))} M3")
-    x0, y0, z0 = plan.start
+    x0, y0, z0 = loops.start
     out.append(f"G0 X{fixed(x0, dp)} Y{fixed(y0, dp)}")
     out.append(f"G1 Z{fixed(z0, dp)} F{fixed(settings.plunge_feed_mm_min * settings.unit_factor, 1, trim=True)}")
     out.append(f"F{fixed(settings.feed_mm_min * settings.unit_factor, 1, trim=True)}")
@@ -71,7 +71,7 @@ def render(plan, settings, precision: int = 8, variable_base: int | None = None)
             elif isinstance(s, Move):
                 out.append(f"G1 X{name(s.x)} Y{name(s.y)} Z{name(s.z)}")
 
-    emit(plan.body, 0)
+    emit(loops.body, 0)
     out.append(f"G0 Z{fixed(settings.safe_z_mm * settings.unit_factor, dp)}")
     out += ["M5", "M30", "%"]
     for line in out:

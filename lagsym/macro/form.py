@@ -36,9 +36,10 @@ from fractions import Fraction
 
 from ..grid import grid_from_table
 from ..lagrange import LagrangeSurface, lagrange_surface
-from ..machine import MachineSettings, choice
+from ..machine import MachineSettings
+from ..values import choice
+from ._placement import placement
 from .model import Assign, Const, Var, add, const, mul, sub, var
-from .plan import exact
 
 __all__ = ["FORMS", "RowForm", "row_form", "row_statements", "point_statements", "differentiation_matrix"]
 
@@ -104,14 +105,13 @@ def row_form(surface: LagrangeSurface, settings: MachineSettings, direction: str
     (((Fraction(3, 2), Fraction(1, 2)), (Fraction(1, 1), Fraction(0, 1))), Fraction(1, 1), Fraction(1, 1))
     """
     g = surface.grid
-    uf = exact(settings.unit_factor)
-    s = exact(settings.scale) * uf
-    ox, oy, oz = (exact(v) * uf for v in settings.origin_mm)
+    place = placement(settings)
+    s, (ox, oy, oz) = place.scale, place.origin
     xc, xk, un = _norm(g.x, s, ox)
     yc, yk, vn = _norm(g.y, s, oy)
     zn = [[z * s for z in row] for row in g.z]
     c = lagrange_surface(grid_from_table(un, vn, zn)).coefficients
-    z0 = oz + exact(settings.stock_to_leave_mm) * uf
+    z0 = oz + place.stock
     zt = tuple(tuple(row) for row in zn)
     choice(kind, FORMS, "form")
     if direction == "x":

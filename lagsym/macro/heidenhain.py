@@ -3,7 +3,7 @@
 Every operation is one ``FN`` block: ``FN 0`` assigns, ``FN 1``-``FN 4`` add,
 subtract, multiply and divide, ``FN 12: IF .. LT .. GOTO LBL n`` jumps.  A
 loop is a label, its body, an increment and a conditional jump back, so it
-runs at least once (every loop of the plan does).  Blocks are numbered from
+runs at least once (every loop of a surface program does).  Blocks are numbered from
 0; positions and constants carry a sign, as the TNC writes them.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 from ..errors import ProgramError
 from ..post.numbers import fixed
 from ._render import literal, number_variables
-from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var
+from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var, variables
 
 __all__ = ["render", "VARIABLE_RANGES", "DEFAULT_BASE", "MAX_LABEL"]
 
@@ -36,88 +36,94 @@ def _signed(text: str) -> str:
     return text if text.startswith("-") else "+" + text
 
 
-def render(plan, settings, precision: int = 8, variable_base: int | None = None) -> str:
-    """The Heidenhain program for ``plan``: ``FN`` arithmetic on Q parameters, labels and jumps."""
-    from .model import variables
+class _Blocks:
+    """The FN blocks of the loops: Q numbers, labels and the block list they are appended to."""
 
-    base = DEFAULT_BASE if variable_base is None else int(variable_base)
-    names = variables(plan.body) + [f"h{n}" for n in range(SCRATCH)]
-    number = number_variables([Assign(Var(n), Const(0)) for n in names], base, VARIABLE_RANGES, letter="Q")
-    dp = settings.digits
-    unit = "MM" if settings.units == "mm" else "INCH"
+    def __init__(self, number: dict[str, int], precision: int, feed: str, out: list[str]):
+        self.number, self.precision, self.feed, self.out = number, precision, feed, out
+        self.labels = iter(range(1, MAX_LABEL + 1))
 
-    def q(v: Var) -> str:
-        return f"Q{number[v.name]}"
+    def q(self, v: Var) -> str:
+        return f"Q{self.number[v.name]}"
 
-    def operand(e) -> str:
+    def operand(self, e) -> str:
         if isinstance(e, Var):
-            return "+" + q(e)
-        return _signed(literal(e.value, precision))
+            return "+" + self.q(e)
+        return _signed(literal(e.value, self.precision))
 
-    def pos(v) -> str:
-        return _signed(fixed(v, dp))
-
-    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}",
-                      f"; lagsym surface macro, {plan.form.shape[0]}x{plan.form.shape[1]}, "
-                      f"normalized {plan.form.kind} form",
-                      f"; {plan.raster.size} points, rows along {plan.raster.direction}, {precision}-digit arithmetic",
-                      f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
-                      f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M3"]
-    x0, y0, z0 = plan.start
-    out.append(f"L X{pos(x0)} Y{pos(y0)} R0 FMAX")
-    out.append(f"L Z{pos(z0)} R0 F{int(round(settings.plunge_feed_mm_min * settings.unit_factor))}")
-    feed = f"F{int(round(settings.feed_mm_min * settings.unit_factor))}"
-    labels = iter(range(1, MAX_LABEL + 1))
-
-    def assign(target: Var, e, depth: int = 0) -> None:
+    def assign(self, target: Var, e, depth: int = 0) -> None:
         # One FN block per operation.  The left operand is built in the target itself
         # (unless the right operand reads the target), the right one in a scratch Q.
+        q, operand, out = self.q, self.operand, self.out
         if isinstance(e, (Var, Const)):
             out.append(f"FN 0: {q(target)} = {operand(e)}")
             return
         if isinstance(e, Sqrt):
             arg = e.a
             if isinstance(arg, (Op, Sqrt)):
-                assign(target, arg, depth)
+                self.assign(target, arg, depth)
                 arg = target
             out.append(f"FN 5: {q(target)} = SQRT {operand(arg)}")
             return
         a, b = e.a, e.b
         if isinstance(a, (Op, Sqrt)):
             dest = Var(f"h{depth}") if _reads(b, target) else target
-            assign(dest, a, depth + 1)
+            self.assign(dest, a, depth + 1)
             a = dest
         if isinstance(b, (Op, Sqrt)):
             tmp = Var(f"h{depth + 1}")
-            assign(tmp, b, depth + 2)
+            self.assign(tmp, b, depth + 2)
             b = tmp
         out.append(f"FN {_FN[e.op]}: {q(target)} = {operand(a)} {e.op} {operand(b)}")
 
-    def label() -> int:
+    def label(self) -> int:
         try:
-            return next(labels)
+            return next(self.labels)
         except StopIteration:
             raise ProgramError(f"the program needs more than {MAX_LABEL} labels") from None
 
-    def emit(stmts) -> None:
+    def emit(self, stmts) -> None:
+        q, out = self.q, self.out
         for s in stmts:
             if isinstance(s, Assign):
-                assign(s.target, s.expr)
+                self.assign(s.target, s.expr)
             elif isinstance(s, Clamp):
-                n = label()
-                lim = operand(s.limit)
+                n = self.label()
+                lim = self.operand(s.limit)
                 out.extend([f"FN 12: IF +{q(s.target)} LT {lim} GOTO LBL {n}",
                             f"FN 0: {q(s.target)} = {lim}", f"LBL {n}"])
             elif isinstance(s, Loop):
-                n = label()
+                n = self.label()
                 c = q(s.counter)
                 out.extend([f"FN 0: {c} = +0", f"LBL {n}"])
-                emit(s.body)
+                self.emit(s.body)
                 out.extend([f"FN 1: {c} = +{c} + +1", f"FN 12: IF +{c} LT +{s.last + 1} GOTO LBL {n}"])
             elif isinstance(s, Move):
-                out.append(f"L X+{q(s.x)} Y+{q(s.y)} Z+{q(s.z)} R0 {feed}")
+                out.append(f"L X+{q(s.x)} Y+{q(s.y)} Z+{q(s.z)} R0 {self.feed}")
 
-    emit(plan.body)
+
+def render(loops, settings, precision: int = 8, variable_base: int | None = None) -> str:
+    """The Heidenhain program for ``loops``: ``FN`` arithmetic on Q parameters, labels and jumps."""
+    base = DEFAULT_BASE if variable_base is None else int(variable_base)
+    names = variables(loops.body) + [f"h{n}" for n in range(SCRATCH)]
+    number = number_variables([Assign(Var(n), Const(0)) for n in names], base, VARIABLE_RANGES, letter="Q")
+    dp = settings.digits
+    unit = "MM" if settings.units == "mm" else "INCH"
+
+    def pos(v) -> str:
+        return _signed(fixed(v, dp))
+
+    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}",
+                      f"; lagsym surface macro, {loops.form.shape[0]}x{loops.form.shape[1]}, "
+                      f"normalized {loops.form.kind} form",
+                      f"; {loops.raster.size} points, rows along {loops.raster.direction}, {precision}-digit arithmetic",
+                      f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
+                      f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M3"]
+    x0, y0, z0 = loops.start
+    out.append(f"L X{pos(x0)} Y{pos(y0)} R0 FMAX")
+    out.append(f"L Z{pos(z0)} R0 F{int(round(settings.plunge_feed_mm_min * settings.unit_factor))}")
+    feed = f"F{int(round(settings.feed_mm_min * settings.unit_factor))}"
+    _Blocks(number, precision, feed, out).emit(loops.body)
     out.append(f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M30")
     out.append(f"END PGM {settings.program_number} {unit}")
     return settings.eol.join(f"{n} {line}" for n, line in enumerate(out)) + settings.eol

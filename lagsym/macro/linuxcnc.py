@@ -8,17 +8,15 @@ from __future__ import annotations
 
 from ..post.numbers import fixed
 from ._render import expression, literal
-from .model import Assign, Clamp, Loop, Move, variables
+from .model import Assign, Clamp, Loop, Move
 
 __all__ = ["render", "MAX_BLOCK"]
 
 MAX_BLOCK = 255  # LinuxCNC reads at most 255 characters per line (LINELEN)
 
 
-def render(plan, settings, precision: int = 15, variable_base: int | None = None) -> str:
-    """The LinuxCNC program for ``plan``; ``variable_base`` is ignored (named parameters)."""
-    variables(plan.body)
-
+def render(loops, settings, precision: int = 15, variable_base: int | None = None) -> str:
+    """The LinuxCNC program for ``loops``; ``variable_base`` is ignored (named parameters)."""
     def name(v):
         return f"#<{v.name}>"
 
@@ -27,9 +25,9 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
 
     dp = settings.digits
     out = ["%", f"(lagsym surface macro, program {settings.program_number})",
-           f"(surface {plan.form.shape[0]}x{plan.form.shape[1]}, normalized {plan.form.kind} form, "
+           f"(surface {loops.form.shape[0]}x{loops.form.shape[1]}, normalized {loops.form.kind} form, "
            f"{precision}-digit arithmetic)",
-           f"({plan.raster.size} points, rows along {plan.raster.direction})",
+           f"({loops.raster.size} points, rows along {loops.raster.direction})",
            f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90 G64 P0.001",
            settings.work_offset,
            f"T{settings.tool_number} M6",
@@ -37,7 +35,7 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
            f"G0 Z{fixed(settings.safe_z_mm * settings.unit_factor, dp)}"]
     if settings.spindle_rpm:
         out.append(f"S{int(round(settings.spindle_rpm))} M3")
-    x0, y0, z0 = plan.start
+    x0, y0, z0 = loops.start
     out.append(f"G0 X{fixed(x0, dp)} Y{fixed(y0, dp)}")
     out.append(f"G1 Z{fixed(z0, dp)} F{fixed(settings.plunge_feed_mm_min * settings.unit_factor, 1, trim=True)}")
     out.append(f"F{fixed(settings.feed_mm_min * settings.unit_factor, 1, trim=True)}")
@@ -64,7 +62,7 @@ def render(plan, settings, precision: int = 15, variable_base: int | None = None
             elif isinstance(s, Move):
                 out.append(f"{pad}G1 X{name(s.x)} Y{name(s.y)} Z{name(s.z)}")
 
-    emit(plan.body, 0)
+    emit(loops.body, 0)
     out.append(f"G0 Z{fixed(settings.safe_z_mm * settings.unit_factor, dp)}")
     out += ["M5", "M2", "%"]
     return settings.eol.join(out) + settings.eol

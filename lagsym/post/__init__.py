@@ -1,1 +1,1 @@
-"""Program text for CNC controls: the shared program model and one module per dialect."""
+"""Point-list program text for CNC controls: the program model, the moves, one module per dialect, the writer table."""

@@ -6,12 +6,11 @@ block; programs end with ``M30``.
 
 from __future__ import annotations
 
-from .program import PointProgram, body, iso_comment, register, units_word
+from .model import PointProgram, body, iso_comment, units_word
 
 __all__ = ["blocks"]
 
 
-@register("fanuc")
 def blocks(program: PointProgram) -> list[str]:
     """The blocks of a Fanuc point-list program."""
     s = program.settings

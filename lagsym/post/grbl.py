@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from .program import PointProgram, body, iso_comment, register, units_word
+from .model import PointProgram, body, iso_comment, units_word
 
 __all__ = ["blocks"]
 
 
-@register("grbl")
 def blocks(program: PointProgram) -> list[str]:
     """The blocks of a Grbl point-list program (every block well under Grbl's 80 characters)."""
     s = program.settings

@@ -13,7 +13,7 @@ from fractions import Fraction
 
 from ..errors import ProgramError
 
-__all__ = ["fixed", "constant"]
+__all__ = ["fixed"]
 
 
 def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = False) -> str:
@@ -42,19 +42,3 @@ def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = Fal
         text = text.rstrip("0")
     return text
 
-
-def constant(value: float | Fraction, significant: int = 15) -> str:
-    """A constant in a macro expression: ``significant`` significant digits, decimal point, no exponent.
-
-    Examples
-    --------
-    >>> constant(Fraction(1, 3), 8), constant(2.5e-7, 8), constant(-1200, 8)
-    ('0.33333333', '0.00000025', '-1200.')
-    """
-    v = Fraction(value) if not isinstance(value, Fraction) else value
-    if v == 0:
-        return "0."
-    d = Decimal(v.numerator) / Decimal(v.denominator)
-    exponent = d.adjusted()
-    decimals = max(significant - 1 - exponent, 0)
-    return fixed(d.quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_EVEN), decimals, trim=True)

@@ -19,7 +19,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import InputError
+from ..values import choice
 from ..grid import ControlGrid
 from .bezier import BernsteinBasis, bernstein_matrix, bezier_surface
 from .bspline import BSplineBasis, bspline_basis, bspline_surface, clamped_uniform_knots
@@ -85,12 +85,11 @@ def make_surface(method: str, grid: ControlGrid, *, degree: int = 3, hermite: st
     >>> [make_surface(m, g).name for m in METHODS]
     ['Lagrange', 'Hermite', 'Bezier', 'B-spline']
     """
+    choice(method, METHODS, "method")
     if method == "lagrange":
         return lagrange_method(grid)
     if method == "hermite":
         return hermite_surface(grid, hermite)
     if method == "bezier":
         return bezier_surface(grid)
-    if method == "bspline":
-        return bspline_surface(grid, degree)
-    raise InputError(f"method {method!r} is not one of {', '.join(METHODS)}")
+    return bspline_surface(grid, degree)

@@ -1,0 +1,48 @@
+"""The points a macro program should produce, computed on the PC, to check the program against.
+
+Z is the surface height at each raster position (stable evaluation, within
+1e-12 of the exact value), placed on the machine, plus the stock to leave; a
+ball-end cutter's point is its tip, one radius off the surface along the
+normal (:mod:`lagsym.macro.ballend`).  Everything in program units.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..lagrange import LagrangeSurface
+from ..machine import MachineSettings, RasterSpec, Tool
+from ._placement import placement
+from .ballend import is_ball, tip_points
+from .raster import macro_raster, raster_positions
+
+__all__ = ["points_at", "planned_points"]
+
+
+def points_at(surface: LagrangeSurface, settings: MachineSettings, tool: Tool | None, x, y) -> np.ndarray:
+    """The programmed points (N, 3) for raster positions (x, y), in program units.
+
+    Z is the surface height at each position, scaled, plus the origin and the
+    stock to leave.  For a ball-end tool with a diameter the point is the tool
+    tip of a ball whose centre sits one radius (plus stock) off the surface
+    along its normal.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if is_ball(tool):
+        return tip_points(surface, settings, tool, x, y)
+    place = placement(settings)
+    s = float(place.scale)
+    ox, oy, oz = (float(v) for v in place.origin)
+    z = surface.evaluate((x - ox) / s, (y - oy) / s) * s + oz + float(place.stock)
+    return np.column_stack([x, y, z])
+
+
+def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
+                   tool: Tool | None = None) -> np.ndarray:
+    """The points a macro program should move through, computed on the PC: an (N, 3) array in program units.
+
+    Every raster position in the order the program visits them, through
+    :func:`points_at`.  The program's first feed move (the plunge) ends at the
+    first of these points.
+    """
+    return points_at(surface, settings, tool, *raster_positions(macro_raster(surface, settings, raster)))

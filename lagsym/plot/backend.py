@@ -1,0 +1,170 @@
+"""How VTK renders in this process, and the one factory of plotters.
+
+Rendering needs no display.  Where there is none (no ``DISPLAY`` on Linux),
+:func:`rendering_backend` picks a way to render offscreen once per process:
+VTK's EGL window on Mesa, else OSMesa, else a private Xvfb server that lives
+as long as the process.  :func:`new_plotter` asks for that choice before it
+makes a plotter, so every figure renders wherever lagsym runs.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import functools
+import os
+import shutil
+import subprocess
+import sys
+
+from ..errors import RenderError
+from .checks import check_window_size
+
+__all__ = ["DEFAULT_WINDOW_SIZE", "rendering_backend", "new_plotter"]
+
+DEFAULT_WINDOW_SIZE = (1024, 768)
+
+# A tiny scene rendered in a child process: a render window that cannot get an
+# OpenGL context may crash the process that asks, so never ask in this one.
+_PROBE = """
+import vtkmodules.vtkRenderingOpenGL2, vtkmodules.vtkRenderingCore as rc
+from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
+w = rc.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8)
+r = rc.vtkRenderer(); r.SetBackground(1.0, 0.0, 0.0); w.AddRenderer(r); w.Render()
+a = vtkUnsignedCharArray(); w.GetPixelData(0, 0, 7, 7, 1, a, 0)
+print("ok" if a.GetValue(0) == 255 and a.GetValue(1) == 0 else "wrong pixels")
+w.Finalize()
+"""
+
+_OFFSCREEN_WINDOWS = (("egl", "vtkEGLRenderWindow"), ("osmesa", "vtkOSOpenGLRenderWindow"))
+
+
+def _has_display() -> bool:
+    if sys.platform != "linux":
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def _probe(window_class: str) -> bool:
+    env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW=window_class)
+    env.pop("DISPLAY", None)
+    try:
+        done = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return done.returncode == 0 and done.stdout.strip() == "ok"
+
+
+def _die_with_parent() -> None:
+    """In the child before exec: ask Linux to end it with SIGTERM when its parent exits."""
+    import ctypes
+    import signal
+
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+
+
+def _start_xvfb() -> str:
+    """Start a private Xvfb server that ends with this process; return its display name.
+
+    The kernel ends the server when this process exits (not an ``atexit``
+    handler, which would run while VTK still holds its X connection).
+    """
+    read_fd, write_fd = os.pipe()
+    try:
+        server = subprocess.Popen(
+            ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+            pass_fds=(write_fd,),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            preexec_fn=_die_with_parent,
+        )
+    finally:
+        os.close(write_fd)
+    with os.fdopen(read_fd) as f:
+        number = f.readline().strip()
+    if not number.isdigit():
+        server.terminate()
+        raise RenderError("Xvfb started but did not report a display number")
+    return f":{number}"
+
+
+@functools.cache
+def rendering_backend() -> str:
+    """Make sure VTK can render in this process, and say how.
+
+    Called by every figure function; the choice is made once per process.
+
+    Returns
+    -------
+    str
+        ``"display"`` when there is a display (or the platform is not Linux),
+        ``"egl"`` or ``"osmesa"`` for VTK's offscreen windows, ``"xvfb"`` for a
+        private X server started here, or the window class named by the
+        ``VTK_DEFAULT_OPENGL_WINDOW`` variable when that is already set.
+
+    Raises
+    ------
+    RenderError
+        When nothing here can render.
+    """
+    if _has_display():
+        return "display"
+    if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW"):
+        return os.environ["VTK_DEFAULT_OPENGL_WINDOW"]
+    for name, window_class in _OFFSCREEN_WINDOWS:
+        if _probe(window_class):
+            # Name the window outright: otherwise VTK tries X first and warns on stderr.
+            os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = window_class
+            return name
+    if shutil.which("Xvfb"):
+        os.environ["DISPLAY"] = _start_xvfb()
+        return "xvfb"
+    raise RenderError(
+        "no display, and VTK cannot render offscreen here: install Mesa's EGL "
+        "(Debian: libegl1 libgl1-mesa-dri) or Xvfb (Debian: xvfb)"
+    )
+
+
+def _has_ipython() -> bool:
+    try:
+        return importlib.util.find_spec("IPython") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def new_plotter(shape=(1, 1), window_size=DEFAULT_WINDOW_SIZE, off_screen: bool | None = None, col_weights=None):
+    """A new :class:`pyvista.Plotter` with its own white theme, on the backend chosen here.
+
+    Parameters
+    ----------
+    shape : (int, int)
+        Rows and columns of panels.
+    window_size : (int, int)
+        Image size in pixels, 16 to 8192 each.
+    off_screen : bool, optional
+        Render without a window; forced where there is no display, since a
+        window on no screen, or on a private Xvfb, would show nobody anything.
+    col_weights : sequence of float, optional
+        Relative widths of the columns.
+
+    Returns
+    -------
+    pyvista.Plotter
+        Shown in Jupyter as a static image, which also works headless; the
+        global theme is left alone.
+    """
+    import pyvista as pv
+
+    size = check_window_size(window_size)
+    if rendering_backend() != "display":
+        off_screen = True
+    theme = pv.themes.DocumentTheme()
+    if _has_ipython():
+        # Notebooks show a static image by default (the same picture -o writes); pyvista refuses to
+        # set a notebook backend at all where IPython is not installed, as after a plain install.
+        theme.jupyter_backend = "static"
+    theme.font.color = "black"
+    theme.font.family = "arial"
+    return pv.Plotter(shape=shape, window_size=list(size), off_screen=off_screen, theme=theme,
+                      lighting="three lights", border=False, col_weights=col_weights)

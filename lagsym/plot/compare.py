@@ -1,0 +1,161 @@
+"""Figures that set surfaces side by side: the comparison of methods and the deviation maps.
+
+Both take plain arrays sampled on shared axes, ``Z[i, j]`` at ``(x[i], y[j])``,
+so any method's surface, or a measurement, can be drawn.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from .backend import DEFAULT_WINDOW_SIZE, new_plotter
+from .checks import check_axis, check_heights, check_points, check_window_size
+from .meshes import outline, pointcloud, scalar_mesh
+from .style import (
+    BAR_COLUMN,
+    DEVIATION_CMAP,
+    POINT_COLOR,
+    SURFACE_CMAP,
+    bar_column,
+    fit,
+    plan_view,
+    view,
+    z_scale,
+)
+
+__all__ = ["compare_figure", "deviation_figure"]
+
+
+def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str = "Lagrange", units: str = "mm",
+                   control_points=None, window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
+                   off_screen: bool | None = None):
+    """Surfaces side by side, with the deviation of each from a reference below it (the paper's Figure 10).
+
+    Top row: every surface, on one colour scale for z.  Bottom row: for each
+    surface but the reference, ``Z - Z_reference`` seen from above, on one
+    colour scale symmetric about 0; under the reference, the plan of the
+    control points.
+
+    Parameters
+    ----------
+    x, y : 1-D array
+        Strictly increasing sample axes, shared by every surface.
+    surfaces : mapping of str to 2-D array
+        Method name to heights ``Z[i, j]`` at ``(x[i], y[j])``, in drawing order.
+    reference : str
+        The key the others are measured against.
+    units : str
+        Length unit of x, y and z.
+    control_points : (K, 3) array, optional
+        Points marked on every surface.
+    window_size : (int, int)
+        Image size in pixels.
+    off_screen : bool, optional
+        Render without a window; forced where there is no display.
+
+    Returns
+    -------
+    pyvista.Plotter
+    """
+    x, y = check_axis(x, "x"), check_axis(y, "y")
+    if not surfaces:
+        raise InputError("no surfaces to compare")
+    if reference not in surfaces:
+        raise InputError(f"reference {reference!r} is not among the surfaces: {', '.join(map(repr, surfaces))}")
+    zs = {name: check_heights(z, (x.size, y.size), f"surface {name!r}") for name, z in surfaces.items()}
+    pts = check_points(control_points, "control_points") if control_points is not None else None
+    ref = zs[reference]
+    zlo = min(float(z.min()) for z in zs.values())
+    zhi = max(float(z.max()) for z in zs.values())
+    dmax = max((float(np.abs(z - ref).max()) for z in zs.values()), default=0.0) or 1.0
+    scale = z_scale(np.ptp(x), np.ptp(y), zhi - zlo)
+    names = list(zs)
+    n = len(names)
+    w, h = check_window_size(window_size)
+    p = new_plotter(shape=(2, n + 1), window_size=(w, h), off_screen=off_screen, col_weights=[1.0] * n + [BAR_COLUMN])
+    panel = w / (n + BAR_COLUMN)
+    zname, dname = f"z ({units})", f"dev. ({units})"
+    top = fit("\n".join(names), panel, largest=14)
+    bottom = fit("\n".join(f"{name} - {reference}" for name in names), panel, largest=12)
+    z_actor = d_actor = None
+    for col, name in enumerate(names):
+        p.subplot(0, col)
+        z_actor = p.add_mesh(scalar_mesh(x, y, zs[name], zname), scalars=zname, cmap=SURFACE_CMAP,
+                             clim=(zlo, zhi), smooth_shading=True, show_scalar_bar=False)
+        if pts is not None:
+            p.add_mesh(pointcloud(pts), color=POINT_COLOR, point_size=8, render_points_as_spheres=True)
+        p.add_text(name, position="upper_edge", font_size=top, color="black")
+        p.set_scale(zscale=scale)
+        view(p, zoom=1.0)
+        p.subplot(1, col)
+        if name == reference:
+            _add_plan(p, x, y, pts, f"{name}\n(reference)", bottom)
+            continue
+        d = zs[name] - ref
+        d_actor = p.add_mesh(scalar_mesh(x, y, np.zeros_like(d), dname, d), scalars=dname, cmap=DEVIATION_CMAP,
+                             clim=(-dmax, dmax), lighting=False, show_scalar_bar=False)
+        p.add_mesh(outline(x, y), color="black", line_width=1, lighting=False)
+        text = f"{name} - {reference}\nlargest {np.abs(d).max():.3g} {units}"
+        p.add_text(text, position="upper_edge", font_size=bottom, color="black")
+        plan_view(p)
+    bar_column(p, 0, n, z_actor.mapper, zname, h // 2)
+    if d_actor is not None:
+        bar_column(p, 1, n, d_actor.mapper, dname, h // 2)
+    return p
+
+
+def _add_plan(p, x, y, pts, text: str, font: int) -> None:
+    p.add_mesh(outline(x, y), color="gray", line_width=1, lighting=False)
+    if pts is not None:
+        p.add_mesh(pointcloud(np.c_[pts[:, :2], np.zeros(len(pts))]), color=POINT_COLOR, point_size=8,
+                   render_points_as_spheres=True)
+    p.add_text(text, position="upper_edge", font_size=font, color="black")
+    plan_view(p)
+
+
+def deviation_figure(x, y, deviations: Mapping[str, np.ndarray], *, units: str = "mm",
+                     window_size: Sequence[int] = DEFAULT_WINDOW_SIZE, off_screen: bool | None = None):
+    """One deviation colour map per method, seen from above, on one colour scale symmetric about 0.
+
+    Parameters
+    ----------
+    x, y : 1-D array
+        Strictly increasing sample axes.
+    deviations : mapping of str to 2-D array
+        Method name to deviations ``D[i, j]`` at ``(x[i], y[j])``.
+    units : str
+        Length unit of x, y and the deviations.
+    window_size : (int, int)
+        Image size in pixels.
+    off_screen : bool, optional
+        Render without a window; forced where there is no display.
+
+    Returns
+    -------
+    pyvista.Plotter
+    """
+    x, y = check_axis(x, "x"), check_axis(y, "y")
+    if not deviations:
+        raise InputError("no deviations to draw")
+    ds = {name: check_heights(d, (x.size, y.size), f"deviations {name!r}") for name, d in deviations.items()}
+    dmax = max(float(np.abs(d).max()) for d in ds.values()) or 1.0
+    n = len(ds)
+    w, h = check_window_size(window_size)
+    p = new_plotter(shape=(1, n + 1), window_size=(w, h), off_screen=off_screen, col_weights=[1.0] * n + [BAR_COLUMN])
+    panel = w / (n + BAR_COLUMN)
+    dname = f"dev. ({units})"
+    font = fit("\n".join([*ds, f"largest 0.000 {units}"]), panel, largest=12)
+    actor = None
+    for col, (name, d) in enumerate(ds.items()):
+        p.subplot(0, col)
+        actor = p.add_mesh(scalar_mesh(x, y, np.zeros_like(d), dname, d), scalars=dname, cmap=DEVIATION_CMAP,
+                           clim=(-dmax, dmax), lighting=False, show_scalar_bar=False)
+        p.add_mesh(outline(x, y), color="black", line_width=1, lighting=False)
+        p.add_text(f"{name}\nlargest {np.abs(d).max():.3g} {units}", position="upper_edge", font_size=font,
+                   color="black")
+        plan_view(p)
+    bar_column(p, 0, n, actor.mapper, dname, h)
+    return p

@@ -1,0 +1,164 @@
+"""One policy for the numbers and choices that reach lagsym from outside.
+
+Every setting, option and file value passes one of these checks once, where it
+enters: an exact number (:func:`as_exact`), a finite float within its range
+(:func:`finite`, :func:`positive`), or one of a list of choices
+(:func:`choice`).  Each raises :class:`~lagsym.errors.InputError` with a
+message that names the value and what it was for.
+
+The exact-number policy: decimal text is the decimal it spells (``"1.06"`` is
+53/50), and so is a Python float (``0.1`` is 1/10, the decimal its ``repr``
+prints), so a step typed on the command line and the same step passed from
+Python mean one number everywhere.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable
+from decimal import Decimal, InvalidOperation
+from fractions import Fraction
+
+from .errors import InputError
+
+__all__ = ["as_exact", "exact_number", "finite", "positive", "choice", "NotANumber", "MAX_EXPONENT"]
+
+MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
+_RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
+_DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
+
+
+class NotANumber(InputError):
+    """Text that is not an exact number; the message says why (without saying where: callers add that)."""
+
+
+def exact_number(text: str) -> Fraction:
+    """Read an exact decimal or rational from text.
+
+    Only ASCII digits count: the text of a file or an option, not a locale's
+    numerals.
+
+    Examples
+    --------
+    >>> exact_number("1.06"), exact_number("-1/3"), exact_number("2e3")
+    (Fraction(53, 50), Fraction(-1, 3), Fraction(2000, 1))
+    """
+    m = _RATIONAL.match(text)
+    if m and text.isascii():
+        num, den = m.groups()
+        if len(num) > MAX_EXPONENT or len(den) > MAX_EXPONENT:
+            raise NotANumber(f"{text!r} is too large")
+        if int(den) == 0:
+            raise NotANumber(f"{text!r} divides by zero")
+        return Fraction(int(num), int(den))
+    if not text.isascii() or not _DECIMAL.match(text):
+        raise NotANumber(f"{text.strip()!r} is not a number")
+    exponent = re.search(r"[eE]([+-]?\d+)", text)
+    if exponent and len(exponent.group(1).lstrip("+-0")) > 6:
+        raise NotANumber(f"{text.strip()!r} is out of range (overflow)")
+    d = Decimal(text.strip())
+    if len(d.as_tuple().digits) > MAX_EXPONENT or abs(d.adjusted()) > MAX_EXPONENT:
+        raise NotANumber(f"{text.strip()!r} is out of range (overflow)")
+    return Fraction(d)
+
+
+def as_exact(value, where: str) -> Fraction:
+    """``value`` as an exact rational; ``where`` names it in the message if it is not a number.
+
+    Examples
+    --------
+    >>> as_exact(0.1, "step"), as_exact("2/3", "x"), as_exact(3, "n")
+    (Fraction(1, 10), Fraction(2, 3), Fraction(3, 1))
+    >>> as_exact(float("nan"), "--step")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: --step = nan is not a finite number
+    """
+    if isinstance(value, bool):
+        raise InputError(f"{where} = {value!r} is not a number")
+    if isinstance(value, Fraction):
+        return value
+    if isinstance(value, int):
+        return Fraction(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise InputError(f"{where} = {value!r} is not a finite number")
+        return Fraction(repr(value))
+    if isinstance(value, str):
+        try:
+            return exact_number(value)
+        except NotANumber as e:
+            raise InputError(f"{where}: {e}") from None
+    if isinstance(value, Decimal):
+        if not value.is_finite():
+            raise InputError(f"{where} = {value} is not a finite number")
+        return Fraction(value)
+    try:
+        f = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{where} = {value!r} is not a number") from None
+    return as_exact(f, where)
+
+
+def finite(value, what: str, *, low: float | None = None, high: float | None = None) -> float:
+    """``value`` as a finite float within ``[low, high]`` (either bound optional).
+
+    Examples
+    --------
+    >>> finite("2.5", "--feed", low=0)
+    2.5
+    >>> finite(float("inf"), "--gouge-limit")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: --gouge-limit = inf is not a finite number
+    """
+    if isinstance(value, bool):
+        raise InputError(f"{what} = {value!r} is not a number")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError, InvalidOperation):
+        raise InputError(f"{what} = {value!r} is not a number") from None
+    if not math.isfinite(v):
+        raise InputError(f"{what} = {value!r} is not a finite number")
+    if low is not None and v < low:
+        raise InputError(f"{what} = {value!r} is below {low:g}")
+    if high is not None and v > high:
+        raise InputError(f"{what} = {value!r} is above {high:g}")
+    return v
+
+
+def positive(value, what: str, *, allow_zero: bool = False, high: float | None = None) -> float:
+    """``value`` as a finite float above zero (or at zero where ``allow_zero``), at most ``high``.
+
+    Examples
+    --------
+    >>> positive(6, "tool diameter")
+    6.0
+    >>> positive(-1, "tool diameter")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: tool diameter -1 must be a positive number
+    """
+    v = finite(value, what, high=high)
+    if not (v > 0 or (allow_zero and v == 0)):
+        raise InputError(f"{what} {value!r} must be {'zero or ' if allow_zero else ''}a positive number")
+    return v
+
+
+def choice(value, options: Iterable, what: str):
+    """Check ``value`` against its list of options; the message names the valid choices.
+
+    Examples
+    --------
+    >>> choice("ball", ("ball", "flat"), "tool shape")
+    'ball'
+    >>> choice("cone", ("ball", "flat"), "tool shape")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: tool shape 'cone' is not one of ball, flat
+    """
+    options = tuple(options)
+    if value not in options:
+        raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
+    return value
