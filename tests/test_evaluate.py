@@ -215,3 +215,11 @@ def test_the_evaluator_is_immutable():
         ev.x_scale = 2.0
     with pytest.raises(ValueError):
         ev.coefficients[0, 0] = 1.0
+
+
+def test_fast_points_agree_with_exact_values():
+    """The float64 path drop-cutter searches with."""
+    example4 = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    ev = surface_evaluator(example4).fast_points
+    for x, y in [(1, 1), (Fraction(5, 2), Fraction(7, 3)), (5, 5), (Fraction(13, 10), 4)]:
+        assert ev(float(x), float(y)) == pytest.approx(float(example4.exact_value(x, y)), abs=1e-12)

@@ -21,9 +21,9 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from numpy.polynomial import polynomial as P
 
 from ..errors import ToolpathError
+from ..evaluate import power_partials
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, Tool
 from ..values import as_exact
@@ -56,21 +56,9 @@ def contact_form(surface: LagrangeSurface, settings: MachineSettings, direction:
 
 def derivatives(form: RowForm, p, r) -> dict[str, np.ndarray]:
     """Height and first and second partial derivatives of ``form`` at (p, r), in program units (floats)."""
-    c = np.array([[float(v) for v in row] for row in form.coefficients])
-    u = (np.asarray(p, dtype=float) - float(form.pc)) * float(form.pk)
-    v = (np.asarray(r, dtype=float) - float(form.rc)) * float(form.rk)
-    ku, kv = float(form.pk), float(form.rk)
-
-    def d(a, b):
-        cc = c
-        if a:
-            cc = P.polyder(cc, a, axis=0) if cc.shape[0] > a else np.zeros((1, cc.shape[1]))
-        if b:
-            cc = P.polyder(cc, b, axis=1) if cc.shape[1] > b else np.zeros((cc.shape[0], 1))
-        return P.polyval2d(u, v, cc) * ku**a * kv**b
-
-    return {"z": d(0, 0) + float(form.z0), "zp": d(1, 0), "zr": d(0, 1),
-            "zpp": d(2, 0), "zpr": d(1, 1), "zrr": d(0, 2)}
+    f = power_partials(form.coefficients, p, r, centre=(form.pc, form.rc), inverse_half_width=(form.pk, form.rk))
+    return {"z": f[0, 0] + float(form.z0), "zp": f[1, 0], "zr": f[0, 1],
+            "zpp": f[2, 0], "zpr": f[1, 1], "zrr": f[0, 2]}
 
 
 def offset_points(form: RowForm, radius: float, offset: float, p, r):

@@ -1,0 +1,55 @@
+"""Lagrange curves in the Chebyshev basis of a normalized coordinate (the 1-D case of :mod:`.surface`)."""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import flint
+import numpy as np
+
+from .._arrays import readonly as _readonly
+from .chebyshev import chebyshev_matrix, chebyshev_transform, data_range, fmpq, fraction
+
+__all__ = ["CurveEvaluator", "curve_evaluator", "evaluate_curve"]
+
+
+@dataclass(frozen=True, eq=False)
+class CurveEvaluator:
+    """A 1-D Lagrange curve in the Chebyshev basis of a normalized coordinate (see :class:`SurfaceEvaluator`)."""
+
+    offset: float
+    scale: float
+    coefficients: np.ndarray
+    data_range: float
+
+    def __call__(self, x) -> np.ndarray:
+        """``F(x)`` for ``x`` of any shape."""
+        x = np.asarray(x, dtype=float)
+        s = (x.astype(np.longdouble) - self.offset) / np.longdouble(self.scale)
+        return (self.coefficients @ chebyshev_matrix(s, len(self.coefficients))).reshape(x.shape)
+
+
+_CURVES: dict[int, CurveEvaluator] = {}
+
+
+def curve_evaluator(curve) -> CurveEvaluator:
+    """The :class:`CurveEvaluator` of a :class:`~lagsym.lagrange.LagrangeCurve` (remembered like :func:`surface_evaluator`)."""
+    key = id(curve)
+    found = _CURVES.get(key)
+    if found is not None:
+        return found
+    off, scale, a = chebyshev_transform(curve.points.x)
+    n = len(curve.coefficients)
+    d = a * flint.fmpq_mat(n, 1, [fmpq(c) for c in curve.coefficients])
+    ev = CurveEvaluator(offset=off, scale=scale,
+                        coefficients=_readonly([float(fraction(d[k, 0])) for k in range(n)]),
+                        data_range=data_range(curve.points.y))
+    _CURVES[key] = ev
+    weakref.finalize(curve, _CURVES.pop, key, None)
+    return ev
+
+
+def evaluate_curve(curve, x) -> np.ndarray:
+    """Evaluate a :class:`~lagsym.lagrange.LagrangeCurve` at ``x`` (any shape)."""
+    return curve_evaluator(curve)(x)

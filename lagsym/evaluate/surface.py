@@ -1,0 +1,305 @@
+"""Surfaces in the Chebyshev basis of normalized coordinates: values on grids and at points, derivatives, bounds.
+
+``F(x, y) = sum_ab C[a, b] T_a(s(x)) T_b(t(y))`` with ``s`` and ``t`` mapping
+the control box onto ``[-1, 1]**2``.  On a grid this is the tensor product
+``Z = Tx.T @ C @ Ty`` of two small Chebyshev basis matrices; at scattered
+points it is a row-wise contraction.  Sampling (:meth:`SurfaceEvaluator.grid`,
+:meth:`SurfaceEvaluator.points`) runs the basis recurrence in long double and
+passes through the control points exactly; a search that evaluates many small
+batches (drop-cutter) uses :meth:`SurfaceEvaluator.fast_points`, float64
+throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from fractions import Fraction
+
+import flint
+import numpy as np
+from numpy.polynomial import chebyshev as C
+
+from .._arrays import readonly as _readonly
+from .bounds import chebyshev_error_bound
+from .chebyshev import (
+    chebyshev_matrix,
+    chebyshev_matrix_float64,
+    chebyshev_transform,
+    data_range,
+    fmpq,
+    fraction,
+)
+
+__all__ = ["CHUNK_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
+           "evaluate_grid"]
+
+CHUNK_POINTS = 1 << 16  # scattered points are evaluated in blocks of this many (bounded memory, warm caches)
+FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceEvaluator:
+    """A surface in the Chebyshev basis of normalized coordinates, ready for fast float evaluation.
+
+    Build one with :func:`surface_evaluator`.
+
+    Attributes
+    ----------
+    x_offset, x_scale, y_offset, y_scale : float
+        ``s = (x - x_offset) / x_scale`` and ``t = (y - y_offset) / y_scale``
+        map the control box onto about ``[-1, 1]**2``.
+    coefficients : numpy.ndarray
+        Read-only ``(n, m)``; ``coefficients[a, b]`` multiplies
+        ``T_a(s) T_b(t)``.  Each is the exact coefficient rounded once.
+    data_range : float
+        Spread of the control heights (``max z - min z``, or ``max |z|`` or 1
+        for a flat grid): the scale errors are measured against.
+    bounds : tuple of float
+        ``(x0, x1, y0, y1)``, the control box.
+    x_nodes, y_nodes : numpy.ndarray
+        The nodes as floats.
+    x_exact, y_exact : numpy.ndarray
+        Which nodes are floats exactly (``1/3`` is not).
+    node_values : numpy.ndarray
+        The control heights rounded once: the value wherever a sample point
+        is a node exactly, so a sample passes through the control points.
+    """
+
+    x_offset: float
+    x_scale: float
+    y_offset: float
+    y_scale: float
+    coefficients: np.ndarray
+    data_range: float
+    bounds: tuple[float, float, float, float]
+    x_nodes: np.ndarray
+    y_nodes: np.ndarray
+    x_exact: np.ndarray
+    y_exact: np.ndarray
+    node_values: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Number of coefficients in x and in y (nodes of the control grid)."""
+        return self.coefficients.shape
+
+    def _s(self, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float).astype(np.longdouble)
+        return (x - self.x_offset) / np.longdouble(self.x_scale)
+
+    def _t(self, y) -> np.ndarray:
+        y = np.asarray(y, dtype=float).astype(np.longdouble)
+        return (y - self.y_offset) / np.longdouble(self.y_scale)
+
+    def x_factor(self, xs) -> np.ndarray:
+        """``W = Tx.T @ C`` for the grid lines ``xs``: shape ``(len(xs), m)``.
+
+        A grid is then ``W @ self.y_basis(ys)``, one matrix product, which
+        lets a sampler compute the small factor once and stream blocks of rows.
+        """
+        n = self.shape[0]
+        return chebyshev_matrix(self._s(xs), n).T @ self.coefficients
+
+    def y_basis(self, ys) -> np.ndarray:
+        """``Ty``: the Chebyshev basis of the grid lines ``ys``, shape ``(m, len(ys))``."""
+        return chebyshev_matrix(self._t(ys), self.shape[1])
+
+    def grid(self, xs, ys) -> np.ndarray:
+        """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``.
+
+        Examples
+        --------
+        >>> from lagsym.grid import grid_from_points
+        >>> from lagsym.lagrange import lagrange_surface
+        >>> pts = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
+        ...        (5, 2, 31), (5, 3, 34), (5, 4, 37)]
+        >>> ev = surface_evaluator(lagrange_surface(grid_from_points(pts)))
+        >>> ev.grid([1.0, 2.0], [2.0, 2.5]).tolist()
+        [[7.0, 8.5], [10.0, 11.5]]
+        """
+        xs = np.asarray(xs, dtype=float).ravel()
+        ys = np.asarray(ys, dtype=float).ravel()
+        return self.snap_grid(self.x_factor(xs) @ self.y_basis(ys), xs, ys)
+
+    @staticmethod
+    def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Indices into ``v`` of values that are a node exactly, and which node."""
+        k = np.clip(np.searchsorted(nodes, v), 0, len(nodes) - 1)
+        hit = (nodes[k] == v) & exact[k]
+        return np.flatnonzero(hit), k[hit]
+
+    def snap_grid(self, z: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Set ``z[i, j]`` to the control height where ``(xs[i], ys[j])`` is a control point exactly; in place."""
+        ix, kx = self._hits(self.x_nodes, self.x_exact, xs)
+        if ix.size:
+            iy, ky = self._hits(self.y_nodes, self.y_exact, ys)
+            if iy.size:
+                z[np.ix_(ix, iy)] = self.node_values[np.ix_(kx, ky)]
+        return z
+
+    def points(self, x, y, chunk: int = CHUNK_POINTS) -> np.ndarray:
+        """``F(x, y)`` at scattered points; ``x`` and ``y`` broadcast together.
+
+        Works in blocks of ``chunk`` points, so memory stays a few megabytes
+        above the result whatever the number of points.
+        """
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        shape = x.shape
+        xf, yf = x.ravel(), y.ravel()
+        n, m = self.shape
+        out = np.empty(xf.size)
+        c = self.coefficients.T  # (m, n)
+        vx = np.empty((n, min(chunk, xf.size)))
+        vy = np.empty((m, min(chunk, xf.size)))
+        for lo in range(0, xf.size, chunk):
+            hi = min(lo + chunk, xf.size)
+            tx = chebyshev_matrix(self._s(xf[lo:hi]), n, vx)
+            ty = chebyshev_matrix(self._t(yf[lo:hi]), m, vy)
+            out[lo:hi] = np.einsum("bp,bp->p", c @ tx, ty)
+        px, kx = self._hits(self.x_nodes, self.x_exact, xf)
+        if px.size:
+            py, ky = self._hits(self.y_nodes, self.y_exact, yf[px])
+            out[px[py]] = self.node_values[kx[py], ky]
+        return out.reshape(shape)
+
+    def partial(self, dx: int = 0, dy: int = 0) -> np.ndarray:
+        """Chebyshev coefficients of ``d**(dx+dy) F / dx**dx dy**dy``, per surface unit, in the same basis.
+
+        Differentiated from the rounded :attr:`coefficients` (a few units of
+        rounding more); the shape shrinks by the orders, to no less than 1.
+        """
+        c = np.asarray(self.coefficients, dtype=float)
+        if dx:
+            c = C.chebder(c, dx, scl=1.0 / self.x_scale, axis=0)
+        if dy:
+            c = C.chebder(c, dy, scl=1.0 / self.y_scale, axis=1)
+        return c
+
+    def fast_points(self, x, y, dx: int = 0, dy: int = 0) -> np.ndarray:
+        """``F(x, y)``, or a partial derivative, at scattered points, in float64 throughout.
+
+        For the many small evaluations of a search (drop-cutter): the basis
+        recurrence runs in float64, so at degree ``k`` it adds up to ``k**2``
+        units of float64 rounding where :meth:`points` adds long-double ones,
+        and control points are not snapped to their heights.  Blocks of :data:`FAST_CHUNK_POINTS`
+        keep the basis matrices in cache.  ``x`` and ``y`` broadcast together.
+
+        Examples
+        --------
+        >>> from lagsym.grid import grid_from_points
+        >>> from lagsym.lagrange import lagrange_surface
+        >>> ev = surface_evaluator(lagrange_surface(grid_from_points([(0, 0, 0), (0, 2, 4), (2, 0, 2), (2, 2, 6)])))
+        >>> ev.fast_points([1.0, 2.0], 1.0).round(12).tolist(), float(ev.fast_points(1.0, 1.0, dx=1))
+        ([3.0, 4.0], 1.0)
+        """
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        shape = x.shape
+        s = (x.ravel() - self.x_offset) / self.x_scale
+        t = (y.ravel() - self.y_offset) / self.y_scale
+        c = (self.partial(dx, dy) if dx or dy else self.coefficients).T  # (m, n)
+        m, n = c.shape
+        out = np.empty(s.size)
+        for lo in range(0, s.size, FAST_CHUNK_POINTS):
+            hi = min(lo + FAST_CHUNK_POINTS, s.size)
+            w = c @ chebyshev_matrix_float64(s[lo:hi], n)
+            w *= chebyshev_matrix_float64(t[lo:hi], m)
+            w.sum(axis=0, out=out[lo:hi])
+        return out.reshape(shape)
+
+    def curvature_bound(self, samples: int = 41) -> float:
+        """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on a ``samples`` x ``samples`` grid over the box (per surface unit).
+
+        A sampled maximum, not a proof: the planners use it for the sag of a
+        path between samples, whose own checks cover what it misses.
+        """
+        u = np.linspace(-1.0, 1.0, samples)
+        out = 0.0
+        for dx, dy in ((2, 0), (0, 2), (1, 1)):
+            c = self.partial(dx, dy)
+            tu, tv = chebyshev_matrix_float64(u, c.shape[0]), chebyshev_matrix_float64(u, c.shape[1])
+            out = max(out, float(np.abs(tu.T @ c @ tv).max()))
+        return out
+
+    def error_bound(self, box: tuple[float, float, float, float] | None = None) -> float:
+        """A bound on the absolute rounding error of :meth:`grid` and :meth:`points` over ``box``.
+
+        Parameters
+        ----------
+        box : tuple of float, optional
+            ``(x0, x1, y0, y1)``; the control box by default.  Beyond the
+            control box (extrapolation) the Chebyshev polynomials grow and the
+            bound with them.
+
+        Returns
+        -------
+        float
+            Against the exact value of the polynomial at the given float
+            coordinates: ``sum |C[a, b]| |T_a| |T_b|`` times ``n + m + 2``
+            units of float64 rounding (the coefficients, the basis values and
+            the two matrix products) plus ``a**2 + b**2`` units of the
+            basis's ``longdouble`` rounding (recurrence and normalization).
+        """
+        x0, x1, y0, y1 = self.bounds if box is None else box
+        sx = max(abs((x0 - self.x_offset) / self.x_scale), abs((x1 - self.x_offset) / self.x_scale))
+        sy = max(abs((y0 - self.y_offset) / self.y_scale), abs((y1 - self.y_offset) / self.y_scale))
+        return chebyshev_error_bound(self.coefficients, sx, sy)
+
+    def relative_error_bound(self, box: tuple[float, float, float, float] | None = None) -> float:
+        """:meth:`error_bound` as a fraction of :attr:`data_range`."""
+        return self.error_bound(box) / self.data_range
+
+
+
+_SURFACES: dict[int, SurfaceEvaluator] = {}
+
+
+def _exact_floats(nodes) -> np.ndarray:
+    a = np.array([Fraction(float(v)) == v for v in nodes])
+    a.setflags(write=False)
+    return a
+
+
+def surface_evaluator(surface) -> SurfaceEvaluator:
+    """The :class:`SurfaceEvaluator` of a :class:`~lagsym.lagrange.LagrangeSurface`.
+
+    The exact change of basis is done once per surface object and remembered
+    while the object lives.
+    """
+    key = id(surface)
+    found = _SURFACES.get(key)
+    if found is not None:
+        return found
+    g = surface.grid
+    xo, xh, ax = chebyshev_transform(g.x)
+    yo, yh, ay = chebyshev_transform(g.y)
+    n, m = g.shape
+    power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
+    cheb = ax * power * ay.transpose()
+    coeffs = np.array([[float(fraction(cheb[a, b])) for b in range(m)] for a in range(n)])
+    ev = SurfaceEvaluator(
+        x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh,
+        coefficients=_readonly(coeffs),
+        data_range=data_range(v for row in g.z for v in row),
+        bounds=tuple(float(v) for v in g.bounds),
+        x_nodes=g.x_array,
+        y_nodes=g.y_array,
+        x_exact=_exact_floats(g.x),
+        y_exact=_exact_floats(g.y),
+        node_values=_readonly(g.z_array),
+    )
+    _SURFACES[key] = ev
+    weakref.finalize(surface, _SURFACES.pop, key, None)
+    return ev
+
+
+def evaluate_points(surface, x, y) -> np.ndarray:
+    """Evaluate a surface at scattered points; ``x`` and ``y`` broadcast together."""
+    return surface_evaluator(surface).points(x, y)
+
+
+def evaluate_grid(surface, xs, ys) -> np.ndarray:
+    """Evaluate a surface on the grid ``xs`` x ``ys``; result ``Z[i, j] = F(xs[i], ys[j])``."""
+    return surface_evaluator(surface).grid(xs, ys)
+
+

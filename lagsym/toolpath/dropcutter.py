@@ -1,0 +1,352 @@
+"""Cutter locations: the tool dropped onto the exact surface until it touches it anywhere under it.
+
+For a ball of radius ``R`` centred over ``c = (cx, cy)`` the tip height is
+
+    CL(c) = max over p in D(c, R) ∩ B of  F(p) + sqrt(R**2 - |p - c|**2) - R,
+
+and for a flat end ``max F(p)`` over the same set; ``D`` is the disc under the
+tool and ``B`` the box spanned by the control points.  Only the surface inside
+the box counts: the polynomial is never evaluated outside it (beyond the box
+lies no part, not a cliff and not an extrapolated surface), so near an edge the
+tool rests on what lies inside.  The maximum is found by a dense lattice of
+candidate contact points in the disc, then a pattern search from the best few
+candidates that shrinks to ``1e-9`` of the tool radius (where the maximum lies on
+the rim or on a box edge the height converges only as fast as the step).  Every value found is
+the height of a real contact, so it can only err low; :data:`CL_MARGIN` (a
+relative ``1e-7``, far below any program's resolution) is added to absorb
+that error.  No normal offset is
+involved, so concave regions tighter than the tool are handled: the tool rests
+on the two walls instead of cutting into them.
+
+The surface is evaluated by :meth:`lagsym.evaluate.SurfaceEvaluator.fast_points`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import weakref
+
+import numpy as np
+from numpy.polynomial import chebyshev as C
+
+from ..errors import ToolpathError
+from ..evaluate import SurfaceEvaluator, surface_evaluator
+from ..machine import TOOL_SHAPES
+from ..values import choice, positive
+
+__all__ = ["CL_MARGIN", "drop_cutter"]
+
+CL_MARGIN = 1e-7
+"""Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
+
+_CHUNK = 1 << 12  # positions per pass: about 30 MB of candidates
+_DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1)], dtype=float)
+_SIGNS = np.array([1.0, -1.0])[None, :, None]
+_HALF = math.sqrt(0.5)
+
+
+def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 3,
+                margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+    """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+        The exact surface; only its part inside the control points' box counts.
+    x, y : array_like
+        Tool axis positions in surface units, inside the box.
+    radius : float
+        Tool radius in surface units (0: a point, the surface itself).
+    shape : {"ball", "flat"}
+        Cutter shape.
+    lattice : int
+        Candidate contact points per tool radius in the first, dense search.
+    starts : int
+        How many of the best candidates the local search refines.
+    margin : bool
+        Add :data:`CL_MARGIN`; without it the value is the best contact found,
+        a lower bound of the exact one.
+    evaluator : SurfaceEvaluator, optional
+        The surface's evaluator (by default :func:`lagsym.evaluate.surface_evaluator`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Tip heights, shape of ``x`` broadcast with ``y``; never below the exact
+        drop-cutter value, above it by at most :data:`CL_MARGIN` relative.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 0), (0, 2, 0), (2, 0, 0), (2, 2, 0)]))
+    >>> round(float(drop_cutter(s, 1.0, 1.0, 0.5)), 6)
+    0.0
+    """
+    radius = positive(radius, "tool radius", allow_zero=True)
+    choice(shape, TOOL_SHAPES, "tool shape")
+    ev = evaluator or surface_evaluator(surface)
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    shape_out = x.shape
+    box = ev.bounds
+    cx, cy = _inside_box(x.ravel(), y.ravel(), box)
+    if radius == 0:
+        return ev.fast_points(cx, cy).reshape(shape_out)
+    x0, x1, y0, y1 = box
+    deg = max(*ev.shape, 2)
+    feature = min(x1 - x0, y1 - y0) / (2 * deg)
+    spacing = min(radius / lattice, feature / 2)
+    spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
+    offsets, inside, nearest = _lattice(radius, spacing)
+    span = _height_scale(ev) + radius + 1.0
+    out = np.empty(cx.size)
+    for s in range(0, cx.size, _CHUNK):
+        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets,
+                                        (inside, nearest), spacing, starts, box, 0.01 * CL_MARGIN * span)
+    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+def _inside_box(cx, cy, box):
+    """The tool positions, refused if outside the box (beyond rounding), clipped onto it."""
+    x0, x1, y0, y1 = box
+    eps_box = 1e-9 * max(x1 - x0, y1 - y0)
+    outside = (cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)
+    if np.any(outside):
+        bad = int(np.flatnonzero(outside)[0])
+        raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+    return np.clip(cx, x0, x1), np.clip(cy, y0, y1)
+
+
+_HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator, float] = weakref.WeakKeyDictionary()
+
+
+def _height_scale(ev: SurfaceEvaluator) -> float:
+    """Spread of the surface's coefficients in the power basis of the normalized coordinates.
+
+    The scale :data:`CL_MARGIN` and the search's settling threshold were set
+    against; the Chebyshev coefficients are converted back (in floats) only
+    to measure it, once per evaluator.
+    """
+    found = _HEIGHT_SCALES.get(ev)
+    if found is None:
+        found = _HEIGHT_SCALES[ev] = _power_spread(ev.coefficients)
+    return found
+
+
+def _power_spread(coefficients: np.ndarray) -> float:
+    n, m = coefficients.shape
+    to_power_x = np.array([np.pad(C.cheb2poly(np.eye(n)[k]), (0, n))[:n] for k in range(n)]).T
+    to_power_y = np.array([np.pad(C.cheb2poly(np.eye(m)[k]), (0, m))[:m] for k in range(m)]).T
+    return float(np.ptp(to_power_x @ coefficients @ to_power_y.T))
+
+
+@functools.lru_cache(maxsize=16)
+def _lattice(radius: float, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Offsets of a square lattice inside the disc, plus points on its rim (for a flat end).
+
+    Also returns the lattice's mask of points inside the disc (its square
+    ``2 k + 1`` by ``2 k + 1``, in the order of the offsets), and for each rim
+    point the index of the lattice point nearest to it.
+    """
+    k = max(int(math.ceil(radius / spacing)), 1)
+    t = np.linspace(-radius, radius, 2 * k + 1)
+    gx, gy = np.meshgrid(t, t, indexing="ij")
+    inside = gx**2 + gy**2 <= radius**2 * (1 + 1e-12)
+    rim_n = max(8 * k, 16)
+    a = np.linspace(0.0, 2 * math.pi, rim_n, endpoint=False)
+    rim = radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+    pts = np.stack([gx[inside], gy[inside]], axis=1)
+    nearest = np.argmin(((rim[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2), axis=1)
+    out = (np.concatenate([pts, rim]), inside, nearest)
+    for v in out:
+        v.setflags(write=False)
+    return out
+
+
+def _peaks(val, inside, nearest):
+    """Which candidates are local maxima of the sampled heights: no neighbour on the lattice (or rim) higher.
+
+    The corners of the region under the tool, after the lattice and rim, always count.
+    """
+    n, m, w = val.shape[0], int(inside.sum()), inside.shape[0]
+    g = np.full((n, w + 2, w + 2), -np.inf)
+    g[:, 1:-1, 1:-1][:, inside] = val[:, :m]
+    c = g[:, 1:-1, 1:-1]
+    top = np.ones(c.shape, dtype=bool)
+    for di in (0, 1, 2):
+        for dj in (0, 1, 2):
+            if di != 1 or dj != 1:
+                top &= c >= g[:, di:di + w, dj:dj + w]
+    peak = np.ones(val.shape, dtype=bool)
+    peak[:, :m] = top[:, inside]
+    rim = val[:, m:m + len(nearest)]
+    peak[:, m:m + len(nearest)] = ((rim >= np.roll(rim, 1, axis=1)) & (rim >= np.roll(rim, -1, axis=1))
+                                   & (rim >= val[:, nearest]))
+    return peak
+
+
+def _project(px, py, cx, cy, radius, box):
+    """Move candidate contact points into the box, then into the disc (the box is convex and holds the centre)."""
+    x0, x1, y0, y1 = box
+    px = np.clip(px, x0, x1)
+    py = np.clip(py, y0, y1)
+    dx, dy = px - cx, py - cy
+    d2 = dx * dx + dy * dy
+    over = d2 > radius * radius
+    if np.any(over):
+        f = np.where(over, radius / np.sqrt(np.where(over, d2, 1.0)), 1.0)
+        px, py = cx + dx * f, cy + dy * f
+        dx, dy = px - cx, py - cy
+        d2 = dx * dx + dy * dy
+    return px, py, d2
+
+
+def _edge_points(cx, cy, radius, box):
+    """Box corners, and for each box edge the foot of the perpendicular from the centre and the rim crossings."""
+    x0, x1, y0, y1 = box
+    n = cx.size
+    xs, ys = [], []
+    for a in (x0, x1):
+        for b in (y0, y1):
+            xs.append(np.full(n, a))
+            ys.append(np.full(n, b))
+    for a in (x0, x1):  # vertical edges
+        w = np.sqrt(np.maximum(radius**2 - (cx - a) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(np.full(n, a))
+            ys.append(cy + off * w)
+    for b in (y0, y1):  # horizontal edges
+        w = np.sqrt(np.maximum(radius**2 - (cy - b) ** 2, 0.0))
+        for off in (0.0, 1.0, -1.0):
+            xs.append(cx + off * w)
+            ys.append(np.full(n, b))
+    return np.stack(xs, axis=1), np.stack(ys, axis=1)
+
+
+def _height(ev, px, py, d2, radius, shape):
+    """Tip height of the tool in contact at ``(px, py)``, ``d2`` the squared distance from its axis."""
+    z = ev.fast_points(px, py)
+    if shape == "ball":
+        z = z + np.sqrt(np.maximum(radius * radius - d2, 0.0)) - radius
+    return z
+
+
+def _drop_chunk(ev, cx, cy, radius, shape, offsets, lattice, spacing, starts, box, settle):
+    """Drop-cutter over one chunk of positions: dense candidates, then a local search from the best of each basin."""
+    val, px, py = _candidates(ev, cx, cy, radius, shape, offsets, box)
+    order = _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts)
+    rows = np.arange(cx.size)[:, None]
+    found = _refine(ev, px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel(),
+                    np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1]), radius, shape, box,
+                    spacing, settle)
+    return np.maximum(found.reshape(cx.size, -1).max(axis=1), val.max(axis=1))
+
+
+def _candidates(ev, cx, cy, radius, shape, offsets, box):
+    """Heights and contact points of the lattice and rim under each tool, then of the corners of the region under it.
+
+    The corners are the box corners and where the rim crosses a box edge.
+    Returns arrays of shape ``(positions, candidates)``.
+    """
+    n, k = cx.size, len(offsets)
+    # Dense candidates, a block of offsets at a time to bound memory.
+    block = max(1, (1 << 22) // max(n, 1))
+    val, px, py = np.empty((n, k)), np.empty((n, k)), np.empty((n, k))
+    for s in range(0, k, block):
+        ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
+        qx, qy, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
+        val[:, s:s + block] = _height(ev, qx, qy, d2, radius, shape)
+        px[:, s:s + block], py[:, s:s + block] = qx, qy
+    ex, ey = _edge_points(cx, cy, radius, box)
+    qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
+    return (np.concatenate([val, _height(ev, qx, qy, d2, radius, shape)], axis=1),
+            np.concatenate([px, qx], axis=1), np.concatenate([py, qy], axis=1))
+
+
+def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
+    """For each position, the candidates the local search starts from: the best candidates of distinct basins.
+
+    Only a local maximum of the sampled heights (no lattice neighbour higher;
+    the region's corners always count) heads a basin of its own: the best few
+    candidates overall may all lie on the slopes of one or two peaks, and a
+    narrow peak elsewhere, its samples all below them, would never be refined.
+    A lattice or rim point the box moved is a copy of a point on its edge,
+    maybe one of many: its peaks come after the others.  The best candidate of
+    all comes first in any case.
+    """
+    n, k = cx.size, len(offsets)
+    moved = np.zeros(val.shape, dtype=bool)
+    moved[:, :k] = (px[:, :k] != cx[:, None] + offsets[:, 0]) | (py[:, :k] != cy[:, None] + offsets[:, 1])
+    rank = np.where(_peaks(val, *lattice), np.where(moved, 1, 0), 2)
+    rank[np.arange(n), np.argmax(val, axis=1)] = 0
+    return _spread_starts(val, px, py, starts, 2.5 * spacing, rank)
+
+
+def _refine(ev, px, py, val, ccx, ccy, radius, shape, box, spacing, settle):
+    """Pattern search from each start, in place: the best contact height found from each.
+
+    Eight steps a round, along the axes and along and across the radius;
+    the step halves where none climbs, down to ``1e-9`` of the radius.
+    """
+    h = np.full(px.size, spacing)
+    stop = radius * 1e-9
+    for _ in range(120):
+        active = h > stop
+        if not active.any():
+            break
+        ia = np.flatnonzero(active)
+        # Axis steps follow the box edges; radial and tangential steps follow the rim of the disc.
+        ox, oy = px[ia] - ccx[ia], py[ia] - ccy[ia]
+        norm = np.hypot(ox, oy)
+        at_centre = norm <= stop
+        norm = np.where(at_centre, 1.0, norm)
+        # At the centre there is no radius to follow: step along the diagonals instead.
+        er = np.stack([np.where(at_centre, _HALF, ox / norm), np.where(at_centre, _HALF, oy / norm)], axis=1)
+        et = np.stack([-er[:, 1], er[:, 0]], axis=1)
+        dirs = np.concatenate([np.broadcast_to(_DIRS[None, :, :], (ia.size, 4, 2)),
+                               er[:, None, :] * _SIGNS, et[:, None, :] * _SIGNS], axis=1)
+        qx = px[ia, None] + h[ia, None] * dirs[:, :, 0]
+        qy = py[ia, None] + h[ia, None] * dirs[:, :, 1]
+        qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
+        qv = _height(ev, qx, qy, d2, radius, shape)
+        j = np.argmax(qv, axis=1)
+        bv = qv[np.arange(ia.size), j]
+        up = bv > val[ia]
+        iu = ia[up]
+        nx, ny = qx[up, j[up]], qy[up, j[up]]
+        # A step the projection shortened to a creep along a constraint counts as a failure too:
+        # shrinking lets the steps along the rim or edge stop overshooting the maximum.
+        creep = np.hypot(nx - px[iu], ny - py[iu]) < 0.25 * h[iu]
+        px[iu], py[iu], val[iu] = nx, ny, bv[up]
+        h[ia[~up]] *= 0.5
+        h[iu[creep]] *= 0.5
+        # Where no neighbour differs by more than a hundredth of the margin, the value has settled.
+        settled = ~up & (np.max(np.abs(np.where(np.isfinite(qv), qv, val[ia, None]) - val[ia, None]), axis=1) < settle)
+        h[ia[settled]] = 0.0
+    return val
+
+
+def _spread_starts(val, px, py, starts, apart, rank=None):
+    """For each row, the best candidate and then the best ones at least ``apart`` from those already chosen.
+
+    Two nearly equal peaks under the tool are then both refined, instead of
+    two neighbours on the slope of one of them.  Where ``rank`` is given, the
+    candidates of rank 0 (the local maxima) come first, best first, then those
+    of rank 1, then those of rank 2.
+    """
+    n, k = val.shape
+    key = val if rank is None else val - rank * (np.ptp(val, axis=1, keepdims=True) + 1.0)
+    top = np.argsort(-key, axis=1)[:, :min(k, 8 * starts + 32)]
+    rows = np.arange(n)[:, None]
+    tx, ty = px[rows, top], py[rows, top]
+    chosen = [top[:, 0]]
+    far = np.ones(top.shape, dtype=bool)
+    for _ in range(1, starts):
+        last = chosen[-1]
+        lx, ly = px[np.arange(n), last], py[np.arange(n), last]
+        far &= np.hypot(tx - lx[:, None], ty - ly[:, None]) >= apart
+        j = np.argmax(far, axis=1)  # the first (best) far candidate, or 0 if none is far
+        chosen.append(np.where(far[np.arange(n), j], top[np.arange(n), j], top[:, min(len(chosen), top.shape[1] - 1)]))
+    return np.stack(chosen, axis=1)
