@@ -31,8 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from lagsym.dnc import plan_transfer, profile, send_program  # noqa: E402
-from lagsym.dncplan import parse_program  # noqa: E402
+from lagsym.dnc import parse_program, profile, send_program, transfer_segments  # noqa: E402
 from simcontrol import KernelPty, PtyPair, SimControl, chars_per_s, program_text  # noqa: E402
 
 HIGH = 192  # the control's high-water mark, characters
@@ -47,7 +46,7 @@ def run(baud: int, blocks: int, drain: float | None, rig: str) -> dict:
                          drain_cps=None if drain is None else drain * cps,
                          buffer_chars=256, high_water=HIGH, low_water=64, tolerance=10)
         sim.start()
-        expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
+        expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
         result = send_program(pair.near, prog, settings, "drip")
         sim.wait_for(len(expected))
         rec = sim.stop()

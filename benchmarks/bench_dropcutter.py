@@ -22,6 +22,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from lagsym.evaluate import evaluate_points  # noqa: E402
 from lagsym.io import read_points  # noqa: E402
 from lagsym.lagrange import lagrange_surface  # noqa: E402
 from lagsym.toolpath import drop_cutter  # noqa: E402
@@ -34,7 +35,7 @@ def stl_surface(ocl, surface, n: int, scale: float):
     x0, x1, y0, y1 = (float(v) for v in surface.grid.bounds)
     xs, ys = np.linspace(x0, x1, n + 1), np.linspace(y0, y1, n + 1)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
-    gz = surface.evaluate(gx, gy)
+    gz = evaluate_points(surface, gx, gy)
     pts = [[ocl.Point(gx[i, j] * scale, gy[i, j] * scale, gz[i, j] * scale) for j in range(n + 1)]
            for i in range(n + 1)]
     stl = ocl.STLSurf()

@@ -31,7 +31,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from lagsym.evaluate import basis_matrix, evaluate_grid, surface_evaluator  # noqa: E402
+from lagsym.evaluate import basis_matrix, evaluate_grid, evaluate_points, lambdify_surface, surface_evaluator  # noqa: E402
+from lagsym.sampling import sample  # noqa: E402
 from lagsym.grid import grid_from_table  # noqa: E402
 from lagsym.io import read_points  # noqa: E402
 from lagsym.lagrange import lagrange_surface  # noqa: E402
@@ -57,8 +58,8 @@ def speed(n: int = 2000) -> None:
     surface = lagrange_surface(read_points(ROOT / "examples" / "paper-example-4.json"))
     g = surface.grid
     xs, ys = np.linspace(1, 5, n), np.linspace(1, 5, n)
-    surface.sample(2, 2)  # the exact change of basis, once per surface
-    f = surface.lambdify()
+    sample(surface, 2, 2)  # the exact change of basis, once per surface
+    f = lambdify_surface(surface)
 
     def scipy_both_axes():
         zx = BarycentricInterpolator(g.x_array, g.z_array, axis=0)(xs)  # (n, m)
@@ -74,7 +75,7 @@ def speed(n: int = 2000) -> None:
 
     t_fill = best(lambda: np.full((n, n), 1.0), repeat=15)
     t_grid = best(lambda: evaluate_grid(surface, xs, ys), repeat=15)
-    t_sample = best(lambda: surface.sample(n, n), repeat=15)
+    t_sample = best(lambda: sample(surface, n, n), repeat=15)
     t_scipy = best(scipy_both_axes, repeat=7)
     t_rows = best(scipy_row_by_row, repeat=3)
     t_lamb = best(lambda: f(xs[:, None], ys[None, :]), repeat=3)
@@ -82,7 +83,7 @@ def speed(n: int = 2000) -> None:
     t_lamb_mesh = best(lambda: f(X, Y), repeat=3)
     rng = np.random.default_rng(0)
     px, py = rng.uniform(1, 5, 10**6), rng.uniform(1, 5, 10**6)
-    t_scatter = best(lambda: surface.evaluate(px, py), repeat=5)
+    t_scatter = best(lambda: evaluate_points(surface, px, py), repeat=5)
     t_scatter_lamb = best(lambda: f(px, py), repeat=3)
 
     print(f"## Speed: {n} x {n} regular sample of paper Example 4 (5x5 nodes)\n")
@@ -91,7 +92,7 @@ def speed(n: int = 2000) -> None:
     print(f"| NumPy `np.full` of the same size (the memory limit) | {t_fill * 1e3:.2f} | "
           f"lagsym is {t_grid / t_fill:.2f}x its time |")
     print(f"| **lagsym** `evaluate_grid` (tensor product, Chebyshev basis) | {t_grid * 1e3:.2f} | 1 |")
-    print(f"| **lagsym** `surface.sample(n, n)` (with exact grid lines) | {t_sample * 1e3:.2f} | "
+    print(f"| **lagsym** `sample(surface, n, n)` (with exact grid lines) | {t_sample * 1e3:.2f} | "
           f"{t_sample / t_grid:.2f}x |")
     print(f"| SciPy `BarycentricInterpolator`, along x then along y (vectorized) | {t_scipy * 1e3:.2f} | "
           f"{t_scipy / t_grid:.1f}x slower |")
@@ -104,7 +105,7 @@ def speed(n: int = 2000) -> None:
     print()
     print("| scattered points | time (ms) | ratio |")
     print("|---|---:|---:|")
-    print(f"| **lagsym** `surface.evaluate(x, y)`, 10^6 random points | {t_scatter * 1e3:.1f} | 1 |")
+    print(f"| **lagsym** `evaluate_points(surface, x, y)`, 10^6 random points | {t_scatter * 1e3:.1f} | 1 |")
     print(f"| `lambdify` of the expanded expression, same points | {t_scatter_lamb * 1e3:.1f} | "
           f"{t_scatter_lamb / t_scatter:.1f}x |")
     print()
@@ -154,7 +155,7 @@ def accuracy(points: int = 60) -> None:
                 g = surface.grid
                 lo, hi = float(xs[0]), float(xs[-1])
                 px, py = rng.uniform(lo, hi, points), rng.uniform(lo, hi, points)
-                ours = _errors(surface, px, py, surface.evaluate(px, py)) / ev.data_range
+                ours = _errors(surface, px, py, evaluate_points(surface, px, py)) / ev.data_range
                 bary = np.einsum("pk,pk->p", basis_matrix(g.x_array, px) @ g.z_array, basis_matrix(g.y_array, py))
                 bary_err = _errors(surface, px, py, bary) / ev.data_range
                 power = np.polynomial.polynomial.polyval2d(px, py, np.array(surface.coefficients, dtype=float))

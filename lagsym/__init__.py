@@ -24,7 +24,8 @@ _EXPORTS = {
     "io": ("read_points", "read_curve_points", "read_any_points"),
     "grid": ("ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points"),
     "lagrange": ("LagrangeCurve", "LagrangeSurface", "lagrange_curve", "lagrange_surface", "lagrange_basis"),
-    "evaluate": ("SurfaceEvaluator", "surface_evaluator"),
+    "evaluate": ("SurfaceEvaluator", "surface_evaluator", "evaluate_points", "evaluate_grid", "evaluate_curve",
+                 "lambdify_surface"),
     "sampling": ("Sample", "SampleGrid", "sample", "sample_grid"),
     "export": ("write_sample",),
     "cad": ("BezierPatch", "BSplinePatch", "bezier_patch", "cad_patch"),
@@ -67,8 +68,9 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .dncplan import Program, parse_program, resume_setup
     from .errors import (ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
-    from .evaluate import SurfaceEvaluator, surface_evaluator
     from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
+    from .evaluate import (SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
+                           surface_evaluator)
     from .export import write_sample
     from .export.cad import write_cad
     from .formula import Formula, parse_formula

@@ -8,21 +8,28 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, localcontext
 from fractions import Fraction
 
+import flint
 import sympy
 
 from .errors import InputError
-from .lagrange import X, Y, LagrangeCurve, LagrangeSurface
+from .lagrange import LagrangeCurve, LagrangeSurface, horner2
 
-__all__ = ["FORMATS", "render", "nested_form", "decimal_text", "round_significant"]
+__all__ = ["FORMATS", "render", "nested_form", "decimal_text", "round_significant", "rounded_coefficients",
+           "RoundingMiss", "rounding_miss"]
 
 FORMATS = ("sympy", "latex", "json", "horner", "python")
 
 
 def _lhs(obj) -> str:
     return "z" if isinstance(obj, LagrangeSurface) else "y"
+
+
+def _symbols(obj) -> tuple[sympy.Symbol, ...]:
+    return obj.symbols if isinstance(obj, LagrangeSurface) else (obj.symbol,)
 
 
 def _coeff_dict(obj) -> dict[tuple[int, ...], Fraction]:
@@ -41,12 +48,13 @@ def nested_form(obj) -> sympy.Expr:
     x*(8 - 2*x) - 5
     """
     if isinstance(obj, LagrangeCurve):
-        return sympy.horner(obj.expr, X) if obj.expr.free_symbols else obj.expr
+        return sympy.horner(obj.expr, obj.symbol) if obj.expr.free_symbols else obj.expr
+    sx, sy = obj.symbols
     expr = sympy.Integer(0)
     for row in reversed(obj.coefficients):
-        py = sum((sympy.Rational(c.numerator, c.denominator) * Y**b for b, c in enumerate(row)), sympy.Integer(0))
-        inner = sympy.horner(py, Y) if py.free_symbols else py
-        expr = expr * X + inner
+        py = sum((sympy.Rational(c.numerator, c.denominator) * sy**b for b, c in enumerate(row)), sympy.Integer(0))
+        inner = sympy.horner(py, sy) if py.free_symbols else py
+        expr = expr * sx + inner
     return expr
 
 
@@ -61,10 +69,35 @@ def round_significant(value: Fraction, digits: int) -> Decimal:
 
 
 def _decimal_str(d: Decimal) -> str:
+    # Scientific notation where Python's repr of a float uses it: a tiny
+    # coefficient as 2.983e-16, not 0.0000000000000002983.
+    exponent = d.adjusted()
+    if d and (exponent < -4 or exponent >= 16):
+        mantissa = (d.scaleb(-exponent)).normalize()
+        return f"{_decimal_str(mantissa)}e{exponent:+03d}"
     text = format(d, "f")
     if "." in text:
         text = text.rstrip("0").rstrip(".")
     return "0" if text in ("-0", "") else text
+
+
+def rounded_coefficients(obj, digits: int) -> dict[tuple[int, ...], Decimal]:
+    """The nonzero coefficients rounded to ``digits`` significant digits, keyed by exponents.
+
+    Examples
+    --------
+    >>> from lagsym import lagrange_curve, curve_from_points
+    >>> rounded_coefficients(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 2), (4, 3)])), 2)
+    {(0,): Decimal('-9'), (1,): Decimal('16'), (2,): Decimal('-6.5'), (3,): Decimal('0.83')}
+    """
+    if digits < 1:
+        raise InputError(f"--digits {digits}: give at least 1 significant digit")
+    out = {}
+    for key, c in sorted(_coeff_dict(obj).items()):
+        d = round_significant(c, digits)
+        if d:
+            out[key] = d
+    return out
 
 
 def decimal_text(obj, digits: int) -> str:
@@ -76,17 +109,13 @@ def decimal_text(obj, digits: int) -> str:
     >>> decimal_text(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 2), (4, 3)])), 4)
     '0.8333*x**3 - 6.5*x**2 + 15.67*x - 9'
     """
-    if digits < 1:
-        raise InputError(f"--digits {digits}: give at least 1 significant digit")
-    coeffs = _coeff_dict(obj)
-    names = ("x", "y")
+    coeffs = rounded_coefficients(obj, digits)
+    names = tuple(str(s) for s in _symbols(obj))
     # Graded order, highest total degree first, as SymPy prints.
     keys = sorted(coeffs, key=lambda k: (sum(k), k), reverse=True)
     parts: list[str] = []
     for key in keys:
-        d = round_significant(coeffs[key], digits)
-        if d == 0:
-            continue
+        d = coeffs[key]
         mono = "*".join(
             names[v] if p == 1 else f"{names[v]}**{p}" for v, p in enumerate(key) if p
         )
@@ -103,7 +132,7 @@ def _json(obj) -> str:
         g = obj.grid
         doc = {
             "equation": f"z = {obj.expr}",
-            "variables": ["x", "y"],
+            "variables": [str(v) for v in obj.symbols],
             "degree": {"x": obj.degree[0], "y": obj.degree[1]},
             "coefficients": {f"{a},{b}": str(c) for (a, b), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in g.x], "y": [str(v) for v in g.y]},
@@ -111,7 +140,7 @@ def _json(obj) -> str:
     else:
         doc = {
             "equation": f"y = {obj.expr}",
-            "variables": ["x"],
+            "variables": [str(obj.symbol)],
             "degree": {"x": obj.degree},
             "coefficients": {str(a): str(c) for (a,), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in obj.points.x]},
@@ -120,7 +149,7 @@ def _json(obj) -> str:
 
 
 def _python(obj) -> str:
-    args = "x, y" if isinstance(obj, LagrangeSurface) else "x"
+    args = ", ".join(str(v) for v in _symbols(obj))
     what = (
         f"tensor-product Lagrange surface of degree {obj.degree[0]} x {obj.degree[1]}"
         if isinstance(obj, LagrangeSurface)
@@ -148,7 +177,8 @@ def render(obj, fmt: str = "sympy", digits: int | None = None) -> str:
         if fmt == "sympy":
             return f"{lhs} = {rhs}"
         if fmt == "latex":
-            return f"{lhs} = {sympy.latex(sympy.sympify(rhs, locals={'x': X, 'y': Y}))}"
+            names = {str(v): v for v in _symbols(obj)}
+            return f"{lhs} = {sympy.latex(sympy.sympify(rhs, locals=names))}"
         raise InputError(f"--digits goes with --format sympy or latex, not {fmt}")
     if fmt == "sympy":
         return f"{lhs} = {obj.expr}"
@@ -159,3 +189,71 @@ def render(obj, fmt: str = "sympy", digits: int | None = None) -> str:
     if fmt == "python":
         return _python(obj).rstrip("\n")
     return _json(obj)
+
+
+@dataclass(frozen=True)
+class RoundingMiss:
+    """How far the equation with rounded coefficients misses the control points, exactly.
+
+    Attributes
+    ----------
+    digits : int
+        Significant digits the coefficients were rounded to.
+    largest : Fraction
+        The largest ``|z_ik - F_rounded(x_i, y_k)|`` over the control points (``|y_i - F(x_i)|``
+        for a curve), exact.
+    at : tuple of Fraction
+        The control point where it is largest, ``(x, y, z)`` (``(x, y)`` for a curve).
+    """
+
+    digits: int
+    largest: Fraction
+    at: tuple[Fraction, ...]
+
+    def text(self, units: str | None = None) -> str:
+        """One line saying it, for standard error or a comment."""
+        unit = f" {units}" if units else ""
+        where = ", ".join(_decimal_str(round_significant(v, 12)) for v in self.at)
+        if not self.largest:
+            return f"rounded to {self.digits} significant digits, the equation still passes through every control point"
+        return (f"rounded to {self.digits} significant digits, the equation misses the control points by up to "
+                f"{_decimal_str(round_significant(self.largest, 3))}{unit} (at the point ({where})); "
+                f"without --digits it passes through all of them exactly")
+
+
+def _fmpq(v: Fraction) -> flint.fmpq:
+    return flint.fmpq(v.numerator, v.denominator)
+
+
+def _vandermonde(nodes, size: int) -> flint.fmpq_mat:
+    return flint.fmpq_mat(len(nodes), size, [_fmpq(v) ** a for v in nodes for a in range(size)])
+
+
+def rounding_miss(obj, digits: int) -> RoundingMiss:
+    """Evaluate the rounded equation in exact rationals at every control point: the largest miss and where.
+
+    Examples
+    --------
+    >>> from lagsym import lagrange_curve, curve_from_points
+    >>> miss = rounding_miss(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 2), (4, 3)])), 4)
+    >>> miss.largest, miss.at
+    (Fraction(7, 625), (Fraction(4, 1), Fraction(3, 1)))
+    """
+    rounded = {k: Fraction(d) for k, d in rounded_coefficients(obj, digits).items()}
+    if isinstance(obj, LagrangeCurve):
+        xs, values = obj.points.x, obj.points.y
+        got = [sum((c * x ** a for (a,), c in rounded.items()), Fraction(0)) for x in xs]
+        misses = [(abs(v - g), (x, v)) for x, v, g in zip(xs, values, got)]
+    else:
+        g = obj.grid
+        n, m = g.shape
+        c = flint.fmpq_mat(n, m, [_fmpq(rounded.get((a, b), Fraction(0))) for a in range(n) for b in range(m)])
+        # All n * m values at once: F(x_i, y_k) = (Vx C Vy^T)[i, k], exact.
+        f = _vandermonde(g.x, n) * c * _vandermonde(g.y, m).transpose()
+        misses = []
+        for i, xi in enumerate(g.x):
+            for k, yk in enumerate(g.y):
+                v = Fraction(int(f[i, k].p), int(f[i, k].q))
+                misses.append((abs(g.z[i][k] - v), (xi, yk, g.z[i][k])))
+    largest, at = max(misses, key=lambda t: t[0])
+    return RoundingMiss(digits=digits, largest=largest, at=at)

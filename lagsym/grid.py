@@ -19,7 +19,8 @@ import numpy as np
 from ._arrays import readonly as _readonly
 from .errors import GridError, InputError
 
-__all__ = ["ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points"]
+__all__ = ["ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points",
+           "SnapReport", "snap_points"]
 
 
 def _fmt(v: Fraction) -> str:
@@ -52,12 +53,16 @@ class ControlGrid:
         ``z[i][k]`` is the height at ``(x[i], y[k])``.
     source : str
         Where the points came from (a file name), for messages.
+    units : str or None
+        The units of the coordinates where the file says them (``"mm"`` or
+        ``"inch"``: a JSON ``"units"`` key or a header such as ``X (mm)``).
     """
 
     x: tuple[Fraction, ...]
     y: tuple[Fraction, ...]
     z: tuple[tuple[Fraction, ...], ...]
     source: str = field(default="<points>", compare=False)
+    units: str | None = field(default=None, compare=False)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -100,16 +105,17 @@ class ControlGrid:
 
     def with_z(self, z: Sequence[Sequence[Fraction]]) -> ControlGrid:
         """The same nodes with other heights."""
-        return grid_from_table(self.x, self.y, z, source=self.source)
+        return grid_from_table(self.x, self.y, z, source=self.source, units=self.units)
 
 
 @dataclass(frozen=True)
 class CurvePoints:
-    """Nodes ``x[0] < ... < x[n-1]`` and values ``y[i]`` of a 1-D curve, exact."""
+    """Nodes ``x[0] < ... < x[n-1]`` and values ``y[i]`` of a 1-D curve, exact (``units`` as for a grid)."""
 
     x: tuple[Fraction, ...]
     y: tuple[Fraction, ...]
     source: str = field(default="<points>", compare=False)
+    units: str | None = field(default=None, compare=False)
 
     @property
     def degree(self) -> int:
@@ -145,7 +151,8 @@ def _check_axis(nodes: Sequence[Fraction], name: str, source: str) -> None:
 
 
 def grid_from_table(
-    x: Sequence[Fraction], y: Sequence[Fraction], z: Sequence[Sequence[Fraction]], source: str = "<points>"
+    x: Sequence[Fraction], y: Sequence[Fraction], z: Sequence[Sequence[Fraction]], source: str = "<points>",
+    units: str | None = None,
 ) -> ControlGrid:
     """Build a grid from node lists and a height table ``z[i][k]`` at ``(x[i], y[k])``.
 
@@ -182,10 +189,12 @@ def grid_from_table(
         y=tuple(ys[k] for k in iy),
         z=tuple(tuple(rows[i][k] for k in iy) for i in ix),
         source=source,
+        units=units,
     )
 
 
-def grid_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>") -> ControlGrid:
+def grid_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>",
+                     units: str | None = None) -> ControlGrid:
     """Arrange ``(x, y, z)`` triples given in any order into the paper's matrix ``p_ik``.
 
     Examples
@@ -222,14 +231,32 @@ def grid_from_points(points: Sequence[Sequence[Fraction]], source: str = "<point
             if (xi, yk) not in heights:
                 raise GridError(
                     f"{source}: no point at (x, y) = ({_fmt(xi)}, {_fmt(yk)}): the {len(points)} points do not "
-                    f"form a rectangular grid over {len(xs)} x-values and {len(ys)} y-values"
+                    f"form a rectangular grid over {len(xs)} x-values and {len(ys)} y-values{_jitter_hint(xs, ys)}"
                 )
             row.append(heights[(xi, yk)][0])
         z.append(tuple(row))
-    return ControlGrid(x=tuple(xs), y=tuple(ys), z=tuple(z), source=source)
+    return ControlGrid(x=tuple(xs), y=tuple(ys), z=tuple(z), source=source, units=units)
 
 
-def curve_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>") -> CurvePoints:
+def _jitter_hint(xs: list[Fraction], ys: list[Fraction]) -> str:
+    """A hint when two node values are so close that they are one node measured twice (CMM jitter)."""
+    for name, vals in (("x", xs), ("y", ys)):
+        gap, a, b = min((vals[j + 1] - vals[j], vals[j], vals[j + 1]) for j in range(len(vals) - 1))
+        if gap * 10**6 < vals[-1] - vals[0]:
+            return (f"; {name} = {_fmt(a)} and {name} = {_fmt(b)} differ by only {float(gap):.3g}: if they are one "
+                    f"node measured twice, snap them together with --snap {_tolerance_for(gap)}")
+    return ""
+
+
+def _tolerance_for(gap: Fraction) -> str:
+    exponent = 0
+    while Fraction(10) ** exponent > gap * 10:
+        exponent -= 1
+    return f"1e{exponent + 2}"
+
+
+def curve_from_points(points: Sequence[Sequence[Fraction]], source: str = "<points>",
+                      units: str | None = None) -> CurvePoints:
     """Sort ``(x, y)`` pairs by x for a 1-D Lagrange curve.
 
     Examples
@@ -253,7 +280,7 @@ def curve_from_points(points: Sequence[Sequence[Fraction]], source: str = "<poin
         seen[px] = idx
         pairs.append((px, py))
     pairs.sort()
-    return CurvePoints(x=tuple(p[0] for p in pairs), y=tuple(p[1] for p in pairs), source=source)
+    return CurvePoints(x=tuple(p[0] for p in pairs), y=tuple(p[1] for p in pairs), source=source, units=units)
 
 
 def _show(p) -> str:
@@ -261,3 +288,97 @@ def _show(p) -> str:
         return "[" + ", ".join(_fmt(v) if isinstance(v, (int, Fraction)) else repr(v) for v in p) + "]"
     except TypeError:
         return repr(p)
+
+
+@dataclass(frozen=True)
+class SnapReport:
+    """What :func:`snap_points` moved.
+
+    Attributes
+    ----------
+    tolerance : Fraction
+        Node values closer than this were taken as one node.
+    moved : int
+        How many points had a coordinate moved.
+    largest : Fraction
+        The largest move of one coordinate.
+    nodes : tuple of int
+        The number of distinct node values per snapped axis afterwards.
+    """
+
+    tolerance: Fraction
+    moved: int
+    largest: Fraction
+    nodes: tuple[int, ...]
+
+    def text(self, source: str) -> str:
+        """One line saying it."""
+        if not self.moved:
+            return f"{source}: --snap {float(self.tolerance):g}: no point needed moving"
+        axes = " x ".join(str(n) for n in self.nodes)
+        return (f"{source}: --snap {float(self.tolerance):g}: moved {self.moved} point(s) onto {axes} nodes, "
+                f"the largest move {float(self.largest):.3g}")
+
+
+def _simplest(lo: Fraction, hi: Fraction) -> Fraction:
+    """The decimal with the fewest digits in ``[lo, hi]``, nearest the middle: 3 for 2.9999999999999996..3.0000000000000004."""
+    if lo == hi:
+        return lo
+    mid = (lo + hi) / 2
+    step = Fraction(1)
+    while step > (hi - lo) / 10:
+        first, last = -((-lo) // step), hi // step
+        if first <= last:
+            return min(max(round(mid / step), first), last) * step
+        step /= 10
+    return mid
+
+
+def _snap_axis(values: list[Fraction], tolerance: Fraction, name: str, source: str) -> dict[Fraction, Fraction]:
+    groups: list[list[Fraction]] = []
+    for v in sorted(set(values)):
+        if groups and v - groups[-1][-1] <= tolerance:
+            groups[-1].append(v)
+        else:
+            groups.append([v])
+    target = {}
+    for g in groups:
+        if g[-1] - g[0] > tolerance:
+            raise GridError(f"{source}: --snap {_fmt(tolerance)}: the {name} values from {_fmt(g[0])} to {_fmt(g[-1])} "
+                            f"chain together but span more than {_fmt(tolerance)}; give a smaller --snap")
+        node = _simplest(g[0], g[-1])
+        target.update({v: node for v in g})
+    return target
+
+
+def snap_points(points: Sequence[Sequence[Fraction]], tolerance, axes: int = 2,
+                source: str = "<points>") -> tuple[list[tuple[Fraction, ...]], SnapReport]:
+    """Move node coordinates that differ by at most ``tolerance`` onto one node (measured grids, CMM jitter).
+
+    The first ``axes`` coordinates of each point are snapped (x and y of a
+    surface, x of a curve); heights never move.  The node a group moves to
+    is the shortest decimal within the group's range.
+
+    Examples
+    --------
+    >>> pts = [(Fraction("2.9999999999999996"), 1, 5), (3, 2, 6), (1, 1, 7), (1, 2, 8)]
+    >>> snapped, report = snap_points(pts, Fraction(1, 10**9))
+    >>> snapped[0][0], report.moved, report.largest
+    (Fraction(3, 1), 1, Fraction(1, 2500000000000000))
+    """
+    from .values import as_exact
+
+    tol = as_exact(tolerance, "--snap")
+    if tol <= 0:
+        raise InputError(f"--snap {_fmt(tol)} must be a positive tolerance")
+    maps = [_snap_axis([Fraction(p[a]) for p in points], tol, "xy"[a], source) for a in range(axes)]
+    out, moved, largest = [], 0, Fraction(0)
+    for p in points:
+        q = tuple(maps[a][Fraction(v)] if a < axes else v for a, v in enumerate(p))
+        shifts = [abs(q[a] - Fraction(p[a])) for a in range(axes)]
+        if any(shifts):
+            moved += 1
+            largest = max(largest, *shifts)
+        out.append(q)
+    nodes = tuple(len(set(m.values())) for m in maps)
+    return out, SnapReport(tolerance=tol, moved=moved, largest=largest, nodes=nodes)

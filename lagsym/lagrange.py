@@ -9,6 +9,11 @@ has the coefficient matrix ``C = Bx.T @ Z @ By`` (``C[a, b]`` multiplies
 ``x**a * y**b``), computed with python-flint's exact rational matrices.  This
 avoids expanding ``n * m`` symbolic products, the textbook route, which is
 hundreds of times slower.
+
+The polynomials are built on plain SymPy symbols, ``x`` and ``y`` by default,
+the ones ``sympy.symbols('x y')`` gives, so that ``subs``, ``diff``,
+``integrate``, ``solve`` and ``==`` work with the symbols a user types; pass
+``x=`` and ``y=`` to use others.
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ from functools import cached_property
 
 import flint
 import sympy
+
+from .errors import InputError
 
 from .grid import ControlGrid, CurvePoints
 
@@ -34,7 +41,18 @@ __all__ = [
     "horner2",
 ]
 
-X, Y = sympy.symbols("x y", real=True)
+# Plain symbols: a symbol with assumptions (real=True) is a different symbol
+# from the x a user types, and every subs, diff or == with it silently fails.
+X, Y = sympy.symbols("x y")
+LATEX_TERMS = 120  # a rich display longer than this shows a summary, not a page of LaTeX
+
+
+def _symbol(value, what: str) -> sympy.Symbol:
+    if isinstance(value, str):
+        value = sympy.Symbol(value)
+    if not isinstance(value, sympy.Symbol):
+        raise InputError(f"{what} = {value!r} is not a SymPy symbol or a name")
+    return value
 
 
 def _fmpq(v: Fraction) -> flint.fmpq:
@@ -107,10 +125,16 @@ class LagrangeCurve:
         The nodes and values.
     coefficients : tuple of Fraction
         ``coefficients[a]`` multiplies ``x**a``.
+    symbol : sympy.Symbol
+        The variable of :attr:`poly`, :attr:`expr` and :attr:`basis`; plain
+        ``x`` by default.
+
+    In Jupyter the curve shows as its equation in LaTeX.
     """
 
     points: CurvePoints
     coefficients: tuple[Fraction, ...]
+    symbol: sympy.Symbol = X
 
     @property
     def degree(self) -> int:
@@ -119,18 +143,25 @@ class LagrangeCurve:
 
     @cached_property
     def poly(self) -> sympy.Poly:
-        """The curve as a ``sympy.Poly`` in ``x`` over QQ."""
-        return _poly1(self.coefficients, X)
+        """The curve as a ``sympy.Poly`` in :attr:`symbol` over QQ."""
+        return _poly1(self.coefficients, self.symbol)
 
     @cached_property
     def expr(self) -> sympy.Expr:
-        """The curve as an exact SymPy expression in ``x``."""
+        """The curve as an exact SymPy expression in :attr:`symbol`."""
         return self.poly.as_expr()
 
     @cached_property
     def basis(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 2)."""
-        return lagrange_basis(self.points.x, X)
+        return lagrange_basis(self.points.x, self.symbol)
+
+    def __repr__(self) -> str:
+        sym = "" if self.symbol == X else f", x={self.symbol}"
+        return f"LagrangeCurve({len(self.points.x)} points, degree {self.degree}{sym}, source={self.points.source!r})"
+
+    def _repr_latex_(self) -> str:
+        return _latex("y", self.expr, len([c for c in self.coefficients if c]), f"degree {self.degree}")
 
     def exact_value(self, x) -> Fraction:
         """``F(x)`` in exact arithmetic."""
@@ -139,12 +170,6 @@ class LagrangeCurve:
         for c in reversed(self.coefficients):
             acc = acc * x + c
         return acc
-
-    def evaluate(self, x):
-        """``F(x)`` in floating point, stable (barycentric form), on NumPy arrays."""
-        from .evaluate import evaluate_curve
-
-        return evaluate_curve(self, x)
 
 
 @dataclass(frozen=True)
@@ -158,10 +183,16 @@ class LagrangeSurface:
     coefficients : tuple of tuple of Fraction
         ``coefficients[a][b]`` multiplies ``x**a * y**b`` (numpy's ``polyval2d``
         order).
+    symbols : tuple of sympy.Symbol
+        The variables ``(x, y)`` of :attr:`poly`, :attr:`expr` and the bases;
+        plain ``x`` and ``y`` by default.
+
+    In Jupyter the surface shows as its equation in LaTeX.
     """
 
     grid: ControlGrid
     coefficients: tuple[tuple[Fraction, ...], ...]
+    symbols: tuple[sympy.Symbol, sympy.Symbol] = (X, Y)
 
     @property
     def degree(self) -> tuple[int, int]:
@@ -170,29 +201,38 @@ class LagrangeSurface:
 
     @cached_property
     def poly(self) -> sympy.Poly:
-        """The surface as a ``sympy.Poly`` in ``x, y`` over QQ."""
+        """The surface as a ``sympy.Poly`` in :attr:`symbols` over QQ."""
         terms = {
             (a, b): sympy.Rational(c.numerator, c.denominator)
             for a, row in enumerate(self.coefficients)
             for b, c in enumerate(row)
             if c
         }
-        return sympy.Poly.from_dict(terms, X, Y, domain=sympy.QQ)
+        return sympy.Poly.from_dict(terms, *self.symbols, domain=sympy.QQ)
 
     @cached_property
     def expr(self) -> sympy.Expr:
-        """The surface as an exact SymPy expression in ``x`` and ``y``."""
+        """The surface as an exact SymPy expression in :attr:`symbols`."""
         return self.poly.as_expr()
 
     @cached_property
     def basis_x(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 6)."""
-        return lagrange_basis(self.grid.x, X)
+        return lagrange_basis(self.grid.x, self.symbols[0])
 
     @cached_property
     def basis_y(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_k(y)`` (paper eq. 7)."""
-        return lagrange_basis(self.grid.y, Y)
+        return lagrange_basis(self.grid.y, self.symbols[1])
+
+    def __repr__(self) -> str:
+        (n, m), (sx, sy) = self.grid.shape, self.symbols
+        sym = "" if self.symbols == (X, Y) else f", x={sx}, y={sy}"
+        return f"LagrangeSurface({n}x{m} nodes, degree {self.degree}{sym}, source={self.grid.source!r})"
+
+    def _repr_latex_(self) -> str:
+        terms = sum(1 for row in self.coefficients for c in row if c)
+        return _latex("z", self.expr, terms, f"degree {self.degree[0]} x {self.degree[1]}")
 
     def exact_value(self, x, y) -> Fraction:
         """``F(x, y)`` in exact arithmetic (nested Horner on the rational coefficients)."""
@@ -200,25 +240,15 @@ class LagrangeSurface:
 
     def derivative(self, dx: int = 1, dy: int = 0) -> sympy.Poly:
         """The exact partial derivative ``d^(dx+dy) F / dx^dx dy^dy`` as a Poly."""
-        return self.poly.diff(*([(X, dx)] if dx else []), *([(Y, dy)] if dy else [])) if (dx or dy) else self.poly
+        sx, sy = self.symbols
+        return self.poly.diff(*([(sx, dx)] if dx else []), *([(sy, dy)] if dy else [])) if (dx or dy) else self.poly
 
-    def evaluate(self, x, y):
-        """``F(x, y)`` in floating point on NumPy arrays with broadcasting, stable (barycentric form)."""
-        from .evaluate import evaluate_points
 
-        return evaluate_points(self, x, y)
-
-    def sample(self, nx: int | None = None, ny: int | None = None, **kwargs):
-        """Sample on a regular grid: ``X, Y, Z = surface.sample(nx, ny)``; see :func:`lagsym.sampling.sample`."""
-        from .sampling import sample
-
-        return sample(self, nx, ny, **kwargs)
-
-    def lambdify(self):
-        """The NumPy function ``f(x, y)`` of the exact expression; see :func:`lagsym.evaluate.lambdify_surface`."""
-        from .evaluate import lambdify_surface
-
-        return lambdify_surface(self)
+def _latex(lhs: str, expr: sympy.Expr, terms: int, degree: str) -> str:
+    if terms > LATEX_TERMS:
+        # MathJax takes seconds over a page of terms; the summary says how to get them all.
+        return rf"${lhs} = F$ ({degree}, {terms} terms: ``.expr`` holds them all)"
+    return f"${lhs} = {sympy.latex(expr)}$"
 
 
 def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
@@ -238,36 +268,64 @@ def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
     return acc
 
 
-def lagrange_curve(points: CurvePoints) -> LagrangeCurve:
+def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = X) -> LagrangeCurve:
     """The exact Lagrange curve through ``points`` (paper eq. 1-3).
+
+    Parameters
+    ----------
+    points : CurvePoints
+        The nodes and values.
+    x : sympy.Symbol or str, optional
+        The variable of the polynomial: plain ``x`` by default.
 
     Examples
     --------
     >>> from lagsym.grid import curve_from_points
-    >>> lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 1)])).expr
+    >>> pts = curve_from_points([(1, 1), (2, 3), (3, 1)])
+    >>> lagrange_curve(pts).expr
     -2*x**2 + 8*x - 5
+    >>> t = sympy.Symbol("t")
+    >>> lagrange_curve(pts, x=t).expr.subs(t, 2)
+    3
     """
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
     c = b.transpose() * yv
-    return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())))
+    return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())),
+                         symbol=_symbol(x, "x"))
 
 
-def lagrange_surface(grid: ControlGrid) -> LagrangeSurface:
+def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = X, y: sympy.Symbol | str = Y) -> LagrangeSurface:
     """The exact tensor-product Lagrange surface through ``grid`` (paper eqs. 6-7).
+
+    Parameters
+    ----------
+    grid : ControlGrid
+        The control points.
+    x, y : sympy.Symbol or str, optional
+        The variables of the polynomial: plain ``x`` and ``y`` by default, the
+        symbols ``sympy.symbols('x y')`` gives.
 
     Examples
     --------
     >>> from lagsym.grid import grid_from_points
     >>> pts = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
     ...        (5, 2, 31), (5, 3, 34), (5, 4, 37)]
-    >>> lagrange_surface(grid_from_points(pts)).expr
-    x**2 + 3*y
+    >>> s = lagrange_surface(grid_from_points(pts))
+    >>> x, y = sympy.symbols("x y")
+    >>> s.expr == x**2 + 3*y, s.expr.subs({x: 1, y: 2}), sympy.diff(s.expr, x)
+    (True, 7, 2*x)
+    >>> u, v = sympy.symbols("u v")
+    >>> lagrange_surface(grid_from_points(pts), x=u, y=v).expr
+    u**2 + 3*v
     """
+    sx, sy = _symbol(x, "x"), _symbol(y, "y")
+    if sx == sy:
+        raise InputError(f"x and y are both the symbol {sx}: a surface needs two different variables")
     n, m = grid.shape
     bx = _basis_matrix(grid.x)
     by = _basis_matrix(grid.y)
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])
     c = bx.transpose() * z * by
     coeffs = tuple(tuple(_frac(c[a, b]) for b in range(m)) for a in range(n))
-    return LagrangeSurface(grid=grid, coefficients=coeffs)
+    return LagrangeSurface(grid=grid, coefficients=coeffs, symbols=(sx, sy))

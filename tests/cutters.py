@@ -7,6 +7,7 @@ from fractions import Fraction
 import numpy as np
 from hypothesis import strategies as st
 
+from lagsym.evaluate import evaluate_points
 from lagsym.grid import grid_from_table
 from lagsym.lagrange import lagrange_surface
 from lagsym.toolpath import drop_cutter
@@ -26,7 +27,7 @@ def brute(surface, cx, cy, radius, shape="ball", n=401):
     px, py = cx + gx[inside], cy + gy[inside]
     ok = (px >= x0) & (px <= x1) & (py >= y0) & (py <= y1)
     px, py = px[ok], py[ok]
-    z = surface.evaluate(px, py)
+    z = evaluate_points(surface, px, py)
     if shape == "ball":
         z = z + np.sqrt(np.maximum(radius**2 - (px - cx) ** 2 - (py - cy) ** 2, 0)) - radius
     return float(z.max())

@@ -365,3 +365,21 @@ def program_text(blocks: int, seed: int = 1) -> str:
     lines += ["G0 Z50.", "M30"]
     return "%\n" + "\n".join(lines) + "\n%\n"
 
+
+# A short program with every modal group a resume set-up restores.
+PROGRAM = """%
+O1000
+G21 G17 G90 G54
+T2 M6
+S4000 M3
+G0 Z25.
+G0 X0. Y0.
+M8
+G1 Z-1. F300.
+G1 X10. Y0. F600.
+G2 X20. Y10. I10. J0.
+G1 X30.
+G0 Z25.
+M30
+%
+"""

@@ -1,27 +1,20 @@
-"""The RS-232 link: framing, resume planning, and real transfers over a socat pty pair to a simulated control."""
+"""The RS-232 link: the bytes a send puts on the line, and real transfers over a socat pty pair to a simulated control."""
 
 from __future__ import annotations
 
-import dataclasses
 import re
 import shutil
 import socket
+import subprocess
+import sys
 import threading
+from pathlib import Path
 
 import pytest
 
-from lagsym.dnc import (
-    PROFILES,
-    LineFault,
-    LineSettings,
-    parse_filler,
-    plan_transfer,
-    profile,
-    send_program,
-)
-from lagsym.dncplan import parse_program, resume_setup
+from lagsym.dnc import LineFault, LineSettings, parse_program, profile, resume_setup, send_program, transfer_segments
 from lagsym.errors import InputError, TransferError
-from simcontrol import KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import PROGRAM, KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
 
 needs_socat = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
 
@@ -42,110 +35,29 @@ def resume_hint(stderr: str) -> int:
     return int(m.group(1))
 
 
-# -- pure parts ---------------------------------------------------------------------------------------------
-
-
-def test_blocks_are_the_non_empty_lines_inside_the_percent_framing():
-    p = parse_program("%\r\nO1000\r\n\r\nG21 G90 \r\nM30\r\n%\r\n")
-    assert p.blocks == ("O1000", "G21 G90", "M30")
-    assert p.block(1) == "O1000"
-
-
-@pytest.mark.parametrize("text, words", [
-    ("O1\nG0 X1.\x13\n", "DC3"),
-    ("O1\nG0 X1.é\n", "7-bit"),
-    ("O1\n%\nG0 X1.\n", "after the closing %"),
-    ("%\n\n%\n", "no blocks"),
-])
-def test_programs_a_line_cannot_carry_are_refused_with_the_line(text, words):
-    with pytest.raises(InputError, match=words):
-        parse_program(text, "p.nc")
+# -- what goes on the line ------------------------------------------------------------------------------
 
 
 def test_framing_puts_leader_percent_blocks_percent_trailer_on_the_line():
-    settings = LineSettings(eol="crlf", leader="\x00\x00", trailer="\x03")
-    wire = b"".join(b for _, b in plan_transfer(parse_program("O1\nM30"), settings))
+    settings = LineSettings(line_ending="crlf", leader="\x00\x00", trailer="\x03")
+    wire = b"".join(b for _, b in transfer_segments(parse_program("O1\nM30"), settings))
     assert wire == b"\x00\x00%\r\nO1\r\nM30\r\n%\r\n\x03"
-
-
-def test_profiles_fill_in_settings_and_any_can_be_overridden():
-    fanuc = profile("fanuc", baud=4800)
-    assert (fanuc.baud, fanuc.bytesize, fanuc.parity, fanuc.stopbits, fanuc.flow) == (4800, 7, "even", 2.0, "xonxoff")
-    assert PROFILES["heidenhain"].percent is False and PROFILES["heidenhain"].trailer == "\x03"
-    assert PROFILES["haas"].eol == "crlf"
-    with pytest.raises(InputError, match="fanuc, haas, heidenhain"):
-        profile("mazak")
-
-
-def test_settings_are_frozen_and_checked_against_their_choices():
-    s = LineSettings()
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        s.baud = 19200
-    with pytest.raises(InputError, match="none, even, odd, mark, space"):
-        LineSettings(parity="evn")
-    with pytest.raises(InputError, match="xonxoff, rtscts, none"):
-        LineSettings(flow="dtr")
-    assert LineSettings(bytesize=8, parity="none", stopbits=1).bits_per_char == 10
-
-
-def test_leader_and_trailer_specs():
-    assert parse_filler("2*NUL,ETX") == "\x00\x00\x03"
-    with pytest.raises(InputError, match="NUL"):
-        parse_filler("3*BEL")
-
-
-PROGRAM = """%
-O1000
-G21 G17 G90 G54
-T2 M6
-S4000 M3
-G0 Z25.
-G0 X0. Y0.
-M8
-G1 Z-1. F300.
-G1 X10. Y0. F600.
-G2 X20. Y10. I10. J0.
-G1 X30.
-G0 Z25.
-M30
-%
-"""
-
-
-def test_resume_setup_restores_modes_retracts_and_approaches():
-    p = parse_program(PROGRAM)
-    setup = resume_setup(p, 11)
-    assert setup == ("(RESUME AT BLOCK 11)", "G21 G17 G90 G54", "T2 M6", "S4000 M3", "G0 Z25.",
-                     "G0 X20. Y10.", "M8", "G1 Z-1. F600.", "G2")
-    assert resume_setup(p, 11, safe_z="40")[4] == "G0 Z40."
-
-
-@pytest.mark.parametrize("text, start, words", [
-    (PROGRAM, 1, "outside the program"),
-    (PROGRAM, 99, "outside the program"),
-    ("O1\nG21 G90\n#1=5\nG0 Z#1\nG1 X1. F100.", 5, "macro variables"),
-    ("O1\nG90 G0 Z5.\nG1 X1. F100.", 3, "G20 or G21"),
-    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG81 Z-2. R1. F100.\nX2.", 5, "canned cycle G81 is still on"),
-    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG41 D1 G1 X2. F100.\nX3.", 5, "cutter compensation G41"),
-    ("O1\nG21 G90 G92 X0 Y0 Z0\nG0 Z5.\nX2.", 4, "G92 shifts"),
-    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG91 G28 Z0.\nG90 G1 X2. F100.\nX3.", 6, "Z position"),
-    ("O1\nG21 G90\nG1 X1. Y1. Z-1. F100.\nX2.", 4, "safe-z"),
-])
-def test_resume_refuses_what_it_cannot_replay(text, start, words):
-    with pytest.raises(InputError, match=words):
-        resume_setup(parse_program(text, "p.nc"), start)
-
-
-def test_resume_after_a_drilling_cycle_and_a_return_home():
-    text = ("O1\nG21 G17 G90 G54\nG91 G28 Z0.\nG90 T3 M6\nS1200 M3\nG0 X0. Y0. Z30.\n"
-            "G98 G81 X5. Y5. Z-4. R2. F80.\nX10.\nG80\nG0 Z30.\nG1 Z-1. F150.\nX20.\nX30.")
-    setup = resume_setup(parse_program(text), 13)
-    assert setup[1:] == ("G21 G17 G90 G54", "T3 M6", "S1200 M3", "G0 Z30.", "G0 X20. Y5.", "G1 Z-1. F150.")
 
 
 def test_start_block_is_only_for_drip_feeds():
     with pytest.raises(InputError, match="drip"):
-        plan_transfer(parse_program(PROGRAM), LineSettings(), "upload", start_block=4)
+        transfer_segments(parse_program(PROGRAM), LineSettings(), "upload", start_block=4)
+
+
+def test_import_lagsym_loads_no_serial_and_only_the_port_module_imports_it():
+    package = Path(__file__).resolve().parent.parent / "lagsym"
+    code = "import lagsym, lagsym.dnc, sys; print('serial' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=package.parent).stdout
+    assert out.strip() == "False"
+    importers = {path.relative_to(package).as_posix() for path in package.rglob("*.py")
+                 if re.search(r"^\s*(import serial|from serial\b)", path.read_text(), re.MULTILINE)}
+    assert importers == {"dnc/port.py"}
 
 
 # -- command line without a control -------------------------------------------------------------------------
@@ -230,7 +142,7 @@ def test_large_drip_feed_arrives_byte_exact(line):
     prog = parse_program(program_text(1200))
     settings = profile("fanuc", baud=baud, stall_timeout_s=10)
     pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=1024, high_water=512, low_water=128)
-    expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
     assert len(expected) > 30_000
     result = send_program(pair.near, prog, settings, "drip")
     assert sim.wait_for(len(expected))
@@ -250,7 +162,7 @@ def test_xoff_stops_the_sender_within_its_limit(line):
     sim_tolerance = 10
     pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
                      low_water=64, tolerance=sim_tolerance)
-    expected = b"".join(b for _, b in plan_transfer(prog, settings, "drip"))
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
     events = []
     result = send_program(pair.near, prog, settings, "drip", log=events.append)
     assert sim.wait_for(len(expected))
@@ -273,7 +185,7 @@ def test_wait_for_xon_starts_only_when_the_control_asks(line):
     pair, sim = line(baud=baud, xon_after_s=0.6)
     events = []
     send_program(pair.near, prog, settings, "upload", log=events.append)
-    expected = b"".join(b for _, b in plan_transfer(prog, settings, "upload"))
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "upload"))
     assert sim.wait_for(len(expected))
     assert bytes(sim.received) == expected
     assert any(e.startswith("XON after 0.") for e in events), events

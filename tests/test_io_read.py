@@ -56,7 +56,7 @@ def test_silent_standard_input_times_out(monkeypatch):
 
     r, w = os.pipe()
     try:
-        monkeypatch.setattr(io_module, "STDIN_SILENCE_S", 0.2)
+        monkeypatch.setattr(io_module.files, "STDIN_SILENCE_S", 0.2)
         with open(r, "rb", closefd=False) as fake, pytest.raises(InputError, match="nothing arrived for 0.2 s"):
             monkeypatch.setattr(sys, "stdin", type("S", (), {"buffer": fake})())
             read_points("-")

@@ -14,6 +14,7 @@ from hypothesis import given, settings as hsettings, strategies as st
 
 from conftest import EXAMPLES
 from lagsym.errors import InputError, ProgramError, ToolpathError
+from lagsym.evaluate import evaluate_points
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
@@ -464,7 +465,7 @@ def test_ball_end_tip_is_one_radius_off_the_surface():
     centres = tips + [0.0, 0.0, 2.0]
     xs = np.linspace(20.0, 100.0, 401)
     X, Y = np.meshgrid(xs, xs)
-    cloud = np.column_stack([X.ravel(), Y.ravel(), 20.0 * s.evaluate(X.ravel() / 20.0, Y.ravel() / 20.0)])
+    cloud = np.column_stack([X.ravel(), Y.ravel(), 20.0 * evaluate_points(s, X.ravel() / 20.0, Y.ravel() / 20.0)])
     # away from the box edges, where the sampled surface ends
     inner = [c for c in centres if 25 < c[0] < 95 and 25 < c[1] < 95]
     near = [np.min(np.linalg.norm(cloud - c, axis=1)) for c in inner[::4]]

@@ -27,7 +27,7 @@ from PIL import Image
 from conftest import EXAMPLES, ROOT, missing_system_package
 from lagsym import plot
 from lagsym.errors import InputError, RenderError
-from lagsym.evaluate import evaluate_grid
+from lagsym.evaluate import evaluate_grid, evaluate_points
 from lagsym.io import read_curve_points, read_points
 from lagsym.lagrange import lagrange_curve, lagrange_surface
 from lagsym.plot.surface import sampled_surface
@@ -138,7 +138,7 @@ def raster(surface, rows: int = 7, per_row: int = 25, safe_z: float = 5.0):
     pts, rapid = [(1.0, 1.0, safe_z)], [False]
     for j, y in enumerate(np.linspace(1.0, 5.0, rows)):
         xs = np.linspace(1.0, 5.0, per_row)[:: 1 if j % 2 == 0 else -1]
-        zs = surface.evaluate(xs, np.full_like(xs, y))
+        zs = evaluate_points(surface, xs, np.full_like(xs, y))
         for k, (x, z) in enumerate(zip(xs, zs)):
             pts.append((x, y, z))
             rapid.append(j == 0 and k == 0)

@@ -7,6 +7,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
+from lagsym.evaluate import evaluate_points
 from lagsym.gcode import parse_moves
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
@@ -68,7 +69,7 @@ def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
     scale, r = 10.0, 15.0
     x = np.linspace(0.0, 4.0, 161)
     y = np.full_like(x, 1.0)
-    z = surf.evaluate(x, y)
+    z = evaluate_points(surf, x, y)
     slope = (x - 2.0)  # dF/dx, surface units
     n = np.stack([-slope, np.zeros_like(x), np.ones_like(x)]) / np.sqrt(1 + slope**2)
     centre = np.stack([x * scale, y * scale, z * scale]) + r * n

@@ -7,8 +7,8 @@ import json
 from ..conditioning import check_curve, check_surface
 from ..errors import ExitStatus
 from ..grid import CurvePoints
-from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
+from ._common import add_points_arguments, load_points
 
 NAME = "check"
 ORDER = 30
@@ -26,12 +26,13 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file (surface x,y,z or curve x,y)")
+    add_points_arguments(p)
     p.add_argument("--strict", action="store_true", help="exit with status 1 when there is a warning")
     p.add_argument("--format", choices=("text", "json"), default="text", help="text (default) or json")
 
 
 def run(args, out, err) -> int:
-    pts = read_any_points(args.file)
+    pts = load_points(args.file, args, err, "any")
     report = check_curve(lagrange_curve(pts)) if isinstance(pts, CurvePoints) else check_surface(lagrange_surface(pts))
     if args.format == "json":
         doc = {

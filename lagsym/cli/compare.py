@@ -26,6 +26,7 @@ points file of measurements, compared at the measured positions.
 examples:
   lagsym compare examples/paper-example-4.json
   lagsym compare examples/parabola.json --reference "50 - ((x-20)**2 + (y-20)**2)/20" --degree 4
+    (a paraboloid like Table 1's; the paper's own function and net are not given)
   lagsym compare examples/paper-example-1.json --reference "x**2 + 3*y" --samples 41x41 --format csv"""
 
 
@@ -74,7 +75,9 @@ def add_arguments(p) -> None:
     p.add_argument("--degree", type=int, default=3, metavar="P",
                    help="B-spline degree in each direction (default 3, capped at n-1)")
     p.add_argument("--hermite", choices=HERMITE_KINDS, default="corner",
-                   help="corner: one patch on the 4 corners (default, as in the paper); "
+                   help="corner: one patch on the 4 corners (default; the paper does not state its Hermite "
+                        "rule, and on an evenly spaced net this patch equals the Bezier surface, which the "
+                        "paper's Table 1 does not show); "
                         "piecewise: C1 patches through every point")
     p.add_argument("--tolerance", type=_tolerance, default=DEFAULT_TOLERANCE_MM, metavar="MM",
                    help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")

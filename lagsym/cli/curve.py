@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 from ..equation import render
-from ..io import read_curve_points
 from ..lagrange import lagrange_curve
-from ._common import emit
-from .equation import add_format_arguments
+from ._common import add_points_arguments, emit, load_points
+from .equation import add_format_arguments, report_rounding
 
 NAME = "curve"
 ORDER = 20
 HELP = "print the exact Lagrange curve y = F(x) through a set of points"
 DESCRIPTION = """Print the exact Lagrange interpolating polynomial y = F(x) through the
-points in FILE (JSON [[x, y], ...] or CSV with x,y).
+points in FILE (JSON [[x, y], ...] or a table with x,y).  With --digits,
+standard error says how far the rounded equation misses the points.
 
 examples:
   lagsym curve examples/paper-curve-3rd.json
@@ -20,11 +20,13 @@ examples:
 
 
 def add_arguments(p) -> None:
-    p.add_argument("file", help="points file: JSON or CSV with x,y")
+    p.add_argument("file", help="points file: JSON or a table with x,y")
+    add_points_arguments(p)
     add_format_arguments(p)
 
 
 def run(args, out, err) -> int:
-    curve = lagrange_curve(read_curve_points(args.file))
+    curve = lagrange_curve(load_points(args.file, args, err, "curve"))
     emit(render(curve, args.format, args.digits), args.output, out)
+    report_rounding(curve, args.digits, curve.points.units, err)
     return 0

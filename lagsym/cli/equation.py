@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
-from ..equation import FORMATS, render
-from ..io import read_points
+from ..equation import FORMATS, render, rounding_miss
 from ..lagrange import lagrange_surface
-from ._common import emit
+from ._common import add_points_arguments, emit, load_points
 
 NAME = "equation"
 ORDER = 10
 HELP = "print the exact Lagrange surface z = F(x, y) through a grid of control points"
 DESCRIPTION = """Print the exact tensor-product Lagrange surface z = F(x, y) through the
-control points in FILE (JSON or CSV), with exact rational coefficients.
+control points in FILE (JSON or a table: CSV, TSV, .xyz), with exact rational
+coefficients.  With --digits, standard error says how far the rounded
+equation misses the control points (computed exactly); standard output stays
+one parseable equation.
 
 examples:
   lagsym equation examples/paper-example-1.json
@@ -20,7 +22,8 @@ examples:
 
 
 def add_arguments(p) -> None:
-    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("file", help="points file: JSON or a table with x,y,z")
+    add_points_arguments(p)
     add_format_arguments(p)
 
 
@@ -33,6 +36,13 @@ def add_format_arguments(p) -> None:
 
 
 def run(args, out, err) -> int:
-    surface = lagrange_surface(read_points(args.file))
+    surface = lagrange_surface(load_points(args.file, args, err))
     emit(render(surface, args.format, args.digits), args.output, out)
+    report_rounding(surface, args.digits, surface.grid.units, err)
     return 0
+
+
+def report_rounding(obj, digits: int | None, units: str | None, err) -> None:
+    """Say on standard error how far the equation rounded to ``digits`` misses the control points."""
+    if digits is not None:
+        err.write(f"# {rounding_miss(obj, digits).text(units)}\n")

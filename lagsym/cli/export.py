@@ -6,7 +6,8 @@ from ..cad import KERNEL_MAX_DEGREE, METHODS, cad_patch, double_error_bound, exa
 from ..conditioning import FLOAT_ERROR_LIMIT
 from ..errors import InputError
 from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
-from ..io import UNITS, read_points, read_units
+from ..export.cadtext import UNITS
+from ..io import read_points
 from ..lagrange import lagrange_surface
 
 NAME = "export"
@@ -55,7 +56,7 @@ def run(args, out, err) -> int:
                          else f"--base-z {args.base_z} is for a solid: add --solid")
     base = exact_height(args.base_z, "--base-z", args.file) if args.solid else None
     grid = read_points(args.file)
-    units = read_units(args.file, default=args.units or "mm")
+    units = grid.units or args.units or "mm"
     if args.units and units != args.units:
         raise InputError(f"{args.file}: the file states \"units\": \"{units}\", not --units {args.units}")
     patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from ._common import emit
+from ..dnc import receive_program
+from ..errors import InputError
 from ..io import event_log
 from .send import add_line_arguments, line_settings
 
@@ -31,9 +33,6 @@ def add_arguments(p) -> None:
 
 
 def run(args, out, err) -> int:
-    from ..dnc import receive_program
-    from ..errors import InputError
-
     for name in ("timeout", "idle_timeout"):
         if not getattr(args, name) > 0:
             raise InputError(f"--{name.replace('_', '-')} {getattr(args, name)!r} must be a positive number of seconds")

@@ -6,8 +6,19 @@ import argparse
 import contextlib
 from pathlib import Path
 
-from ..dncplan import parse_program
+from ..dnc import (
+    FLOW_CONTROLS,
+    MODES,
+    PARITIES,
+    PROFILES,
+    LineSettings,
+    parse_filler,
+    parse_program,
+    profile,
+    send_program,
+)
 from ..io import event_log, read_program
+from ..machine import LINE_ENDINGS
 
 NAME = "send"
 ORDER = 80
@@ -35,18 +46,17 @@ examples:
 
 
 def add_line_arguments(p) -> None:
-    """The serial line options ``send`` and ``receive`` share."""
-    from ..dnc import FLOW_CONTROLS, LINE_ENDINGS, PARITIES, PROFILES
-
+    """The serial line options ``send`` and ``receive`` share; the defaults they print are :class:`LineSettings`'s."""
+    d = LineSettings()
     p.add_argument("--port", required=True, help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port)")
     g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
     g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
-    g.add_argument("--baud", type=int, help="bits per second (default 9600)")
-    g.add_argument("--bytesize", type=int, choices=(5, 6, 7, 8), help="data bits (default 7)")
-    g.add_argument("--parity", choices=tuple(PARITIES), help="parity (default even)")
-    g.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help="stop bits (default 2)")
-    g.add_argument("--flow", choices=FLOW_CONTROLS, help="flow control (default xonxoff)")
-    g.add_argument("--eol", choices=tuple(LINE_ENDINGS), help="end of block (default lf)")
+    g.add_argument("--baud", type=int, help=f"bits per second (default {d.baud})")
+    g.add_argument("--bytesize", type=int, choices=(5, 6, 7, 8), help=f"data bits (default {d.bytesize})")
+    g.add_argument("--parity", choices=tuple(PARITIES), help=f"parity (default {d.parity})")
+    g.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help=f"stop bits (default {d.stopbits:g})")
+    g.add_argument("--flow", choices=FLOW_CONTROLS, help=f"flow control (default {d.flow})")
+    g.add_argument("--eol", choices=tuple(LINE_ENDINGS), help=f"end of block (default {d.line_ending})")
     g.add_argument("--leader", metavar="SPEC", help="characters before the program: a count of NULs or e.g. 50*NUL")
     g.add_argument("--trailer", metavar="SPEC", help="characters after the program, e.g. 20, ETX or 10*NUL,ETX")
     g.add_argument("--percent", action=argparse.BooleanOptionalAction, default=None,
@@ -58,11 +68,9 @@ def add_line_arguments(p) -> None:
 
 def line_settings(args):
     """The :class:`~lagsym.dnc.LineSettings` the options ask for."""
-    from ..dnc import LineSettings, parse_filler, profile
-
     overrides = {}
     for option, field in (("baud", "baud"), ("bytesize", "bytesize"), ("parity", "parity"), ("stopbits", "stopbits"),
-                          ("flow", "flow"), ("eol", "eol"), ("percent", "percent"), ("dtr", "dtr")):
+                          ("flow", "flow"), ("eol", "line_ending"), ("percent", "percent"), ("dtr", "dtr")):
         value = getattr(args, option, None)
         if value is not None:
             overrides[field] = value
@@ -104,10 +112,9 @@ def progress_bar(err, quiet: bool, what: str):
 
 
 def add_arguments(p) -> None:
-    from ..dnc import MODES
-
     p.add_argument("file", help="the program (G-code or Heidenhain text)")
     add_line_arguments(p)
+    d = LineSettings()
     t = p.add_argument_group("transfer")
     t.add_argument("--mode", choices=MODES, default="upload",
                    help="upload: store in the control's memory (needed for macro programs); drip: feed while it runs")
@@ -116,15 +123,14 @@ def add_arguments(p) -> None:
     t.add_argument("--safe-z", metavar="Z", help="retract height for a resume, in program units "
                                                   "(default: the highest rapid Z before block N)")
     t.add_argument("--stall-timeout", type=float, metavar="SECONDS",
-                   help="give up when XOFF or CTS low lasts longer (default 120)")
+                   help=f"give up when XOFF or CTS low lasts longer (default {d.stall_timeout_s:g})")
     t.add_argument("--overrun-chars", type=int, metavar="N",
-                   help="most characters in flight, so at most N arrive after XOFF (default 8; Fanuc tolerates ~10)")
+                   help=f"most characters in flight, so at most N arrive after XOFF (default {d.overrun_chars}; "
+                        "Fanuc tolerates ~10)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
 
 
 def run(args, out, err) -> int:
-    from ..dnc import send_program
-
     program = parse_program(read_program(args.file), source=args.file)
     settings = line_settings(args)
     with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from ..io import UNITS
 from ..values import choice
 
 __all__ = ["UNITS", "check_units", "real", "multiplicities"]
+
+UNITS = ("mm", "inch")  # the length units the files declare, as lagsym.io reads them
 
 
 def check_units(units: str) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..evaluate import evaluate_points
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ._placement import placement
@@ -33,7 +34,7 @@ def points_at(surface: LagrangeSurface, settings: MachineSettings, tool: Tool | 
     place = placement(settings)
     s = float(place.scale)
     ox, oy, oz = (float(v) for v in place.origin)
-    z = surface.evaluate((x - ox) / s, (y - oy) / s) * s + oz + float(place.stock)
+    z = evaluate_points(surface, (x - ox) / s, (y - oy) / s) * s + oz + float(place.stock)
     return np.column_stack([x, y, z])
 
 

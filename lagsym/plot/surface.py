@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..evaluate import basis_matrix, evaluate_grid
+from ..evaluate import basis_matrix, evaluate_curve, evaluate_grid
 from ..sampling import axis_lines, sample_grid
 from .backend import DEFAULT_WINDOW_SIZE, new_plotter
 from .checks import check_samples, check_window_size
@@ -126,7 +126,7 @@ def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | N
     n = check_samples(samples)
     px, py = curve.points.x_array, curve.points.y_array
     xs = axis_lines(curve.points.x[0], curve.points.x[-1], n)
-    ys = curve.evaluate(xs)
+    ys = evaluate_curve(curve, xs)
     p = new_plotter(window_size=window_size, off_screen=off_screen)
     chart = pv.Chart2D(x_label=f"x ({units})", y_label=f"y ({units})")
     chart.title = title if title is not None else title_for(curve)

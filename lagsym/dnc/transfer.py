@@ -1,4 +1,4 @@
-"""RS-232 transfer to and from a CNC control: upload, drip feed and receive (the only module that imports serial).
+"""RS-232 transfer to and from a CNC control: upload, drip feed and receive.
 
 The sender does its own XON/XOFF: it paces writes to the line rate
 (characters per second = baud / bits per character), keeps at most
@@ -15,6 +15,11 @@ time has passed, and a later look at the port found it still healthy.  A
 fault names the last delivered block and the ``--start-block`` that resumes
 the drip feed after it; a cut in mid-transfer also names the blocks that
 were on their way and may have arrived too.
+
+Nothing here imports serial: :func:`send_program` and
+:func:`receive_program` open the line through :mod:`lagsym.dnc.port` when
+they are called, so the settings, the framing and :func:`transfer_segments`
+work where pyserial is not loaded.
 """
 
 from __future__ import annotations
@@ -22,175 +27,26 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import serial
+from ..errors import InputError, TransferError
+from ..values import choice
+from .blocks import DC1, DC2, DC3, DC4, Program, frame
+from .resume import resume_setup
+from .settings import MODES, LineSettings
 
-from .dncplan import DC1, DC2, DC3, DC4, Program, frame, resume_setup
-from .errors import InputError, TransferError
-from .values import choice
+if TYPE_CHECKING:
+    from .port import Port
 
-__all__ = [
-    "LineSettings",
-    "PROFILES",
-    "FLOW_CONTROLS",
-    "PARITIES",
-    "LINE_ENDINGS",
-    "MODES",
-    "TransferProgress",
-    "TransferResult",
-    "LineFault",
-    "profile",
-    "parse_filler",
-    "plan_transfer",
-    "send_program",
-    "receive_program",
-]
+__all__ = ["TransferProgress", "TransferResult", "LineFault", "transfer_segments", "send_program", "receive_program"]
 
-FLOW_CONTROLS = ("xonxoff", "rtscts", "none")
-PARITIES = {"none": serial.PARITY_NONE, "even": serial.PARITY_EVEN, "odd": serial.PARITY_ODD,
-            "mark": serial.PARITY_MARK, "space": serial.PARITY_SPACE}
-LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
-MODES = ("upload", "drip")
-_FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
 _POLL_S = 0.002  # longest sleep between looks at the port while the line is busy
 _PROGRESS_S = 0.1
 # A byte counts as arrived only this long after the line clock says it left: longer through a network
 # serial server, which holds what it has not yet put on its line.
 _SETTLE_S = 0.05
 _SETTLE_NETWORK_S = 0.25
-
-
-@dataclass(frozen=True)
-class LineSettings:
-    """How the serial line to one control is set up.
-
-    Attributes
-    ----------
-    baud : int
-        Bits per second.
-    bytesize : int
-        Data bits, 7 or 8 (5 and 6 are accepted for odd hardware).
-    parity : str
-        ``none``, ``even``, ``odd``, ``mark`` or ``space``.
-    stopbits : float
-        1, 1.5 or 2.
-    flow : str
-        ``xonxoff`` (DC1/DC3 from the control, handled by lagsym), ``rtscts``
-        (hardware) or ``none``.
-    eol : str
-        End of block: ``lf``, ``crlf`` or ``cr``.
-    leader, trailer : str
-        Characters sent before and after the program (tape feed, ETX).
-    percent : bool
-        Frame the program with ``%`` lines.
-    dtr : bool
-        Assert DTR while the port is open.
-    stall_timeout_s : float
-        Longest XOFF, CTS low or stopped output queue before the transfer
-        gives up.  In a drip feed it must exceed the longest time the control
-        spends on the blocks in its buffer.
-    overrun_chars : int
-        Most characters on their way at any moment, so at most this many
-        arrive after the control says XOFF.  Keep it below the control's
-        tolerance (about 10 on a Fanuc).
-    wait_for_xon : bool
-        Wait for the control's DC1 before the first character (a Fanuc sends
-        it when READ is pressed).
-    """
-
-    baud: int = 9600
-    bytesize: int = 7
-    parity: str = "even"
-    stopbits: float = 2
-    flow: str = "xonxoff"
-    eol: str = "lf"
-    leader: str = ""
-    trailer: str = ""
-    percent: bool = True
-    dtr: bool = True
-    stall_timeout_s: float = 120.0
-    overrun_chars: int = 4
-    wait_for_xon: bool = False
-
-    def __post_init__(self):
-        if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
-            raise InputError(f"baud rate {self.baud!r} must be a whole number from 50 to 4000000")
-        choice(self.bytesize, (5, 6, 7, 8), "data bits")
-        choice(self.parity, tuple(PARITIES), "parity")
-        object.__setattr__(self, "stopbits", float(self.stopbits))
-        choice(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
-        choice(self.flow, FLOW_CONTROLS, "flow control")
-        choice(self.eol, tuple(LINE_ENDINGS), "end of block")
-        for name in ("leader", "trailer"):
-            text = getattr(self, name)
-            if any(ord(c) in (DC1, DC2, DC3, DC4) or ord(c) > 127 for c in text):
-                raise InputError(f"{name} {text!r} holds a character the line cannot carry or that steers it")
-        if not self.stall_timeout_s > 0 or math.isinf(self.stall_timeout_s):
-            raise InputError(f"stall timeout {self.stall_timeout_s!r} s must be a positive number of seconds")
-        if not isinstance(self.overrun_chars, int) or not 1 <= self.overrun_chars <= 4096:
-            raise InputError(f"overrun limit {self.overrun_chars!r} must be 1 to 4096 characters")
-
-    @property
-    def bits_per_char(self) -> float:
-        """Start bit, data bits, parity bit and stop bits of one character."""
-        return 1 + self.bytesize + (0 if self.parity == "none" else 1) + self.stopbits
-
-    @property
-    def chars_per_s(self) -> float:
-        """The line rate in characters per second.
-
-        Examples
-        --------
-        >>> LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2).chars_per_s
-        872.7272727272727
-        """
-        return self.baud / self.bits_per_char
-
-
-# Sources for each profile are in docs/dnc.md.
-PROFILES: dict[str, LineSettings] = {
-    "fanuc": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2, flow="xonxoff", eol="lf",
-                          leader="\x00" * 20, trailer="\x00" * 20, percent=True),
-    "haas": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", eol="crlf",
-                         leader="", trailer="", percent=True),
-    "heidenhain": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", eol="crlf",
-                               leader="\x00" * 50, trailer="\x03", percent=False),
-}
-
-
-def profile(name: str, **overrides) -> LineSettings:
-    """The usual line settings of a control family, with any field overridden.
-
-    Examples
-    --------
-    >>> profile("haas", baud=19200).eol
-    'crlf'
-    """
-    choice(name, tuple(PROFILES), "profile")
-    return replace(PROFILES[name], **overrides)
-
-
-def parse_filler(spec: str) -> str:
-    """Read a leader or trailer: a count of NULs (``20``) or items like ``50*NUL,ETX``.
-
-    Examples
-    --------
-    >>> parse_filler("3"), parse_filler("2*NUL,ETX"), parse_filler("")
-    ('\\x00\\x00\\x00', '\\x00\\x00\\x03', '')
-    """
-    out = []
-    for item in (s.strip() for s in spec.split(",") if s.strip()):
-        count, _, name = item.rpartition("*")
-        if not count and item.isdigit():
-            count, name = item, "NUL"
-        name = name.upper()
-        if name not in _FILLERS:
-            raise InputError(f"leader/trailer item {item!r}: {name!r} is not one of {', '.join(_FILLERS)}")
-        if count and (not count.isdigit() or int(count) > 10_000):
-            raise InputError(f"leader/trailer item {item!r}: {count!r} is not a count from 0 to 10000")
-        out.append(_FILLERS[name] * (int(count) if count else 1))
-    return "".join(out)
 
 
 @dataclass(frozen=True)
@@ -255,19 +111,19 @@ class LineFault(TransferError):
         self.last_sent_block = last_block if last_sent_block is None else last_sent_block
 
 
-def plan_transfer(program: Program, settings: LineSettings, mode: str = "upload", start_block: int = 1,
-                  safe_z: str | None = None) -> list[tuple[int | None, bytes]]:
+def transfer_segments(program: Program, settings: LineSettings, mode: str = "upload", start_block: int = 1,
+                      safe_z: str | None = None) -> list[tuple[int | None, bytes]]:
     """The exact bytes a send puts on the line, as ``(block number or None, bytes)`` segments.
 
     With ``start_block`` above 1 (drip only) the modal set-up from
-    :func:`lagsym.dncplan.resume_setup` goes first, then block ``start_block``
+    :func:`lagsym.dnc.resume_setup` goes first, then block ``start_block``
     onwards.
 
     Examples
     --------
-    >>> from lagsym.dncplan import parse_program
+    >>> from lagsym.dnc import parse_program
     >>> p = parse_program("O1\\nM30")
-    >>> b"".join(b for _, b in plan_transfer(p, LineSettings(eol="crlf")))
+    >>> b"".join(b for _, b in transfer_segments(p, LineSettings(line_ending="crlf")))
     b'%\\r\\nO1\\r\\nM30\\r\\n%\\r\\n'
     """
     choice(mode, MODES, "mode")
@@ -281,49 +137,15 @@ def plan_transfer(program: Program, settings: LineSettings, mode: str = "upload"
     elif safe_z is not None:
         raise InputError("--safe-z only applies with --start-block above 1")
     blocks.extend((n, program.block(n)) for n in range(start_block, len(program) + 1))
-    return frame(blocks, LINE_ENDINGS[settings.eol], settings.percent, settings.leader, settings.trailer)
-
-
-def _open(port: str, settings: LineSettings, write_timeout: float | None):
-    try:
-        ser = serial.serial_for_url(port, do_not_open=True)
-        ser.baudrate = settings.baud
-        ser.bytesize = settings.bytesize
-        ser.parity = PARITIES[settings.parity]
-        ser.stopbits = settings.stopbits if settings.stopbits == 1.5 else int(settings.stopbits)
-        ser.xonxoff = False  # lagsym reads DC1/DC3 itself; see the module notes
-        ser.rtscts = settings.flow == "rtscts"
-        ser.timeout = 0
-        ser.write_timeout = write_timeout
-        ser.dtr = settings.dtr
-        ser.open()
-    except (ValueError, serial.SerialException, OSError) as e:
-        reason = str(e).strip() or type(e).__name__
-        raise TransferError(f"cannot open {port}: {reason}; check the cable, the device name or URL, "
-                            "and that no other program holds the port") from None
-    return ser
-
-
-def _out_waiting(ser) -> int:
-    try:
-        return int(ser.out_waiting)
-    except (AttributeError, NotImplementedError, ValueError, TypeError):
-        return 0
-
-
-def _cts(ser) -> bool:
-    try:
-        return bool(ser.cts)
-    except (AttributeError, NotImplementedError, serial.SerialException, OSError):
-        return True
+    return frame(blocks, settings.eol, settings.percent, settings.leader, settings.trailer)
 
 
 class _Sender:
     """One send over an open port: pacing, flow control, accounting.  Not reused."""
 
-    def __init__(self, ser, segments, settings: LineSettings, mode: str, port: str,
+    def __init__(self, line: Port, segments, settings: LineSettings, mode: str, port: str,
                  progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None):
-        self.ser, self.settings, self.mode, self.port = ser, settings, mode, port
+        self.line, self.settings, self.mode, self.port = line, settings, mode, port
         self.progress, self.log = progress, log or (lambda _m: None)
         self.data = b"".join(b for _, b in segments)
         self.ends: list[tuple[int, int]] = []  # (end offset, block number) of program blocks
@@ -353,7 +175,7 @@ class _Sender:
     def in_flight(self, now: float) -> int:
         """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
         clock = max(0.0, (self.line_free - now) * self.cps)
-        return max(math.ceil(clock), _out_waiting(self.ser))
+        return max(math.ceil(clock), self.line.out_waiting())
 
     def unsettled(self, now: float) -> int:
         """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
@@ -403,7 +225,7 @@ class _Sender:
 
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""
-        incoming = self.ser.read(4096)
+        incoming = self.line.read(4096)
         # Everything that had left the line before this look is on the far side.
         self.sure = max(self.sure, self.pos - self.unsettled(now))
         for byte in incoming:
@@ -419,7 +241,7 @@ class _Sender:
                     self.log(f"XON after {now - self.pause_since:.3f} s")
                 self.paused = False
         if self.settings.flow == "rtscts":
-            cts = _cts(self.ser)
+            cts = self.line.cts()
             if not cts and not self.paused:
                 self.paused, self.pause_since = True, now
                 self.pause_reason = "CTS stayed low (control not ready) for more than {t} s"
@@ -428,7 +250,7 @@ class _Sender:
 
     def check_queue(self, now: float) -> None:
         """An output queue that does not shrink means nothing reads the line."""
-        queued = _out_waiting(self.ser)
+        queued = self.line.out_waiting()
         if queued and queued >= self.last_queue:
             if self.queue_stuck_since is None:
                 self.queue_stuck_since = now
@@ -476,8 +298,7 @@ class _Sender:
             while self.segment_ends[seg] <= self.pos:
                 seg += 1
             n = min(limit - in_flight, self.segment_ends[seg] - self.pos)
-            written = self.ser.write(self.data[self.pos:self.pos + n])
-            written = n if written is None else written
+            written = self.line.write(self.data[self.pos:self.pos + n])
             self.line_free = max(self.line_free, now) + written / self.cps
             self.pos += written
         # A healthy look once the last byte has settled, so the last block counts as delivered.
@@ -502,14 +323,14 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
         A device (``/dev/ttyUSB0``, ``COM3``) or a pyserial URL
         (``socket://host:port``, ``rfc2217://host:port``, ``loop://``).
     program : Program
-        From :func:`lagsym.dncplan.parse_program`.
+        From :func:`lagsym.dnc.parse_program`.
     settings : LineSettings
         The line set-up, e.g. ``profile("fanuc")``.
     mode : str
         ``upload`` stores the program in the control's memory; ``drip``
         feeds it while the control runs it.
     start_block : int
-        Resume a drip feed at this block (see :mod:`lagsym.dncplan` for the
+        Resume a drip feed at this block (see :mod:`lagsym.dnc.blocks` for the
         numbering); the modal set-up is sent first.
     safe_z : str, optional
         Retract height for a resume, in program units.
@@ -532,25 +353,24 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     InputError
         For a bad mode, start block or resume.
     """
-    segments = plan_transfer(program, settings, mode, start_block, safe_z)
-    ser = _open(port, settings, write_timeout=settings.stall_timeout_s)
-    sender = _Sender(ser, segments, settings, mode, port, progress, log)
+    from .port import LINE_ERRORS, Port, WriteTimeout  # serial loads only when a line is used
+
+    segments = transfer_segments(program, settings, mode, start_block, safe_z)
+    line = Port(port, settings, write_timeout=settings.stall_timeout_s)
+    sender = _Sender(line, segments, settings, mode, port, progress, log)
     try:
         return sender.run()
     except KeyboardInterrupt:
         raise sender.fault("stopped by the user", "when the control is ready") from None
-    except serial.SerialTimeoutException:
+    except WriteTimeout:
         raise sender.fault(f"a write waited more than {settings.stall_timeout_s:g} s",
                            "check the cable, the flow control setting and that the control is reading") from None
-    except (serial.SerialException, OSError) as e:
+    except LINE_ERRORS as e:
         reason = str(e).strip() or type(e).__name__
         raise sender.fault(f"the line was lost ({reason})",
                            "reconnect the cable or the network port and clear the control") from None
     finally:
-        try:
-            ser.close()
-        except (serial.SerialException, OSError):
-            pass
+        line.close()
 
 
 def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 60.0, idle_timeout_s: float = 5.0,
@@ -567,8 +387,10 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
         If nothing arrives within ``start_timeout_s``, the line is lost, or
         the program ends without its closing ``%``.
     """
+    from .port import LINE_ERRORS, Port
+
     log = log or (lambda _m: None)
-    ser = _open(port, settings, write_timeout=1.0)
+    line = Port(port, settings, write_timeout=1.0)
     raw = bytearray()
     started = False
     percents = 0
@@ -579,7 +401,7 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
     try:
         while not ended:
             now = time.monotonic()
-            chunk = ser.read(4096)
+            chunk = line.read(4096)
             if not chunk:
                 if not started and now - begin > start_timeout_s:
                     raise TransferError(f"nothing arrived on {port} in {start_timeout_s:g} s; start the output "
@@ -611,14 +433,11 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
                     break
             if progress:
                 progress(len(raw))
-    except (serial.SerialException, OSError) as e:
+    except LINE_ERRORS as e:
         raise TransferError(f"the line on {port} was lost after {len(raw)} bytes ({e}); "
                             "reconnect and punch the program again") from None
     finally:
-        try:
-            ser.close()
-        except (serial.SerialException, OSError):
-            pass
+        line.close()
     text = raw.decode("ascii", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
     if settings.percent:
         first = text.find("%")

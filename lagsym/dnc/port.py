@@ -1,0 +1,89 @@
+"""The serial port: opening it and every call a transfer makes on it (the only module in lagsym that imports serial).
+
+:class:`Port` is the few operations :mod:`lagsym.dnc.transfer` needs: read
+what the control sent, write, look at the driver's output queue and CTS, and
+close.  A lost line shows as one of :data:`LINE_ERRORS`; a write that waited
+longer than its timeout as :data:`WriteTimeout`.  The kernel's IXON stays off
+on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
+"""
+
+from __future__ import annotations
+
+import serial
+
+from ..errors import TransferError
+from .settings import PARITIES, LineSettings
+
+__all__ = ["Port", "LINE_ERRORS", "WriteTimeout"]
+
+LINE_ERRORS = (serial.SerialException, OSError)
+WriteTimeout = serial.SerialTimeoutException
+
+
+class Port:
+    """An open serial line to a control.
+
+    Parameters
+    ----------
+    name : str
+        A device (``/dev/ttyUSB0``, ``COM3``) or a pyserial URL
+        (``socket://host:port``, ``rfc2217://host:port``, ``loop://``).
+    settings : LineSettings
+        Baud rate, character format, hardware flow control and DTR.
+    write_timeout : float or None
+        Longest a write may wait, in seconds.
+
+    Raises
+    ------
+    TransferError
+        If the port cannot be opened.
+    """
+
+    def __init__(self, name: str, settings: LineSettings, write_timeout: float | None):
+        try:
+            ser = serial.serial_for_url(name, do_not_open=True)
+            ser.baudrate = settings.baud
+            ser.bytesize = settings.bytesize
+            ser.parity = PARITIES[settings.parity]
+            ser.stopbits = settings.stopbits if settings.stopbits == 1.5 else int(settings.stopbits)
+            ser.xonxoff = False  # lagsym reads DC1/DC3 itself; see the module notes
+            ser.rtscts = settings.flow == "rtscts"
+            ser.timeout = 0
+            ser.write_timeout = write_timeout
+            ser.dtr = settings.dtr
+            ser.open()
+        except (ValueError, *LINE_ERRORS) as e:
+            reason = str(e).strip() or type(e).__name__
+            raise TransferError(f"cannot open {name}: {reason}; check the cable, the device name or URL, "
+                                "and that no other program holds the port") from None
+        self._ser = ser
+
+    def read(self, size: int) -> bytes:
+        """What has arrived, up to ``size`` bytes, without waiting."""
+        return self._ser.read(size)
+
+    def write(self, data: bytes) -> int:
+        """Queue ``data``; the number of bytes taken."""
+        written = self._ser.write(data)
+        return len(data) if written is None else written
+
+    def out_waiting(self) -> int:
+        """Bytes in the driver's output queue, or 0 where the port cannot tell."""
+        try:
+            return int(self._ser.out_waiting)
+        except (AttributeError, NotImplementedError, ValueError, TypeError):
+            return 0
+
+    def cts(self) -> bool:
+        """Whether the control holds CTS high; True where the port cannot tell."""
+        try:
+            return bool(self._ser.cts)
+        except (AttributeError, NotImplementedError, *LINE_ERRORS):
+            return True
+
+    def close(self) -> None:
+        """Close the port; a line already lost needs no closing."""
+        try:
+            self._ser.close()
+        except LINE_ERRORS:
+            pass

@@ -1,0 +1,171 @@
+"""How the serial line to a control is set up: :class:`LineSettings` and the usual profile of each control family.
+
+Plain values, checked when they are made; nothing here opens a port, so
+parities are the letters pyserial takes (``N``, ``E``, ``O``, ``M``, ``S``)
+rather than its constants.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from ..errors import InputError
+from ..machine import LINE_ENDINGS
+from ..values import choice, positive
+from .blocks import DC1, DC2, DC3, DC4
+
+__all__ = ["LineSettings", "PROFILES", "FLOW_CONTROLS", "PARITIES", "MODES", "profile", "parse_filler"]
+
+FLOW_CONTROLS = ("xonxoff", "rtscts", "none")
+PARITIES = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}
+MODES = ("upload", "drip")
+_FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
+
+
+@dataclass(frozen=True)
+class LineSettings:
+    """How the serial line to one control is set up.
+
+    Attributes
+    ----------
+    baud : int
+        Bits per second.
+    bytesize : int
+        Data bits, 7 or 8 (5 and 6 are accepted for odd hardware).
+    parity : str
+        ``none``, ``even``, ``odd``, ``mark`` or ``space``.
+    stopbits : float
+        1, 1.5 or 2.
+    flow : str
+        ``xonxoff`` (DC1/DC3 from the control, handled by lagsym), ``rtscts``
+        (hardware) or ``none``.
+    line_ending : str
+        End of block: ``lf``, ``crlf`` or ``cr`` (the characters are
+        :attr:`eol`).
+    leader, trailer : str
+        Characters sent before and after the program (tape feed, ETX).
+    percent : bool
+        Frame the program with ``%`` lines.
+    dtr : bool
+        Assert DTR while the port is open.
+    stall_timeout_s : float
+        Longest XOFF, CTS low or stopped output queue before the transfer
+        gives up.  In a drip feed it must exceed the longest time the control
+        spends on the blocks in its buffer.
+    overrun_chars : int
+        Most characters on their way at any moment, so at most this many
+        arrive after the control says XOFF.  Keep it below the control's
+        tolerance (about 10 on a Fanuc).
+    wait_for_xon : bool
+        Wait for the control's DC1 before the first character (a Fanuc sends
+        it when READ is pressed).
+    """
+
+    baud: int = 9600
+    bytesize: int = 7
+    parity: str = "even"
+    stopbits: float = 2
+    flow: str = "xonxoff"
+    line_ending: str = "lf"
+    leader: str = ""
+    trailer: str = ""
+    percent: bool = True
+    dtr: bool = True
+    stall_timeout_s: float = 120.0
+    overrun_chars: int = 4
+    wait_for_xon: bool = False
+
+    def __post_init__(self):
+        if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
+            raise InputError(f"baud rate {self.baud!r} must be a whole number from 50 to 4000000")
+        choice(self.bytesize, (5, 6, 7, 8), "data bits")
+        choice(self.parity, tuple(PARITIES), "parity")
+        object.__setattr__(self, "stopbits", float(self.stopbits))
+        choice(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
+        choice(self.flow, FLOW_CONTROLS, "flow control")
+        choice(self.line_ending, tuple(LINE_ENDINGS), "end of block")
+        for name in ("leader", "trailer"):
+            text = getattr(self, name)
+            if any(ord(c) in (DC1, DC2, DC3, DC4) or ord(c) > 127 for c in text):
+                raise InputError(f"{name} {text!r} holds a character the line cannot carry or that steers it")
+        object.__setattr__(self, "stall_timeout_s", positive(self.stall_timeout_s, "stall timeout (seconds)"))
+        if not isinstance(self.overrun_chars, int) or not 1 <= self.overrun_chars <= 4096:
+            raise InputError(f"overrun limit {self.overrun_chars!r} must be 1 to 4096 characters")
+
+    @property
+    def eol(self) -> str:
+        """The end-of-block characters :attr:`line_ending` names.
+
+        Examples
+        --------
+        >>> LineSettings(line_ending="crlf").eol
+        '\\r\\n'
+        """
+        return LINE_ENDINGS[self.line_ending]
+
+    @property
+    def bits_per_char(self) -> float:
+        """Start bit, data bits, parity bit and stop bits of one character.
+
+        Examples
+        --------
+        >>> LineSettings(bytesize=7, parity="even", stopbits=2).bits_per_char
+        11.0
+        """
+        return 1 + self.bytesize + (0 if self.parity == "none" else 1) + self.stopbits
+
+    @property
+    def chars_per_s(self) -> float:
+        """The line rate in characters per second.
+
+        Examples
+        --------
+        >>> LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2).chars_per_s
+        872.7272727272727
+        """
+        return self.baud / self.bits_per_char
+
+
+# Sources for each profile are in docs/dnc.md.
+PROFILES: dict[str, LineSettings] = {
+    "fanuc": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=2, flow="xonxoff", line_ending="lf",
+                          leader="\x00" * 20, trailer="\x00" * 20, percent=True),
+    "haas": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", line_ending="crlf",
+                         leader="", trailer="", percent=True),
+    "heidenhain": LineSettings(baud=9600, bytesize=7, parity="even", stopbits=1, flow="xonxoff", line_ending="crlf",
+                               leader="\x00" * 50, trailer="\x03", percent=False),
+}
+
+
+def profile(name: str, **overrides) -> LineSettings:
+    """The usual line settings of a control family, with any field overridden.
+
+    Examples
+    --------
+    >>> profile("haas", baud=19200).line_ending
+    'crlf'
+    """
+    choice(name, tuple(PROFILES), "profile")
+    return replace(PROFILES[name], **overrides)
+
+
+def parse_filler(spec: str) -> str:
+    """Read a leader or trailer: a count of NULs (``20``) or items like ``50*NUL,ETX``.
+
+    Examples
+    --------
+    >>> parse_filler("3"), parse_filler("2*NUL,ETX"), parse_filler("")
+    ('\\x00\\x00\\x00', '\\x00\\x00\\x03', '')
+    """
+    out = []
+    for item in (s.strip() for s in spec.split(",") if s.strip()):
+        count, _, name = item.rpartition("*")
+        if not count and item.isdigit():
+            count, name = item, "NUL"
+        name = name.upper()
+        if name not in _FILLERS:
+            raise InputError(f"leader/trailer item {item!r}: {name!r} is not one of {', '.join(_FILLERS)}")
+        if count and (not count.isdigit() or int(count) > 10_000):
+            raise InputError(f"leader/trailer item {item!r}: {count!r} is not a count from 0 to 10000")
+        out.append(_FILLERS[name] * (int(count) if count else 1))
+    return "".join(out)

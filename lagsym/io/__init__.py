@@ -1,0 +1,46 @@
+"""Every path lagsym reads or writes passes here.
+
+- :mod:`~lagsym.io.files`: the bytes of an input (a regular file or standard
+  input, within a size limit), programs as a control reads them, event logs;
+- :mod:`~lagsym.io.points` and :mod:`~lagsym.io.table`: point files (JSON,
+  CSV and other tables) into exact control grids;
+- :mod:`~lagsym.io.write`: results written atomically, respecting what is at
+  the path.
+"""
+
+from __future__ import annotations
+
+from ..values import exact_number
+from .files import MAX_BYTES, STDIN_SILENCE_S, event_log, read_bytes, read_program, read_text
+from .points import (
+    TABLE_SUFFIXES,
+    PointsFile,
+    parse_curve_points,
+    parse_points,
+    read_any_points,
+    read_curve_points,
+    read_point_file,
+    read_points,
+)
+from .write import atomic_path, atomic_write, write_text
+
+__all__ = [
+    "read_points",
+    "read_point_file",
+    "PointsFile",
+    "read_curve_points",
+    "read_any_points",
+    "read_program",
+    "read_bytes",
+    "read_text",
+    "event_log",
+    "parse_points",
+    "parse_curve_points",
+    "exact_number",
+    "atomic_path",
+    "atomic_write",
+    "write_text",
+    "MAX_BYTES",
+    "STDIN_SILENCE_S",
+    "TABLE_SUFFIXES",
+]

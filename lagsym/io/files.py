@@ -1,0 +1,135 @@
+"""Reading the bytes of an input: only a regular file or standard input, always within a size limit.
+
+A device or a named pipe could hand over endless bytes or none, so it is
+refused with a line that says what it is; standard input (``-``) that stays
+silent is refused after :data:`STDIN_SILENCE_S`.  Programs are read as a
+control reads them: ASCII, line endings kept.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import time
+from collections.abc import Iterator
+
+from ..errors import InputError
+
+__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "read_bytes", "read_text", "read_program", "event_log"]
+
+MAX_BYTES = 64 * 1024 * 1024
+
+_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe (FIFO)"),
+          (stat.S_ISSOCK, "a socket"))
+STDIN_NAMES = ("-", "/dev/stdin")
+STDIN_SILENCE_S = 10.0  # standard input that sends nothing for this long is refused, not waited on forever
+
+
+def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
+    """The bytes of ``path`` (``-``: standard input), at most ``limit``; every failure is one InputError naming it.
+
+    Only a regular file or standard input is read: a device or a named pipe
+    could hand over endless bytes or none, so it is refused with a line that
+    says what it is.
+    """
+    name = str(path)
+    if name in STDIN_NAMES:
+        return _read_stdin(what, limit)
+    try:
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
+    except FileNotFoundError:
+        raise InputError(f"{name}: no such file") from None
+    except PermissionError:
+        raise InputError(f"{name}: permission denied") from None
+    except IsADirectoryError:
+        raise InputError(f"{name}: is a directory, not {what}") from None
+    except OSError as e:
+        raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    info = os.fstat(fd)
+    refusal = f"{name}: is a directory, not {what}" if stat.S_ISDIR(info.st_mode) else next(
+        (f"{name}: is {kind}, not {what}; give a regular file, or '-' for standard input"
+         for test, kind in _KINDS if test(info.st_mode)), None)
+    if refusal:
+        os.close(fd)
+        raise InputError(refusal)
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            if (size := info.st_size) > limit:
+                raise InputError(f"{name}: {size} bytes is too large for {what} (at most {limit} bytes)")
+            raw = fh.read(limit + 1)
+        except OSError as e:
+            raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+    if len(raw) > limit:  # the file grew while it was read
+        raise InputError(f"{name}: more than {limit} bytes is too large for {what}")
+    return raw
+
+
+def _read_stdin(what: str, limit: int) -> bytes:
+    import select
+    import sys
+
+    stream = sys.stdin.buffer
+    chunks, total = [], 0
+    while True:
+        ready, _, _ = select.select([stream], [], [], STDIN_SILENCE_S)
+        if not ready:
+            raise InputError(f"standard input: nothing arrived for {STDIN_SILENCE_S:g} s; "
+                             f"pipe {what} in, or give a file name")
+        chunk = os.read(stream.fileno(), 1 << 16)
+        if not chunk:
+            return b"".join(chunks)
+        total += len(chunk)
+        if total > limit:
+            raise InputError(f"standard input: more than {limit} bytes is too large for {what}")
+        chunks.append(chunk)
+
+
+def read_text(path: str | os.PathLike) -> tuple[str, str]:
+    name = str(path)
+    raw = read_bytes(path, "a points file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        hint = "" if b"\x00" in raw[:4096] else "; if it is text, save it as UTF-8 (Excel: 'CSV UTF-8')"
+        raise InputError(f"{name}: not a text file (byte 0x{raw[e.start]:02x} at offset {e.start}){hint}") from None
+    if "\x00" in text:
+        raise InputError(f"{name}: not a text file (NUL byte at offset {text.index(chr(0))})")
+    if not text.strip():
+        raise InputError(f"{name}: the file is empty")
+    return name, text
+
+
+def read_program(path: str | os.PathLike) -> str:
+    """Read a part program as a control reads it: ASCII text, line endings kept as they are.
+
+    Raises
+    ------
+    InputError
+        For a missing or unreadable file, a directory, or a byte that is not ASCII.
+    """
+    name = str(path)
+    raw = read_bytes(path, "a program")
+    try:
+        return raw.decode("ascii")
+    except UnicodeDecodeError as e:
+        raise InputError(f"{name}: byte 0x{raw[e.start]:02x} at offset {e.start} is not ASCII; "
+                         f"a control reads ASCII programs") from None
+
+
+@contextlib.contextmanager
+def event_log(path: str | os.PathLike | None) -> Iterator:
+    """A function that appends a time-stamped line to the log file ``path``, or None without a path."""
+    if not path:
+        yield None
+        return
+    try:
+        fh = open(path, "a", encoding="utf-8")
+    except OSError as e:
+        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
+    with fh:
+        def log(message: str) -> None:
+            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
+            fh.flush()
+
+        yield log

@@ -1,0 +1,40 @@
+"""Resuming a drip feed: the modal set-up before a block, and what a resume refuses to replay."""
+
+from __future__ import annotations
+
+import pytest
+
+from lagsym.dnc import parse_program, resume_setup
+from lagsym.errors import InputError
+from simcontrol import PROGRAM
+
+
+def test_resume_setup_restores_modes_retracts_and_approaches():
+    p = parse_program(PROGRAM)
+    setup = resume_setup(p, 11)
+    assert setup == ("(RESUME AT BLOCK 11)", "G21 G17 G90 G54", "T2 M6", "S4000 M3", "G0 Z25.",
+                     "G0 X20. Y10.", "M8", "G1 Z-1. F600.", "G2")
+    assert resume_setup(p, 11, safe_z="40")[4] == "G0 Z40."
+
+
+@pytest.mark.parametrize("text, start, words", [
+    (PROGRAM, 1, "outside the program"),
+    (PROGRAM, 99, "outside the program"),
+    ("O1\nG21 G90\n#1=5\nG0 Z#1\nG1 X1. F100.", 5, "macro variables"),
+    ("O1\nG90 G0 Z5.\nG1 X1. F100.", 3, "G20 or G21"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG81 Z-2. R1. F100.\nX2.", 5, "canned cycle G81 is still on"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG41 D1 G1 X2. F100.\nX3.", 5, "cutter compensation G41"),
+    ("O1\nG21 G90 G92 X0 Y0 Z0\nG0 Z5.\nX2.", 4, "G92 shifts"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG91 G28 Z0.\nG90 G1 X2. F100.\nX3.", 6, "Z position"),
+    ("O1\nG21 G90\nG1 X1. Y1. Z-1. F100.\nX2.", 4, "safe-z"),
+])
+def test_resume_refuses_what_it_cannot_replay(text, start, words):
+    with pytest.raises(InputError, match=words):
+        resume_setup(parse_program(text, "p.nc"), start)
+
+
+def test_resume_after_a_drilling_cycle_and_a_return_home():
+    text = ("O1\nG21 G17 G90 G54\nG91 G28 Z0.\nG90 T3 M6\nS1200 M3\nG0 X0. Y0. Z30.\n"
+            "G98 G81 X5. Y5. Z-4. R2. F80.\nX10.\nG80\nG0 Z30.\nG1 Z-1. F150.\nX20.\nX30.")
+    setup = resume_setup(parse_program(text), 13)
+    assert setup[1:] == ("G21 G17 G90 G54", "T3 M6", "S1200 M3", "G0 Z30.", "G0 X20. Y5.", "G1 Z-1. F150.")

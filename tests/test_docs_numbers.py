@@ -1,0 +1,165 @@
+"""Numbers the documentation states, recomputed: each fails if the page and the computation part."""
+
+from __future__ import annotations
+
+import math
+import re
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+import sympy
+
+from lagsym import lagrange_surface, read_points
+from lagsym.conditioning import check_surface, lebesgue_constant
+from lagsym.equation import rounding_miss
+from lagsym.evaluate import evaluate_grid
+from lagsym.grid import grid_from_table
+
+from conftest import EXAMPLES, ROOT
+
+DOCS = ROOT / "docs"
+
+
+def page(name: str) -> str:
+    return " ".join((DOCS / name).read_text().split())
+
+
+def lebesgue_mp(nodes, t) -> mpmath.mpf:
+    total = mpmath.mpf(0)
+    for j, xj in enumerate(nodes):
+        p = mpmath.mpf(1)
+        for k, xk in enumerate(nodes):
+            if k != j:
+                p *= (t - xk) / (xj - xk)
+        total += abs(p)
+    return total
+
+
+def first_kind(n):
+    return [math.cos(math.pi * (2 * i + 1) / (2 * n)) for i in range(n)]
+
+
+def extrema(n):
+    return [math.cos(math.pi * i / (n - 1)) for i in range(n)]
+
+
+def test_theory_and_sampling_lebesgue_constants():
+    theory, sampling = page("theory.md"), page("sampling.md")
+    eq = {n: lebesgue_constant(range(n)) for n in (7, 11, 20)}
+    assert f"({eq[7]:.3g} for 7 nodes, {eq[11]:.3g} for 11, {eq[20]:.0f} for 20)" in theory
+    assert f"for 20 equally spaced nodes is {eq[20]:.0f} each" in sampling
+    assert f"give {lebesgue_constant(first_kind(7)):.3g} for 7 nodes and {lebesgue_constant(first_kind(20)):.3g} for 20" in theory
+    assert f"give {lebesgue_constant(extrema(7)):.3g} and {lebesgue_constant(extrema(20)):.3g}" in theory
+
+
+@pytest.mark.parametrize("nodes", [[1.1**k for k in range(40)], [2.0**k for k in range(30)], list(range(20))],
+                         ids=["geometric-1.1", "geometric-2", "equispaced-20"])
+def test_lebesgue_constant_agrees_with_60_digit_arithmetic(nodes):
+    mpmath.mp.dps = 60
+    mp_nodes = [mpmath.mpf(v) for v in nodes]
+    lam = lebesgue_constant(nodes)
+    # A dense 60-digit search of the widest-valued interval and the last one bounds the maximum from below.
+    probe = max(lebesgue_mp(mp_nodes, mp_nodes[j] + (mp_nodes[j + 1] - mp_nodes[j]) * mpmath.mpf(k) / 200)
+                for j in (0, len(nodes) - 2) for k in range(1, 200))
+    assert float(probe) <= lam * (1 + 1e-9)
+    assert lam <= float(probe) * (1 + 1e-4)
+
+
+def test_the_spacing_ratio_changes_no_measure_of_the_surface():
+    g = read_points(EXAMPLES / "paper-example-4.json")
+    stretched = grid_from_table([v * 40 for v in g.x], g.y, g.z)
+    a = {f.name: f for f in check_surface(lagrange_surface(g)).findings}
+    b = {f.name: f for f in check_surface(lagrange_surface(stretched)).findings}
+    assert b["spacing_ratio"].value == pytest.approx(40 * a["spacing_ratio"].value)
+    assert not b["spacing_ratio"].warning
+    for name in ("lebesgue_x", "lebesgue_y", "overshoot"):
+        assert b[name].value == pytest.approx(a[name].value, rel=1e-9), name
+
+
+def test_comparison_deviation_percentage_evidence():
+    text = page("comparison.md")
+    hermite, bezier = 66.2265 / 108.0572, 31.4031 / 51.2383
+    assert f"{hermite:.5f}" == f"{bezier:.5f}" == "0.61288"
+    assert "66.2265 / 108.0572 = 31.4031 / 51.2383 = 0.61288" in text
+    assert f"{100 / hermite:.2f}" == f"{100 / bezier:.2f}" == "163.16" and "/ 163.16" in text
+
+
+def runge_max_deviation(n: int) -> float:
+    nodes = [Fraction(-2) + Fraction(4 * i, n - 1) for i in range(n)]
+    z = [[1 / (1 + 4 * (a * a + b * b)) for b in nodes] for a in nodes]
+    s = lagrange_surface(grid_from_table(nodes, nodes, z))
+    t = np.linspace(-2, 2, 81)
+    f = 1 / (1 + 4 * (t[:, None] ** 2 + t[None, :] ** 2))
+    return float(np.abs(evaluate_grid(s, t, t) - f).max())
+
+
+def test_paper_page_degree_6_sentence():
+    text = page("paper.md")
+    d5, d7 = runge_max_deviation(5), runge_max_deviation(7)
+    assert f"| 5x5 | 4 | {d5:.4f} |" in text and f"| 7x7 | 6 | {d7:.4f} |" in text
+    assert d7 > d5 > runge_max_deviation(9) / 10
+    assert f"the deviation is larger than at 5x5 ({d7:.4f} against {d5:.4f})" in text
+
+
+def test_equations_page_rounding_numbers():
+    from test_symbolic import dome
+
+    text = page("equations.md")
+    nodes, z = dome()
+    s = lagrange_surface(grid_from_table(nodes, nodes, z))
+    m = {d: f"{float(rounding_miss(s, d).largest):.3g}" for d in (4, 5, 6)}
+    assert f"misses the control points by up to {m[4]} mm" in text
+    assert f"5 digits miss by {m[5]} mm, 6 by {m[6]} mm" in text
+    ex4 = rounding_miss(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")), 4)
+    assert f"Example 4 at 4 digits misses by {float(ex4.largest):.3g} mm (at (5, 5))" in text
+    assert ex4.at[:2] == (5, 5)
+
+
+def test_errata_equation_4_as_printed_misses_its_second_point():
+    x, x1, x2, y1, y2 = sympy.symbols("x x_1 x_2 y_1 y_2")
+    printed = (x - x2) / (x1 - x2) * y1 - (x - x1) / (x2 - x1) * y2
+    assert sympy.simplify(printed.subs(x, x1) - y1) == 0
+    assert sympy.simplify(printed.subs(x, x2) + y2) == 0  # through (x_2, -y_2)
+    second = y1 + (y2 - y1) * (x1 - x) / (x1 - x2)
+    assert sympy.simplify(second.subs(x, x2) - y2) == 0
+    text = page("paper-errata.md")
+    assert "through `(x_2, -y_2)`, not `(x_2, y_2)`" in text and "`j = 0 .. n`" in text
+
+
+def test_plotting_page_lists_no_view_as_to_come():
+    assert "(to come)" not in page("plotting.md")
+    assert re.search(r"static\*\* by default", page("plotting.md"))
+
+
+def test_notebook_1_overshoot_sentence_matches_its_table():
+    import json
+
+    from lagsym import curve_from_points, lagrange_curve
+    from lagsym.conditioning import check_curve
+
+    def overshoot(n):
+        xs = [Fraction(-1) + Fraction(2 * i, n - 1) for i in range(n)]
+        c = lagrange_curve(curve_from_points([(v, 1 / (1 + 25 * v * v)) for v in xs]))
+        return {f.name: f.value for f in check_curve(c).findings}
+
+    found = {n - 1: overshoot(n) for n in (5, 7, 9, 11)}
+    assert found[6]["overshoot"] < found[4]["overshoot"] and found[10]["overshoot"] < found[8]["overshoot"]
+    assert found[4]["lebesgue_x"] < found[6]["lebesgue_x"] < found[8]["lebesgue_x"] < found[10]["lebesgue_x"]
+    nb = json.loads((ROOT / "notebooks" / "01-lagrange-curves.ipynb").read_text())
+    text = " ".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "markdown")
+    assert "drops from degree 4 to 6 and from 8 to 10" in text
+
+
+def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_cli):
+    text = (DOCS / "macros.md").read_text()
+    block = text.split("$ lagsym macro examples/paper-example-4.json", 1)[1].split("```", 1)[0]
+    argv = ("macro " + block.split("\n", 2)[0] + " " + block.split("\n", 2)[1]).replace("\\", " ").split()
+    quoted = block.split("\n", 2)[2].split("\n$ ", 1)[0].strip()
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run_cli(argv[0], "examples/paper-example-4.json", *argv[1:])
+    assert status == 0, err
+    assert quoted == (out + err).strip()
+    assert f"takes {quoted.split('macro program:')[1].split()[0]} bytes on a Fanuc" in text
