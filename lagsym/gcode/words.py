@@ -99,7 +99,9 @@ def numeric_words(block: str, *, semicolon: bool = True, strict: bool = True) ->
     >>> numeric_words("G1 X#1", strict=False)
     [('G', '1')]
     """
-    text = strip_comments(block, semicolon=semicolon)
+    text = block
+    if "(" in text or (semicolon and ";" in text):
+        text = (_COMMENTS if semicolon else _PARENTHESES).sub(" ", text)
     found = _NUMERIC_WORD.findall(text)
     if strict:
         if "(" in text:
@@ -107,7 +109,9 @@ def numeric_words(block: str, *, semicolon: bool = True, strict: bool = True) ->
         rest = _NUMERIC_WORD.sub("", text).strip()
         if rest:
             raise WordError(f"cannot read {rest!r}")
-    return [(letter.upper(), value) for letter, value in found]
+    if not text.isupper():  # some letter is lower case (most programs have none: skip the copy)
+        found = [(letter.upper(), value) for letter, value in found]
+    return found
 
 
 def words(block: str) -> list[tuple[str, str]]:
