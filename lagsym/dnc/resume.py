@@ -14,12 +14,11 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import InputError
+from ..gcode.words import numeric_words, strip_comments
 from .blocks import Program
 
 __all__ = ["resume_setup"]
 
-_WORD = re.compile(r"([A-Z])\s*([+-]?(?:\d+\.?\d*|\.\d+))")
-_COMMENT = re.compile(r"\([^)]*\)|;.*$")
 _MACRO = re.compile(r"#|\bGOTO\b|\bWHILE\b|\bIF\b|\bM98\b|\bM99\b|\bG65\b")
 
 
@@ -45,7 +44,7 @@ class _Modal:
 
 
 def _words(block: str) -> list[tuple[str, str]]:
-    return _WORD.findall(_COMMENT.sub(" ", block.upper()))
+    return numeric_words(block, strict=False)  # macro blocks are refused before modal tracking
 
 
 def _number(text: str) -> Decimal:
@@ -191,7 +190,7 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     for number in range(1, start_block):
         block = program.block(number)
         where = f"{program.source}: block {number}"
-        if _MACRO.search(_COMMENT.sub(" ", block.upper())):
+        if _MACRO.search(strip_comments(block).upper()):
             raise InputError(f"{where} uses macro variables, jumps or subprogram calls; a resume cannot know the "
                              "state they leave, so send the program from the start")
         try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 from ..errors import ProgramError
-from ..post.numbers import fixed
+from ..gcode.numbers import fixed
 from .model import Const, Op, Sqrt, Var, variables, written
 
 __all__ = ["number_variables", "expression", "literal"]

@@ -10,15 +10,16 @@ constant, at most 8 significant digits on 8-digit controls, no exponent;
 from __future__ import annotations
 
 from ..errors import ProgramError
-from ..post.numbers import fixed
+from ..gcode import limits
+from ..gcode.numbers import fixed
 from ._render import expression, literal, number_variables
 from .model import Assign, Clamp, Loop, Move
 
 __all__ = ["render", "VARIABLE_RANGES", "DEFAULT_BASE", "MAX_BLOCK"]
 
-VARIABLE_RANGES = ((100, 199), (500, 999))
+VARIABLE_RANGES = limits.MACRO_VARIABLES["fanuc"]
 DEFAULT_BASE = 100
-MAX_BLOCK = 128  # characters per block the simulator accepts
+MAX_BLOCK = limits.MAX_BLOCK["fanuc"]
 
 
 def _comment(text: str) -> str:

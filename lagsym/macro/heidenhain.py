@@ -10,13 +10,14 @@ runs at least once (every loop of a surface program does).  Blocks are numbered 
 from __future__ import annotations
 
 from ..errors import ProgramError
-from ..post.numbers import fixed
+from ..gcode import limits
+from ..gcode.numbers import fixed
 from ._render import literal, number_variables
 from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var, variables
 
 __all__ = ["render", "VARIABLE_RANGES", "DEFAULT_BASE", "MAX_LABEL"]
 
-VARIABLE_RANGES = ((0, 99),)
+VARIABLE_RANGES = limits.MACRO_VARIABLES["heidenhain"]
 DEFAULT_BASE = 1
 MAX_LABEL = 254
 _FN = {"+": 1, "-": 2, "*": 3, "/": 4}

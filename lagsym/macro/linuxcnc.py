@@ -6,13 +6,14 @@ parameters ``#<name>`` keep the program readable.
 
 from __future__ import annotations
 
-from ..post.numbers import fixed
+from ..gcode import limits
+from ..gcode.numbers import fixed
 from ._render import expression, literal
 from .model import Assign, Clamp, Loop, Move
 
 __all__ = ["render", "MAX_BLOCK"]
 
-MAX_BLOCK = 255  # LinuxCNC reads at most 255 characters per line (LINELEN)
+MAX_BLOCK = limits.MAX_BLOCK["linuxcnc"]
 
 
 def render(loops, settings, precision: int = 15, variable_base: int | None = None) -> str:

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import ProgramError
 from ..machine import MachineSettings
 from .moves import format_moves
-from .numbers import fixed
+from ..gcode.numbers import fixed
 
 __all__ = ["PointProgram", "point_program", "iso_comment", "body", "units_word"]
 
