@@ -55,7 +55,10 @@ class Port:
             ser.timeout = 0
             if "://" not in name:
                 ser.exclusive = True  # a second reader would take the control's DC1 and stall the transfer
-            _set_write_timeout(ser, write_timeout)
+            if not name.lower().startswith("rfc2217://"):
+                # pyserial's RFC 2217 client refuses a write timeout when it opens (its writes wait on the
+                # network); the sender's own stall check bounds them there.
+                ser.write_timeout = write_timeout
             ser.dtr = settings.dtr
             ser.open()
         except (ValueError, *LINE_ERRORS) as e:
@@ -103,15 +106,6 @@ class Port:
             self._ser.close()
         except LINE_ERRORS:
             pass
-
-
-def _set_write_timeout(ser, timeout: float | None) -> None:
-    """A write timeout where the port supports one (pyserial's RFC 2217 client does not: its writes wait on the
-    network, and the sender's own stall check bounds them)."""
-    try:
-        ser.write_timeout = timeout
-    except NotImplementedError:
-        pass
 
 
 def _open_failure(name: str, e: BaseException) -> str:

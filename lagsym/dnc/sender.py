@@ -41,6 +41,7 @@ _PROGRESS_S = 0.1
 _SETTLE_S = 0.05
 _SETTLE_NETWORK_S = 0.25
 _HARDWARE = {"rtscts": "cts", "dtrdsr": "dsr"}
+_CARRIER_POLL_S = 0.1
 
 
 class Sender:
@@ -82,6 +83,7 @@ class Sender:
                                     f"({'flow ' + settings.flow if sig == self.hardware else 'carrier ' + sig}); "
                                     "use a port with modem lines or change the setting")
         self.carrier_down_since: float | None = None
+        self.carrier_checked = -1.0
 
     def in_flight(self, now: float) -> int:
         """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
@@ -179,7 +181,8 @@ class Sender:
                 self.paused, self.pause_since, self.pause_reason = True, now, reason
             elif ready and self.paused and self.pause_reason == reason:
                 self.paused = False
-        if self.carrier:
+        if self.carrier and now - self.carrier_checked >= _CARRIER_POLL_S:
+            self.carrier_checked = now  # a network port may wait on the server to tell its modem lines
             self.check_carrier(now)
 
     def check_carrier(self, now: float) -> None:
