@@ -111,7 +111,7 @@ class Port:
 def _open_failure(name: str, e: BaseException) -> str:
     reason = str(e).strip() or type(e).__name__
     busy = (getattr(e, "errno", None) in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK)
-            or "exclusively lock" in reason or isinstance(e, termios.error))
+            or "exclusively lock" in reason)
     if busy:
         return (f"cannot open {name}: the port is in use by another program (another lagsym, a terminal or a "
                 "DNC service); close it and try again")

@@ -44,7 +44,7 @@ def _settings_text(settings: LineSettings) -> str:
 def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 60.0, idle_timeout_s: float = 5.0,
                     progress: Callable[[int], None] | None = None, log: Callable[[str], None] | None = None,
                     ready: Callable[[], None] | None = None,
-                    should_stop: Callable[[], bool] | None = None) -> str:
+                    should_stop: Callable[[], bool] | None = None, line=None) -> str:
     """Receive a program the control punches out, as text with ``\\n`` line ends.
 
     Parameters
@@ -58,6 +58,8 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
         press PUNCH).
     should_stop : callable, optional
         Looked at between reads; True gives up the wait (a service stopping).
+    line : lagsym.dnc.port.Port, optional
+        A port already open (a service keeps its port), used and left open.
 
     Raises
     ------
@@ -68,7 +70,9 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
     """
     from .port import LINE_ERRORS, Port
 
-    line = Port(port, settings, write_timeout=1.0)
+    owned = line is None
+    if owned:
+        line = Port(port, settings, write_timeout=1.0)
     raw = bytearray()
     try:
         if ready:
@@ -85,7 +89,8 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
         raise TransferError(f"the line on {port} was lost after {len(raw)} bytes ({e}); "
                             "reconnect and punch the program again") from None
     finally:
-        line.close()
+        if owned:
+            line.close()
     return _program_text(bytes(raw), percents, port, settings)
 
 

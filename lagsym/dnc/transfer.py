@@ -64,7 +64,7 @@ def transfer_segments(program: Program, settings: LineSettings, mode: str = "upl
 
 def send_program(port: str, program: Program, settings: LineSettings, mode: str = "upload", start_block: int = 1,
                  safe_z: str | None = None, progress: Callable[[TransferProgress], None] | None = None,
-                 log: Callable[[str], None] | None = None) -> TransferResult:
+                 log: Callable[[str], None] | None = None, line=None) -> TransferResult:
     """Send a program to a control over a serial line.
 
     Parameters
@@ -88,6 +88,8 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
         Called about ten times a second with a :class:`TransferProgress`.
     log : callable, optional
         Called with one line of text per event (XOFF, XON, fault, end).
+    line : lagsym.dnc.port.Port, optional
+        A port already open (a service keeps its port), used and left open.
 
     Returns
     -------
@@ -108,11 +110,14 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
 
     segments = transfer_segments(program, settings, mode, start_block, safe_z)
     timeout = None if settings.stall_timeout_s == float("inf") else settings.stall_timeout_s
-    line = Port(port, settings, write_timeout=timeout)
+    owned = line is None
+    if owned:
+        line = Port(port, settings, write_timeout=timeout)
     try:
         sender = Sender(line, segments, settings, mode, port, progress, log)
     except BaseException:
-        line.close()
+        if owned:
+            line.close()
         raise
     try:
         return sender.run()
@@ -128,6 +133,7 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
         raise sender.fault(f"the line was lost ({reason})",
                            "reconnect the cable or the network port and clear the control") from None
     finally:
-        line.close()
+        if owned:
+            line.close()
 
 
