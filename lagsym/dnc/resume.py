@@ -60,7 +60,10 @@ _TRANSFORM_ENDS = {"69": "68", "50": "51", "50.1": "51.1", "15": "16"}
 
 
 def _track(state: _Modal, block: str, where: str) -> None:
-    """Update ``state`` with one block, as a control would."""
+    """Update ``state`` with one block, as a control would.
+
+    Long because it is one table of the modal groups a control keeps, read in the order the control reads them.
+    """
     words = _words(block)
     gs = [_g(v) for k, v in words if k == "G"]
     ms = [v for k, v in words if k == "M"]
@@ -159,6 +162,9 @@ def _fmt(value: Decimal) -> str:
 
 def resume_setup(program: Program, start_block: int, safe_z: str | None = None) -> tuple[str, ...]:
     """The blocks that put a control in the state block ``start_block`` expects.
+
+    Long because each state a resume cannot trust is its own check with its own message, in the order a
+    reader of the set-up would ask.
 
     The blocks before ``start_block`` are read for the modal state they leave:
     units, plane, distance mode, work offset, tool and tool length offset,
