@@ -27,8 +27,7 @@ SIGTERM, SIGHUP or Ctrl-C stops the server within 2 s.  --check reads and
 checks the configuration and exits.
 
 examples:
-  lagsym dnc serve examples/dnc.toml --check
-  lagsym dnc serve /etc/lagsym/dnc.toml"""
+  lagsym dnc serve examples/dnc.toml --check"""
 
 
 def add_arguments(p) -> None:
