@@ -67,6 +67,7 @@ COMMANDS = {
     "simulate": "dry-run a macro program at the control's precision and write the moves it makes",
     "send": "send a program to a CNC control over RS-232 (upload to memory or drip feed)",
     "receive": "receive a program punched out by a CNC control over RS-232",
+    "dnc": "run a DNC server: ports that machines call to punch programs and to ask for them",
 }
 
 
