@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -38,6 +39,13 @@ def missing_system_package(packages: str, what: str) -> None:
     if os.environ.get("LAGSYM_TEST_REQUIRE_ALL"):
         pytest.fail(line, pytrace=False)
     pytest.skip(line, allow_module_level=True)
+
+
+@pytest.fixture(autouse=True)
+def _socat(request):
+    """Tests marked ``socat`` need Debian's socat for their pseudo-terminal pairs."""
+    if request.node.get_closest_marker("socat") and shutil.which("socat") is None:
+        missing_system_package("socat", "socat")
 
 
 @pytest.fixture(scope="session")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import shutil
 import socket
 import subprocess
 import sys
@@ -16,7 +15,7 @@ from lagsym.dnc import LineFault, LineSettings, parse_program, profile, resume_s
 from lagsym.errors import InputError, TransferError
 from simcontrol import PROGRAM, KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
 
-needs_socat = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
+needs_socat = pytest.mark.socat
 
 
 def program_blocks(text: str) -> list[str]:

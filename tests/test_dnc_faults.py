@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -18,7 +17,7 @@ from lagsym.dnc.port import Port
 from rfc2217rig import Rfc2217Server
 from simcontrol import PROGRAM, PtyPair, SimControl, chars_per_s, program_text, punch
 
-pytestmark = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
+pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -16,7 +15,7 @@ import pytest
 from lagsym.dnc import parse_program, profile, transfer_segments
 from simcontrol import PtyPair, SimControl, program_text, punch
 
-pytestmark = pytest.mark.skipif(shutil.which("socat") is None, reason="socat is not installed")
+pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
 
 
