@@ -15,13 +15,14 @@ FIGURES = {
     "fig4-basis.png": ["plot", "examples/paper-example-2.json", "--show", "basis"],
     "fig9-surface.png": ["plot", "examples/paper-example-4.json"],
     "fig10-compare.png": ["plot", "examples/paper-example-4.json", "--show", "compare"],
+    "fig11-growth.png": ["plot", "examples/parabola.json", "--show", "growth", "1/(1 + ((x-20)**2 + (y-20)**2)/25)"],
 }
 
 
 def main() -> int:
     from lagsym.cli import main as lagsym
 
-    size = ["--size", "800x600"]
+    size = []  # the default size: sharp on the page, text legible
     for name, argv in FIGURES.items():
         if lagsym([*argv, *size, "-o", str(HERE / "images" / name)]) != 0:
             return 1

@@ -177,3 +177,4 @@ def chart_text(chart, height_px: int) -> None:
         axis.label_size = text_size(height_px, 1 / 40)
         axis.tick_label_size = text_size(height_px, 1 / 44)
     chart.legend.GetLabelProperties().SetFontSize(text_size(height_px, 1 / 44))
+    chart.GetTitleProperties().SetFontSize(text_size(height_px, 1 / 36))
