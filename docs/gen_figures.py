@@ -15,6 +15,7 @@ FIGURES = {
     "fig4-basis.png": ["plot", "examples/paper-example-2.json", "--show", "basis"],
     "fig9-surface.png": ["plot", "examples/paper-example-4.json"],
     "fig10-compare.png": ["plot", "examples/paper-example-4.json", "--show", "compare"],
+    "fig11-growth.png": ["plot", "examples/parabola.json", "--show", "growth", "1/(1 + ((x-20)**2 + (y-20)**2)/25)"],
 }
 
 
@@ -43,15 +44,15 @@ def export_figure(path: Path) -> None:
 def main(names: list[str] | None = None) -> int:
     from lagsym.cli import main as lagsym
 
+    size = []  # the default size: sharp on the page, text legible
     if names:  # only these
         for name in names:
             if name == "export-net.png":
                 export_figure(HERE / "images" / name)
-            elif name in FIGURES and lagsym([*FIGURES[name], "--size", "800x600", "-o", str(HERE / "images" / name)]):
+            elif name in FIGURES and lagsym([*FIGURES[name], *size, "-o", str(HERE / "images" / name)]):
                 return 1
         return 0
     export_figure(HERE / "images" / "export-net.png")
-    size = ["--size", "800x600"]
     for name, argv in FIGURES.items():
         if lagsym([*argv, *size, "-o", str(HERE / "images" / name)]) != 0:
             return 1

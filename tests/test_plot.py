@@ -210,20 +210,130 @@ def test_toolpath_figure(surface4):
     moves, rapid = raster(surface4)
     img = render(plot.toolpath_figure(surface4, moves, rapid=rapid, samples=31, window_size=SIZE))
     check_picture(img, SIZE, 0.11)
-    # Feed moves are drawn in their own colour.
+    # Feed moves and rapids are drawn, each in its own colour.
     red = (np.abs(img.astype(int) - (255, 69, 0)).max(axis=-1) < 40).mean()
-    assert red > 0.003
+    blue = (np.abs(img.astype(int) - (65, 105, 225)).max(axis=-1) < 40).mean()
+    assert red > 0.003 and blue > 0.0005
     check_reference(img, "toolpath")
+
+
+def test_toolpath_figure_is_in_machine_millimetres(surface4):
+    """Placed at 20 mm per unit from (100, 0, -5), the surface and the moves share the machine's millimetres."""
+    from lagsym.machine import Placement
+
+    moves, rapid = raster(surface4)
+    moves_mm = moves * 20.0 + (100.0, 0.0, -5.0)
+    p = plot.toolpath_figure(surface4, moves_mm, rapid=rapid, placement=Placement(20.0, (100.0, 0.0, -5.0)),
+                             samples=9, window_size=SIZE, z_exaggeration=1)
+    x0, x1, y0, y1, z0, z1 = p.bounds
+    p.close()
+    # The control box is [1, 5] x [1, 5]; the highest point is the safe height 5 (surface units).
+    assert (x0, x1, y0, y1) == (120.0, 200.0, 20.0, 100.0)
+    zs = np.array(surface4.grid.points(), dtype=float)[:, 2]
+    assert z1 == 5.0 * 20 - 5 and z0 <= zs.min() * 20 - 5
 
 
 def test_deviation_map_writes_a_png(surface4, tmp_path):
     x, y, surfaces = comparison(surface4)
-    devs = {name: z - surfaces["Lagrange"] for name, z in surfaces.items() if name != "Lagrange"}
+    devs = {name: surfaces["Lagrange"] - z for name, z in surfaces.items() if name != "Lagrange"}
     out = plot.deviation_map(x, y, devs, tmp_path / "dev.png", window_size=WIDE)
     assert out == tmp_path / "dev.png"
     img = np.asarray(Image.open(out).convert("RGB"))
     check_picture(img, WIDE, 0.07)
     check_reference(img, "deviation")
+
+
+def _warmth(img: np.ndarray, box) -> float:
+    """Red minus blue over the saturated pixels of ``img[r0:r1, c0:c1]``: above 0 when the panel is mostly red."""
+    r0, r1, c0, c1 = box
+    px = img[r0:r1, c0:c1].reshape(-1, 3).astype(float)
+    px = px[px.max(axis=1) - px.min(axis=1) > 40]
+    return float((px[:, 0] - px[:, 2]).mean()) if len(px) else 0.0
+
+
+def test_one_sign_for_deviations(surface4):
+    """Both deviation pictures draw d = z_f - z_a: Hermite lies above the reference (blue), Bezier below (red)."""
+    x, y, surfaces = comparison(surface4)
+    order = {"Lagrange": surfaces["Lagrange"], "Hermite": surfaces["Hermite"], "Bezier": surfaces["Bezier"]}
+    w, h = 640, 400
+    both = render(plot.compare_figure(x, y, order, window_size=(w, h)))
+    panel = int(w / 3.55)
+    hermite, bezier = (h // 2, h, panel, 2 * panel), (h // 2, h, 2 * panel, 3 * panel)
+    assert _warmth(both, hermite) < -20 and _warmth(both, bezier) > 20
+    z_f = surfaces["Lagrange"]
+    alone = render(plot.deviation_figure(x, y, {"Hermite": z_f - surfaces["Hermite"], "Bezier": z_f - surfaces["Bezier"]},
+                                         reference="Lagrange", window_size=(w, 250)))
+    panel = int(w / 2.55)
+    assert _warmth(alone, (0, 250, 0, panel)) < -20 and _warmth(alone, (0, 250, panel, 2 * panel)) > 20
+
+
+def test_every_comparison_panel_has_axes(surface4):
+    x, y, surfaces = comparison(surface4)
+    p = plot.compare_figure(x, y, surfaces, window_size=WIDE)
+    n = len(surfaces)
+    bottom = [p.renderers[p.renderers.loc_to_index((1, col))] for col in range(n)]
+    for r in bottom:
+        axes = r.cube_axes_actor
+        assert axes is not None and axes.GetXAxisVisibility() and axes.GetYAxisVisibility()
+        assert axes.GetXTitle() == "x (mm)" and axes.GetYTitle() == "y (mm)"
+    p.close()
+    d = plot.deviation_figure(x, y, {"Bezier": surfaces["Lagrange"] - surfaces["Bezier"]}, window_size=WIDE)
+    assert d.renderers[0].cube_axes_actor.GetYTitle() == "y (mm)"
+    d.close()
+
+
+def test_z_exaggeration(tmp_path):
+    """Example 1 rises 30 mm over a 4 x 2 mm box: squeezed by default, the ticks still read the true heights."""
+    s1 = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
+    zs = [float(p[2]) for p in s1.grid.points()]
+    p = plot.surface_figure(s1, samples=9, window_size=SIZE)
+    assert p.scale[2] == pytest.approx(4.0 / (max(zs) - min(zs)))  # the drawn height equals the larger plan side
+    assert p.renderer.cube_axes_actor.GetZAxisRange() == pytest.approx((min(zs), max(zs)))
+    p.close()
+    p = plot.surface_figure(s1, samples=9, window_size=SIZE, z_exaggeration=1)
+    assert p.scale[2] == 1.0
+    p.close()
+    img = render(plot.surface_figure(s1, samples=21, window_size=SIZE))
+    check_picture(img, SIZE, 0.12)
+    check_reference(img, "surface_example1")
+    with pytest.raises(InputError, match="z exaggeration -2 must be a positive number"):
+        plot.surface_figure(s1, z_exaggeration=-2)
+
+
+def runge_brute_force(n: int, samples: int = 81) -> float:
+    """Largest |f - F| of the n x n Lagrange interpolant of 1/(1 + 4(x^2 + y^2)) on [-2, 2]^2, by the basis products."""
+    nodes = np.linspace(-2.0, 2.0, n)
+    t = np.linspace(-2.0, 2.0, samples)
+    basis = np.ones((samples, n))
+    for i in range(n):
+        for k in range(n):
+            if k != i:
+                basis[:, i] *= (t - nodes[k]) / (nodes[i] - nodes[k])
+    z = 1 / (1 + 4 * (nodes[:, None] ** 2 + nodes[None, :] ** 2))
+    f = 1 / (1 + 4 * (t[:, None] ** 2 + t[None, :] ** 2))
+    return float(np.abs(basis @ z @ basis.T - f).max())
+
+
+def test_growth_past_degree_6():
+    """Figure 11's numbers: the Lagrange deviation against the degree, checked by brute force."""
+    from lagsym.formula import parse_formula
+
+    g = plot.degree_growth(parse_formula("1/(1 + 4*(x**2 + y**2))"), (-2, 2, -2, 2), degrees=[2, 4, 6, 8, 10])
+    assert g.degrees == (2, 4, 6, 8, 10) and list(g.largest) == ["Lagrange", "B-spline"]
+    expected = [runge_brute_force(d + 1) for d in g.degrees]
+    assert g.largest["Lagrange"] == pytest.approx(expected, rel=1e-9)
+    lag = g.largest["Lagrange"]
+    assert lag[2] < lag[3] < lag[4] and lag[4] > 5 * lag[2]  # past degree 6 it grows greatly
+    img = render(plot.growth_figure(g, window_size=SIZE))
+    check_picture(img, SIZE, 0.03)
+    check_reference(img, "growth")
+
+
+def test_growth_refuses_a_runaway_degree():
+    from lagsym.formula import parse_formula
+
+    with pytest.raises(InputError, match="degree 40 is out of range: give degrees from 1 to 20"):
+        plot.degree_growth(parse_formula("x"), (0, 1, 0, 1), degrees=[2, 40])
 
 
 # ----------------------------------------------------------------------------- the checks themselves
@@ -365,9 +475,9 @@ def test_axes_must_increase(surface4):
 
 
 def test_moves_shape_and_rapid_mask(surface4):
-    with pytest.raises(InputError, match=r"moves should be an \(N, 3\) array"):
+    with pytest.raises(InputError, match=r"moves_mm should be an \(N, 3\) array"):
         plot.toolpath_figure(surface4, np.zeros((4, 2)))
-    with pytest.raises(InputError, match=r"moves\[1\] = \[1.0, nan, 0.0\] is not finite"):
+    with pytest.raises(InputError, match=r"moves_mm\[1\] = \[1.0, nan, 0.0\] is not finite"):
         plot.toolpath_figure(surface4, [[0, 0, 0], [1, np.nan, 0]])
     with pytest.raises(InputError, match=r"rapid should be a boolean array of shape \(2,\)"):
         plot.toolpath_figure(surface4, np.zeros((2, 3)), rapid=np.array([0, 1]))
@@ -397,6 +507,8 @@ def png_size(path: Path) -> tuple[int, int]:
     ("paper-curve-3rd.json", []),
     ("paper-curve-2nd.json", ["--show", "basis"]),
     ("paper-example-4.json", ["--show", "compare"]),
+    ("paper-example-4.json", ["--show", "growth", "x**2 * y"]),
+    ("paper-example-1.json", ["--z-exaggeration", "2"]),
 ])
 def test_cli_writes_pictures(run_cli, tmp_path, file, show):
     out = tmp_path / "fig.png"
@@ -445,9 +557,13 @@ def test_cli_units_reach_the_axes(run_cli, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--show", "toolpath"], "--show toolpath needs exactly one PROGRAM file"),
+    (["--show", "toolpath"], "--show toolpath needs exactly one PROGRAM"),
+    (["--show", "growth"], "--show growth needs exactly one FORMULA"),
+    (["--scale", "20", "-o", "x.png"], "--scale and --origin place a program on the machine"),
+    (["--show", "basis", "--z-exaggeration", "2", "-o", "x.png"], "--z-exaggeration applies to a surface"),
+    (["--z-exaggeration", "0", "-o", "x.png"], "z exaggeration 0.0 must be a positive number"),
     (["--show", "toolpath", "part.ngc", "-o", "x.png"], "part.ngc: no such file"),
-    (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath"),
+    (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath, growth"),
     (["--show", "basis", "extra"], "--show basis takes no file, but got 'extra'"),
     (["-o", "out.svg"], "cannot tell the image format from '.svg'"),
     (["--size", "10x10", "-o", "x.png"], "window size 10x10 is out of range"),

@@ -83,7 +83,7 @@ def add_arguments(p) -> None:
                    help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")
     p.add_argument("--format", choices=TABLE_FORMATS, default="text", help="table format (default text)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the table to FILE instead of standard output")
-    p.add_argument("--plot", metavar="FILE", help="also write a deviation colour map per method to FILE")
+    p.add_argument("--plot", metavar="FILE", help="also write a map of the deviation z_f - z_a per method to FILE (an image)")
 
 
 def _reference(text: str):
@@ -110,6 +110,8 @@ def run(args, out, err) -> int:
     if args.plot:
         from ..plot import deviation_map
 
-        deviation_map(comparison.xs, comparison.ys, comparison.deviations, args.plot)
+        # The maps draw the table's d = z_f - z_a, titled "Lagrange - Hermite" when z_f is the Lagrange surface.
+        name = "Lagrange" if reference == "lagrange" else "z_f"
+        deviation_map(comparison.xs, comparison.ys, comparison.deviations, args.plot, reference=name)
     emit(render_table(comparison, args.format), args.output, out)
     return 0

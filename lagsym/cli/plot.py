@@ -17,7 +17,12 @@ coloured by z, with the control points and the net joining them; or, with
 --show basis, every basis function L_i(x) L_k(y) as a grid of small pictures;
 with --show compare, the Lagrange, Hermite, Bezier and B-spline surfaces side
 by side with their deviation from the Lagrange surface (the paper's Figure 10);
-with --show toolpath PROGRAM, the moves of a G-code program over the surface.
+with --show toolpath PROGRAM, the moves of a G-code program over the surface,
+in machine millimetres (give the --scale and --origin it was made with); with
+--show growth FORMULA, the largest deviation of the Lagrange and cubic B-spline
+surfaces from FORMULA on n x n evenly spaced points over the box of FILE, for
+the degrees 2, 4, ..., 12 (the paper's Figure 11: past degree 6 it grows).
+Deviations are d = z_f - z_a everywhere, as lagsym compare prints them.
 A file of [x, y] points draws the curve through them (and, with --show basis,
 its basis polynomials L_i(x)).
 
@@ -30,10 +35,13 @@ examples:
   lagsym plot examples/paper-curve-3rd.json -o curve.png
   lagsym plot examples/paper-example-4.json --show compare -o compare.png
   lagsym plot examples/paper-example-1.json --size 800x600 --units in -o small.png
+  lagsym plot examples/paper-example-1.json --z-exaggeration 1 -o true-proportions.png
   lagsym toolpath examples/paper-example-4.json --scale 20 --stepover 2 --step 1 --safe-z 80 -o rough.nc
-  lagsym plot examples/paper-example-4.json --show toolpath rough.nc --scale 20 -o toolpath.png"""
+  lagsym plot examples/paper-example-4.json --show toolpath rough.nc --scale 20 -o toolpath.png
+  lagsym plot examples/parabola.json --show growth "1/(1 + ((x-20)**2 + (y-20)**2)/25)" -o growth.png"""
 
-SHOW = ("surface", "basis", "compare", "toolpath")
+SHOW = ("surface", "basis", "compare", "toolpath", "growth")
+TAKES_A_WORD = {"toolpath": "PROGRAM", "growth": "FORMULA"}
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -47,20 +55,24 @@ def add_arguments(p) -> None:
     # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
-                   help="surface (default), basis, compare, or 'toolpath PROGRAM'")
+                   help="surface (default), basis, compare, 'toolpath PROGRAM' or 'growth FORMULA'")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
     p.add_argument("--units", default="mm", help="length unit for the axis labels (default: mm)")
-    p.add_argument("--size", type=_size, default=(1024, 768), metavar="WxH",
-                   help="picture size in pixels (default: 1024x768)")
+    p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
+                   help="picture size in pixels (default: 1280x960)")
+    p.add_argument("--z-exaggeration", type=float, metavar="K",
+                   help="draw z K times its true size (surface, compare, toolpath; the ticks read true heights); "
+                        "default: chosen so the height lies between a fifth of the plan and the plan, 1 for true "
+                        "proportions")
     p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
-    p.add_argument("--scale", type=float, default=1.0,
+    p.add_argument("--scale", type=float, default=None,
                    help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
-    p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
+    p.add_argument("--origin", default=None, metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
 
 
 def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None, str]:
-    """What to draw, the program file for a toolpath, and the points file.
+    """What to draw, the word after it (a toolpath's program, a growth's formula), and the points file.
 
     ``--show`` takes one or more words, so it may have swallowed FILE when the
     user wrote ``--show basis FILE``; take it back from the end.
@@ -69,14 +81,15 @@ def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None,
     what = words.pop(0)
     if what not in SHOW:
         raise InputError(f"--show {what!r} is not one of: {', '.join(SHOW)}")
-    wanted = 1 if what == "toolpath" else 0
+    wanted = 1 if what in TAKES_A_WORD else 0
     if file is None and len(words) > wanted:
         file = words.pop()
     if file is None:
         raise InputError("no points FILE given: lagsym plot FILE [--show WHAT] [-o IMAGE]")
     if len(words) != wanted:
-        if what == "toolpath":
-            raise InputError("--show toolpath needs exactly one PROGRAM file: --show toolpath PROGRAM")
+        if what in TAKES_A_WORD:
+            word = TAKES_A_WORD[what]
+            raise InputError(f"--show {what} needs exactly one {word}: --show {what} {word}")
         raise InputError(f"--show {what} takes no file, but got {' '.join(words)!r}")
     return what, (words[0] if words else None), file
 
@@ -90,9 +103,12 @@ def run(args, out, err) -> int:
     elif plot.rendering_backend() != "display":
         raise InputError("no display to open a window on: give -o FILE to write the picture to a file")
     points = read_any_points(file)
+    _check_options(what, isinstance(points, CurvePoints), args)
     opts = dict(units=args.units, window_size=args.size, off_screen=True if args.output else None)
     if args.samples is not None:
         opts["samples"] = args.samples
+    if args.z_exaggeration is not None:
+        opts["z_exaggeration"] = args.z_exaggeration
     if isinstance(points, CurvePoints):
         curve = lagrange_curve(points)
         figure = plot.curve_basis_figure(curve, **opts) if what == "basis" else plot.curve_figure(curve, **opts)
@@ -100,6 +116,8 @@ def run(args, out, err) -> int:
         figure = _compare_figure(plot, points, args, opts)
     elif what == "toolpath":
         figure = _toolpath_figure(plot, points, program, args, opts)
+    elif what == "growth":
+        figure = _growth_figure(plot, points, program, opts)
     else:
         surface = lagrange_surface(points)
         figure = plot.basis_figure(surface, **opts) if what == "basis" else plot.surface_figure(surface, **opts)
@@ -108,6 +126,18 @@ def run(args, out, err) -> int:
     else:
         figure.show(title=f"lagsym plot {file}")
     return 0
+
+
+def _check_options(what: str, curve: bool, args) -> None:
+    """Refuse an option the picture asked for would not use."""
+    if curve and what not in ("surface", "basis"):
+        raise InputError(f"--show {what} needs a surface: a file of x, y, z points")
+    if what != "toolpath" and (args.scale is not None or args.origin is not None):
+        raise InputError("--scale and --origin place a program on the machine: they go with --show toolpath PROGRAM")
+    if what == "toolpath" and args.units != "mm":
+        raise InputError(f"--units {args.units}: a toolpath is drawn in the machine's millimetres")
+    if args.z_exaggeration is not None and (curve or what in ("basis", "growth")):
+        raise InputError("--z-exaggeration applies to a surface, --show compare and --show toolpath")
 
 
 def _compare_figure(plot, grid, args, opts):
@@ -119,6 +149,15 @@ def _compare_figure(plot, grid, args, opts):
     surfaces = {"Lagrange": c.z_reference}
     surfaces.update({m.name: m.z for m in c.methods if m.name != "Lagrange"})
     return plot.compare_figure(c.xs, c.ys, surfaces, control_points=_control_points(grid), **opts)
+
+
+def _growth_figure(plot, grid, formula, opts):
+    """The largest deviation from FORMULA against the degree, over the box of the points (the paper's Figure 11)."""
+    from ..formula import parse_formula
+
+    n = opts.pop("samples", None) or 81
+    growth = plot.degree_growth(parse_formula(formula), grid.bounds, samples=n)
+    return plot.growth_figure(growth, **{k: v for k, v in opts.items() if k != "z_exaggeration"})
 
 
 def _control_points(grid):
@@ -139,7 +178,7 @@ def _toolpath_figure(plot, grid, program, args, opts):
     points_mm, rapid = move_points(read_program(program), source=program)
     if not len(points_mm):
         raise InputError(f"{program}: no move with a Z position to draw")
-    place = Placement(args.scale, origin(args.origin))
-    tips = np.column_stack(place.to_surface(*points_mm.T))  # machine mm to surface units
     ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
-    return plot.toolpath_figure(lagrange_surface(grid), tips, rapid=ends_rapid, **opts)
+    opts = {k: v for k, v in opts.items() if k != "units"}  # checked in run: the machine's mm
+    return plot.toolpath_figure(lagrange_surface(grid), points_mm, rapid=ends_rapid,
+                                placement=Placement(1.0 if args.scale is None else args.scale, origin(args.origin or "0,0,0")), **opts)

@@ -25,6 +25,7 @@ The modules, one concern each:
   Xvfb) and the one factory of plotters;
 - :mod:`~lagsym.plot.surface`: a surface, a curve and their basis functions;
 - :mod:`~lagsym.plot.compare`: methods side by side, and deviation maps;
+- :mod:`~lagsym.plot.growth`: the deviation against the degree (Figure 11);
 - :mod:`~lagsym.plot.toolpath`: a cutter path over its surface;
 - :mod:`~lagsym.plot.output`: image formats and writing images;
 - :mod:`~lagsym.plot.style`, :mod:`~lagsym.plot.meshes` and
@@ -35,7 +36,8 @@ The modules, one concern each:
 from __future__ import annotations
 
 from .backend import DEFAULT_WINDOW_SIZE, rendering_backend
-from .compare import compare_figure, deviation_figure
+from .compare import DEVIATION_WINDOW_SIZE, compare_figure, deviation_figure
+from .growth import DegreeGrowth, degree_growth, growth_figure
 from .output import IMAGE_FORMATS, deviation_map, image_format, save_figure
 from .style import BASIS_CMAP, DEVIATION_CMAP, FEED_COLOR, NET_COLOR, POINT_COLOR, RAPID_COLOR, SURFACE_CMAP
 from .surface import basis_figure, curve_basis_figure, curve_figure, surface_figure
@@ -50,11 +52,15 @@ __all__ = [
     "deviation_figure",
     "deviation_map",
     "curve_basis_figure",
+    "growth_figure",
+    "degree_growth",
+    "DegreeGrowth",
     "save_figure",
     "image_format",
     "rendering_backend",
     "IMAGE_FORMATS",
     "DEFAULT_WINDOW_SIZE",
+    "DEVIATION_WINDOW_SIZE",
     "SURFACE_CMAP",
     "DEVIATION_CMAP",
     "BASIS_CMAP",

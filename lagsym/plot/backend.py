@@ -22,7 +22,7 @@ from .checks import check_window_size
 
 __all__ = ["DEFAULT_WINDOW_SIZE", "rendering_backend", "new_plotter"]
 
-DEFAULT_WINDOW_SIZE = (1024, 768)
+DEFAULT_WINDOW_SIZE = (1280, 960)  # sharp in the docs, and text still legible scaled to a notebook's width
 
 # A tiny scene rendered in a child process: a render window that cannot get an
 # OpenGL context may crash the process that asks, so never ask in this one.

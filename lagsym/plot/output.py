@@ -11,8 +11,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io import atomic_write
-from .backend import DEFAULT_WINDOW_SIZE
-from .compare import deviation_figure
+from .compare import DEVIATION_WINDOW_SIZE, deviation_figure
 
 __all__ = ["IMAGE_FORMATS", "image_format", "save_figure", "deviation_map"]
 
@@ -68,7 +67,9 @@ def save_figure(plotter, path: str | os.PathLike, *, close: bool = True) -> Path
     return path
 
 
-def deviation_map(x, y, deviations: Mapping[str, np.ndarray], path: str | os.PathLike, *, units: str = "mm",
-                  window_size: Sequence[int] = DEFAULT_WINDOW_SIZE) -> Path:
-    """Draw :func:`deviation_figure` offscreen and write it to ``path``; returns ``path``."""
-    return save_figure(deviation_figure(x, y, deviations, units=units, window_size=window_size, off_screen=True), path)
+def deviation_map(x, y, deviations: Mapping[str, np.ndarray], path: str | os.PathLike, *, reference: str = "z_f",
+                  units: str = "mm", window_size: Sequence[int] = DEVIATION_WINDOW_SIZE) -> Path:
+    """Draw :func:`deviation_figure` (``d = z_f - z_a``) offscreen and write it to ``path``; returns ``path``."""
+    figure = deviation_figure(x, y, deviations, reference=reference, units=units, window_size=window_size,
+                              off_screen=True)
+    return save_figure(figure, path)

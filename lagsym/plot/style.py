@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..values import positive
+
 __all__ = [
     "SURFACE_CMAP",
     "DEVIATION_CMAP",
@@ -15,10 +17,16 @@ __all__ = [
     "bar_args",
     "bar_column",
     "axis_labels",
+    "true_ranges",
     "view",
     "plan_view",
     "fit",
     "z_scale",
+    "z_factor",
+    "z_note",
+    "plan_axes",
+    "text_size",
+    "chart_text",
     "padded",
     "title_for",
 ]
@@ -38,7 +46,7 @@ BAR_COLUMN = 0.55  # width of the colour-bar column of a multi-panel figure, in 
 
 def bar_args(title: str, height_px: int, **extra) -> dict:
     """Arguments of ``add_scalar_bar`` for a bar beside a single panel ``height_px`` high."""
-    font = max(8, min(16, height_px // 40))
+    font = text_size(height_px, 1 / 40)
     args = dict(title=title, vertical=True, position_x=0.84, position_y=0.2, width=0.07, height=0.6,
                 title_font_size=font + 2, label_font_size=font, fmt="%.3g", color="black")
     args.update(extra)
@@ -52,10 +60,17 @@ def bar_column(p, row: int, col: int, mapper, title: str, height_px: int) -> Non
                                                position_y=0.08))
 
 
-def axis_labels(plotter, units: str, font_size: int = 10) -> None:
-    """A grid with x, y and z titled in ``units``."""
+def axis_labels(plotter, units: str, font_size: int = 10, **extra) -> None:
+    """A grid with x, y and z titled in ``units`` (``extra`` goes to ``show_grid``, e.g. ``axes_ranges``)."""
     plotter.show_grid(xtitle=f"x ({units})", ytitle=f"y ({units})", ztitle=f"z ({units})", color="black",
-                      font_size=font_size, fmt="%.3g")
+                      font_size=font_size, fmt="%.3g", **extra)
+
+
+def true_ranges(plotter) -> list[float]:
+    """The plotter's bounds with z divided by its z scale: the ticks of a stretched picture read true heights."""
+    x0, x1, y0, y1, z0, z1 = plotter.bounds
+    k = plotter.scale[2]
+    return [x0, x1, y0, y1, z0 / k, z1 / k]
 
 
 def view(plotter, zoom: float = 1.0) -> None:
@@ -89,17 +104,55 @@ def fit(text: str, width_px: float, largest: int = 14, smallest: int = 5) -> int
 
 
 def z_scale(x_span: float, y_span: float, z_span: float) -> float:
-    """Stretch z so a flat part still shows its shape: at least a fifth of the larger plan side.
+    """The automatic z exaggeration: the drawn height lies between a fifth of the larger plan side and that side.
+
+    A flat part is stretched so it still shows its shape; a tall, narrow one
+    (Example 1 rises 30 mm over a 4 x 2 mm box) is squeezed so it is not a
+    sliver with its ticks piled on one another.
 
     Examples
     --------
-    >>> z_scale(10.0, 5.0, 0.5), z_scale(10.0, 5.0, 4.0)
-    (4.0, 1.0)
+    >>> z_scale(10.0, 5.0, 0.5), z_scale(10.0, 5.0, 4.0), z_scale(4.0, 2.0, 30.0)
+    (4.0, 1.0, 0.13333333333333333)
     """
     plan = max(x_span, y_span)
-    if z_span <= 0 or z_span >= plan / 5:
+    if z_span <= 0 or plan <= 0:
         return 1.0
-    return plan / 5 / z_span
+    if z_span < plan / 5:
+        return plan / 5 / z_span
+    if z_span > plan:
+        return plan / z_span
+    return 1.0
+
+
+def z_factor(z_exaggeration, x_span: float, y_span: float, z_span: float) -> float:
+    """``z_exaggeration`` checked (a finite number > 0), or :func:`z_scale`'s choice when it is None."""
+    if z_exaggeration is None:
+        return z_scale(x_span, y_span, z_span)
+    return float(positive(z_exaggeration, "z exaggeration"))
+
+
+def z_note(factor: float) -> str:
+    """The line a figure carries when z is drawn stretched or squeezed ("" when it is not).
+
+    Examples
+    --------
+    >>> z_note(1.0), z_note(0.1333), z_note(4.0)
+    ('', 'z drawn x0.133', 'z drawn x4')
+    """
+    return "" if factor == 1.0 else f"z drawn x{factor:.3g}"
+
+
+def text_size(height_px: int, share: float = 1 / 32, smallest: int = 8) -> int:
+    """A font size readable at ``height_px``: text stays the same share of the picture at any size."""
+    return max(smallest, int(height_px * share))
+
+
+def plan_axes(plotter, units: str, font_size: int) -> None:
+    """x and y axes with ticks on a panel seen from above (no z axis: the panel is flat)."""
+    plotter.show_bounds(xtitle=f"x ({units})", ytitle=f"y ({units})", show_zaxis=False, show_zlabels=False,
+                        color="black", font_size=font_size, fmt="%.3g", n_xlabels=3, n_ylabels=3,
+                        location="front", bold=False)
 
 
 def padded(lo: float, hi: float, share: float = 0.06) -> list[float]:
@@ -116,3 +169,12 @@ def title_for(surface_or_curve) -> str:
         d = f"degree {n}" if n == m else f"degree {n} in x, {m} in y"
         return f"Lagrange surface z = F(x, y), {d} ({n + 1}x{m + 1} points)"
     return f"Lagrange curve y = F(x), degree {deg} ({deg + 1} points)"
+
+
+def chart_text(chart, height_px: int) -> None:
+    """Axis titles, ticks and legend of a 2-D chart at sizes legible at ``height_px``."""
+    for axis in (chart.x_axis, chart.y_axis):
+        axis.label_size = text_size(height_px, 1 / 40)
+        axis.tick_label_size = text_size(height_px, 1 / 44)
+    chart.legend.GetLabelProperties().SetFontSize(text_size(height_px, 1 / 44))
+    chart.GetTitleProperties().SetFontSize(text_size(height_px, 1 / 36))

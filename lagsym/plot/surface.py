@@ -27,11 +27,15 @@ from .style import (
     axis_labels,
     bar_args,
     bar_column,
+    chart_text,
     fit,
     padded,
+    text_size,
     title_for,
+    true_ranges,
     view,
-    z_scale,
+    z_factor,
+    z_note,
 )
 
 __all__ = ["surface_figure", "basis_figure", "curve_figure", "curve_basis_figure", "sampled_surface"]
@@ -46,7 +50,8 @@ def sampled_surface(surface, samples: int) -> tuple[np.ndarray, np.ndarray, np.n
 
 def surface_figure(surface, *, samples: int = 61, units: str = "mm", title: str | None = None,
                    cmap: str = SURFACE_CMAP, control_net: bool = True, scalar_bar: bool = True,
-                   window_size: Sequence[int] = DEFAULT_WINDOW_SIZE, off_screen: bool | None = None):
+                   z_exaggeration: float | None = None, window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
+                   off_screen: bool | None = None):
     """The shaded surface with its control points and control net (the paper's Figures 6-9).
 
     Parameters
@@ -65,6 +70,11 @@ def surface_figure(surface, *, samples: int = 61, units: str = "mm", title: str 
         Draw the control points and the net joining them.
     scalar_bar : bool
         Draw the colour bar for z.
+    z_exaggeration : float, optional
+        Draw z this many times its true size (the ticks still read true
+        heights).  Default: chosen so the drawn height lies between a fifth of
+        the larger plan side and that side (:func:`lagsym.plot.style.z_scale`);
+        the title says when z is not drawn true.  Give 1 for true proportions.
     window_size : (int, int)
         Image size in pixels.
     off_screen : bool, optional
@@ -83,11 +93,14 @@ def surface_figure(surface, *, samples: int = 61, units: str = "mm", title: str 
     if control_net:
         g = surface.grid
         _add_control(p, g.x_array, g.y_array, g.z_array)
-    p.set_scale(zscale=z_scale(np.ptp(xs), np.ptp(ys), float(np.ptp(zz))))
-    axis_labels(p, units, font_size=max(8, h // 60))
+    factor = z_factor(z_exaggeration, np.ptp(xs), np.ptp(ys), float(np.ptp(zz)))
+    p.set_scale(zscale=factor)
+    axis_labels(p, units, font_size=text_size(h, 1 / 45), axes_ranges=true_ranges(p))
     text = title if title is not None else title_for(surface)
-    p.add_text(text, position="upper_edge", font_size=fit(text, w, largest=12), color="black")
-    view(p, zoom=0.9)
+    if z_note(factor):
+        text = f"{text}\n{z_note(factor)}" if text else z_note(factor)
+    p.add_text(text, position="upper_edge", font_size=fit(text, w, largest=text_size(h, 1 / 48)), color="black")
+    view(p, zoom=0.85)
     return p
 
 
@@ -135,6 +148,7 @@ def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | N
     chart.x_range = padded(xs.min(), xs.max())
     chart.y_range = padded(min(ys.min(), py.min()), max(ys.max(), py.max()))
     chart.legend.visible = False
+    chart_text(chart, p.window_size[1])
     p.add_chart(chart)
     return p
 
@@ -176,6 +190,7 @@ def curve_basis_figure(curve, *, samples: int = 401, units: str = "mm",
     chart.scatter(nodes, np.zeros_like(nodes), color="black", size=6, style="o")
     chart.x_range = padded(xs.min(), xs.max())
     chart.y_range = padded(float(lx.min()), float(lx.max()))
+    chart_text(chart, p.window_size[1])
     p.add_chart(chart)
     return p
 
