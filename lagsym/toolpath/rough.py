@@ -236,7 +236,12 @@ def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
     rows = []
     for c in spaced(c0, c1, spec.stepover_mm):
         gap = max(b_c0 - c, c - b_c1, 0.0)
-        extra = [b_a0, b_a1]
+        # Where the disc under the tool starts to meet a box edge or corner, the height may bend down sharply.
+        extra = [b_a0, b_a1, b_a0 + radius, b_a1 - radius]
+        for edge_gap in (abs(c - b_c0), abs(c - b_c1)):
+            if edge_gap <= radius:
+                w = math.sqrt(radius * radius - edge_gap * edge_gap)
+                extra += [b_a0 + w, b_a1 - w]
         if gap <= radius:
             w = math.sqrt(radius * radius - gap * gap)
             extra += [b_a0 - w, b_a1 + w]
