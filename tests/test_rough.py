@@ -105,9 +105,6 @@ def program():
         return out.read_text(), err.getvalue()
 
 
-@pytest.mark.xfail(strict=True, reason="known defect: near the box's corners a straight move between two samples "
-                   "dips up to 0.04 mm into the stock to leave (the flat end's height bends down sharply where "
-                   "its disc meets a box edge); the sag allowance does not bound that yet")
 def test_roughing_example_4_is_gouge_free_and_clears_the_block(rs274, program):
     """No cut below surface + stock; everywhere the block is down to one step-down above what the tool reaches."""
     text, _ = program

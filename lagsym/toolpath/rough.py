@@ -42,12 +42,14 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import DIRECTIONS, TOOL_SHAPES, MachineSettings, Tool
 from ..values import choice, finite, positive
+from .chordal import check_moves, crosses_box_edge, lift
 from .dropcutter import drop_cutter
 from .pattern import levels as spaced
 
 __all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around"]
 
 MILLING = ("zigzag", "climb", "conventional")
+_SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
 FEED, RAPID, PLUNGE = 0, 1, 2
 """How the tool moves into a point: at the cutting feed, at rapid, or at the plunge feed."""
 
@@ -190,7 +192,8 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     _check_stock(stock, box, ev, place)
     rows = _rows(stock, box, tool.radius_mm, spec)
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
-    floors = _floors(surface, ev, place, tool, box, rows, spec)
+    rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev, place,
+                                   tool, box, spec, sigma)
     reachable = np.concatenate([f for f in floors])
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
@@ -199,7 +202,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     if spec.reach_mm is not None and depth > spec.reach_mm:
         raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
                             f"the tool reaches {spec.reach_mm:g} mm below its holder")
-    pts, kinds, floor = _assemble(rows, floors, z_levels, sigma, stock, spec)
+    pts, kinds, floor = _assemble(rows, floors, lifts, z_levels, stock, spec)
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
@@ -259,12 +262,13 @@ def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec) -> list[
     return floor_at(surface, ev, place, tool, box, xs, ys, spec.stock_to_leave_mm)
 
 
-def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float) -> list[np.ndarray]:
+def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **search) -> list[np.ndarray]:
     """``CL + stock`` (mm) at tool positions ``xs, ys`` (lists of mm arrays) anywhere on the machine.
 
     A position outside the box but within the tool radius of it takes the
     height at the nearest point of the box; farther out the tool touches
-    nothing (``-inf``).
+    nothing (``-inf``).  ``search`` goes to
+    :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``).
     """
     x, y = np.concatenate(xs), np.concatenate(ys)
     px, py = np.clip(x, box[0], box[1]), np.clip(y, box[2], box[3])
@@ -272,9 +276,49 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float) -> li
     out = np.full(x.size, -np.inf)
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
-        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, evaluator=ev)
+        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, evaluator=ev, **search)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
+
+
+def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float):
+    """Rows whose moves are checked against the true floor where the tool meets a box edge, and each sample's lift.
+
+    Away from the box edges the flat or ball end's height is semi-convex and
+    ``sigma`` bounds how far it rises above a move.  Where the disc under
+    the tool starts to meet an edge or a corner across the move, the height
+    can rise like a square root between two samples; there every move is
+    checked against dense drop-cutter samples
+    (:func:`~lagsym.toolpath.chordal.check_moves`), split where it dips more
+    than :data:`_SPLIT_TOL_MM` below the floor plus ``sigma``, and raised at
+    both ends by what is left.  A move with an end where the tool touches
+    nothing lies wholly in the air (the samples include where the tool
+    starts to touch the box), so it needs no check.  Returns the rows, their
+    floors and ``sigma`` plus the lift at every sample.
+    """
+    along_x = spec.direction == "x"
+
+    def cl(x, y, **search):
+        return floor_at(surface, ev, place, tool, box, [np.asarray(x, float)], [np.asarray(y, float)],
+                        spec.stock_to_leave_mm, **search)[0]
+
+    out_rows, out_floors, lifts = [], [], []
+    for r, f in zip(rows, floors):
+        cross = np.full(len(r.along), r.cross)
+        vx, vy = (r.along, cross) if along_x else (cross, r.along)
+        live = np.isfinite(f)
+        dense = crosses_box_edge(vx, vy, box, tool.radius_mm) & live[:-1] & live[1:]
+        vz = np.where(live, f, 0.0) + sigma
+        zeros = np.zeros(len(f) - 1)
+        vx, vy, vz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, zeros.copy(), dense,
+                                         _SPLIT_TOL_MM, tool.radius_mm)
+        along = vx if along_x else vy
+        floor = vz.copy()  # a point the check added has its floor there, without sigma
+        floor[np.isin(along, r.along)] = f
+        out_rows.append(_Row(r.cross, along))
+        out_floors.append(floor)
+        lifts.append(sigma + lift(sag))
+    return out_rows, out_floors, lifts
 
 
 def _climb_forward(direction: str, progress: int) -> bool:
@@ -293,7 +337,7 @@ def _kept(z: np.ndarray) -> np.ndarray:
     return np.flatnonzero(~flat)
 
 
-def _assemble(rows, floors, z_levels, sigma, stock: Stock, spec: RoughSpec):
+def _assemble(rows, floors, lifts, z_levels, stock: Stock, spec: RoughSpec):
     """The moves level by level: rows, links outside the block, and retracts above it for a one-way raster.
 
     Long because the three kinds of link (along a row end, down between
@@ -314,14 +358,14 @@ def _assemble(rows, floors, z_levels, sigma, stock: Stock, spec: RoughSpec):
         order = range(len(rows)) if k % 2 == 0 else range(len(rows) - 1, -1, -1)
         progress = 1 if k % 2 == 0 else -1
         for i in order:
-            r, f = rows[i], floors[i]
+            r, f, up = rows[i], floors[i], lifts[i]
             if spec.milling == "zigzag":
                 fwd = toggle % 2 == 0
                 toggle += 1
             else:
                 fwd = _climb_forward(spec.direction, progress) == (spec.milling == "climb")
-            a, ff = (r.along, f) if fwd else (r.along[::-1], f[::-1])
-            z = np.maximum(zl, ff + sigma)
+            a, ff, uu = (r.along, f, up) if fwd else (r.along[::-1], f[::-1], up[::-1])
+            z = np.maximum(zl, ff + uu)
             if not pts:
                 add(a[0], r.cross, top, RAPID)
                 add(a[0], r.cross, float(z[0]), PLUNGE)
