@@ -34,6 +34,9 @@ _EXPORTS = {
     "surfaces": ("make_surface", "bezier_surface", "bspline_surface", "hermite_surface"),
     "compare": ("Comparison", "DeviationMeasures", "compare_surfaces", "deviation_measures", "render_table"),
     "toolpath": ("Toolpath", "plan_toolpath", "drop_cutter", "raster_pattern", "scallop_stepover"),
+    "toolpath.rough": ("Stock", "RoughSpec", "RoughPath", "rough_toolpath", "stock_around"),
+    "job": ("JobSpec", "OperationSpec", "ToolSpec", "read_job", "Operation", "plan_job", "job_program",
+            "cycle_minutes"),
     "gcode": ("Moves", "parse_moves", "move_points"),
     "verify": ("CutReport", "simulate_cut"),
     "post.program": ("PointProgram", "point_program", "write_program"),
@@ -73,6 +76,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .export.cad import write_cad
     from .formula import Formula, parse_formula
     from .gcode import Moves, move_points, parse_moves
+    from .job import (JobSpec, Operation, OperationSpec, ToolSpec, cycle_minutes, job_program, plan_job,
+                      read_job)
     from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
     from .io import read_any_points, read_curve_points, read_points
     from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
@@ -82,4 +87,5 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .simulate import ControlAlarm, Simulation, simulate
     from .surfaces import bezier_surface, bspline_surface, hermite_surface, make_surface
     from .toolpath import Toolpath, drop_cutter, plan_toolpath, raster_pattern, scallop_stepover
+    from .toolpath.rough import RoughPath, RoughSpec, Stock, rough_toolpath, stock_around
     from .verify import CutReport, simulate_cut

@@ -62,6 +62,8 @@ COMMANDS = {
     "compare": "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)",
     "plot": "draw the surface, its basis functions or a curve (an image with -o, else a window)",
     "toolpath": "plan a raster toolpath over the exact surface and write it as G-code",
+    "rough": "rough a block down to the surface in z levels and write it as G-code",
+    "job": "write one program for a whole job file: roughing, finishing, tool changes, cycle time",
     "verify": "simulate a G-code program's cut on a height map and report gouge, scallop and area not reached",
     "macro": "write a macro program that evaluates the surface on the control (Fanuc, LinuxCNC, Heidenhain)",
     "simulate": "dry-run a macro program at the control's precision and write the moves it makes",

@@ -1,0 +1,43 @@
+"""``lagsym job JOB.toml``: one program for a whole job (roughing, finishing, tool changes) and its cycle time."""
+
+from __future__ import annotations
+
+from ..io import write_text
+
+NAME = "job"
+ORDER = 63
+HELP = "write one program for a whole job file: roughing, finishing, tool changes, cycle time"
+DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
+block, work offset, tools, operations) and write them as one point-list
+program, in order, with a tool change, spindle speed, feeds and coolant for
+each.  Every key of the job file is checked.  The cycle-time estimate of
+each operation and of the whole job is printed and written in the program's
+header.  See docs/roughing.md for the job file.
+
+examples:
+  lagsym job examples/example-4-job.toml -o part.ngc"""
+
+
+def add_arguments(p) -> None:
+    p.add_argument("job", help="job file (TOML)")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+
+
+def run(args, out, err) -> int:
+    from ..job import job_program, plan_job, read_job
+
+    planned = plan_job(read_job(args.job))
+    prog = job_program(planned)
+    if args.output and args.output != "-":
+        write_text(args.output, prog.text, newline="")
+    else:
+        out.write(prog.text)
+    report(planned, prog, err)
+    return 0
+
+
+def report(planned, prog, err) -> None:
+    """One line per operation (moves and minutes) and the total."""
+    for op, m in zip(planned.operations, prog.minutes):
+        err.write(f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min\n")
+    err.write(f"cycle time about {prog.total_minutes:.1f} min (rapids at {planned.spec.rapid_mm_min:g} mm/min)\n")

@@ -1,0 +1,110 @@
+"""``lagsym rough FILE``: z-level roughing from a block, written as a point-list program."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..io import write_text
+from ..machine import DIRECTIONS, UNITS
+from ._common import origin
+
+NAME = "rough"
+ORDER = 62
+HELP = "rough a block down to the surface in z levels and write it as G-code"
+DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
+points in FILE: at each level (the stock top down by the step-down) a
+raster whose height is never below the cutter's exact drop-cutter height
+plus the stock to leave.  Every level is entered from beside the block, so
+no cutter plunges into solid stock.
+
+examples:
+  lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-shape flat \\
+      --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc"""
+
+
+def add_arguments(p) -> None:
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+    p.add_argument("--dialect", choices=("fanuc", "linuxcnc", "grbl"), default="fanuc", help="fanuc (default), linuxcnc or grbl")
+    s = p.add_argument_group("stock")
+    top = s.add_mutually_exclusive_group(required=True)
+    top.add_argument("--stock-top", type=float, metavar="MM", help="machine Z of the block's top")
+    top.add_argument("--stock-above", type=float, metavar="MM", help="block top this far above the surface's highest point")
+    s.add_argument("--margin", type=float, metavar="MM", help="block beyond the control points' box on every side (default 0)")
+    s.add_argument("--block", metavar="X0,X1,Y0,Y1", help="the block's extent in machine mm instead of a margin")
+    r = p.add_argument_group("roughing")
+    r.add_argument("--stepdown", type=float, default=2.0, metavar="MM", help="depth of each level (default 2)")
+    r.add_argument("--stepover", type=float, metavar="MM", help="side step between rows (default half the tool)")
+    r.add_argument("--step", type=float, default=0.5, metavar="MM", help="forward sampling step (default 0.5)")
+    r.add_argument("--stock-to-leave", type=float, default=0.3, metavar="MM", help="material left above the surface (default 0.3)")
+    r.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
+    r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
+                   help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
+    t = p.add_argument_group("cutter")
+    t.add_argument("--tool-shape", default="flat", help="flat (default) or ball end")
+    t.add_argument("--tool-diameter", type=float, default=10.0, metavar="MM", help="cutter diameter (default 10)")
+    t.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool and length offset number (default 1)")
+    t.add_argument("--flute-length", type=float, metavar="MM", help="refuse a step-down longer than the flutes")
+    t.add_argument("--reach", type=float, metavar="MM", help="tool length below the holder: refuse a deeper cut")
+    m = p.add_argument_group("machine")
+    m.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
+    m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
+    m.add_argument("--feed", type=float, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
+    m.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
+    m.add_argument("--rapid", type=float, default=5000.0, metavar="MM/MIN", help="rapid rate for the cycle time (default 5000)")
+    m.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    m.add_argument("--coolant", choices=("off", "flood", "mist"), default="off", help="coolant (default off)")
+    m.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="retract height (default 50)")
+    m.add_argument("--program", type=int, default=1000, metavar="N", help="program number O N (default 1000)")
+
+
+def job_data(args) -> dict:
+    """The job file's data the options describe: one roughing operation."""
+    stock = {"top": args.stock_top} if args.stock_top is not None else {"top_above": args.stock_above}
+    if args.block is not None:
+        stock["block"] = list(origin_list(args.block))
+    if args.margin is not None:
+        stock["margin"] = args.margin
+    tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
+    for key in ("flute_length", "reach"):
+        if getattr(args, key) is not None:
+            tool[key] = getattr(args, key)
+    op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
+          "plunge_feed": args.plunge_feed, "coolant": args.coolant, "stepdown": args.stepdown, "step": args.step,
+          "stock_to_leave": args.stock_to_leave, "direction": args.direction, "milling": args.milling}
+    if args.stepover is not None:
+        op["stepover"] = args.stepover
+    return {"points": str(Path(args.file).resolve()), "dialect": args.dialect, "units": args.units,
+            "scale": args.scale, "origin": list(origin(args.origin)), "safe_z": args.safe_z, "rapid": args.rapid,
+            "program_number": args.program, "title": Path(args.file).name, "stock": stock,
+            "tools": {"cutter": tool}, "operations": [op]}
+
+
+def origin_list(text: str):
+    from ..errors import InputError
+
+    try:
+        v = [float(t) for t in text.split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 4:
+        raise InputError(f"--block {text!r} must be four numbers X0,X1,Y0,Y1 in mm")
+    return v
+
+
+def run(args, out, err) -> int:
+    from ..job import job_program, plan_job
+    from ..job.spec import parse_job
+    from .job import report
+
+    planned = plan_job(parse_job(job_data(args), "lagsym rough"))
+    prog = job_program(planned)
+    if args.output and args.output != "-":
+        write_text(args.output, prog.text, newline="")
+    else:
+        out.write(prog.text)
+    rp = planned.operations[0].path
+    err.write(f"{len(rp.levels_mm)} levels from Z{rp.levels_mm[0]:.3f} to Z{rp.levels_mm[-1]:.3f} mm\n")
+    report(planned, prog, err)
+    return 0

@@ -1,0 +1,134 @@
+"""Each operation of a job planned as moves: roughing from the block, then the finishing rasters.
+
+A finishing raster (semi-finish, finish, cross-finish) is
+:func:`~lagsym.toolpath.plan_toolpath`'s zig-zag; the tool comes down to it
+at rapid to just above the block and at the plunge feed from there.  A
+cross-finish runs across the finish (rows along y unless its direction is
+given).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import freeze_fields
+from ..errors import InputError, LagsymError, ToolpathError
+from ..evaluate import surface_evaluator
+from ..io import read_points
+from ..lagrange import lagrange_surface
+from ..machine import MachineSettings, RasterSpec
+from ..toolpath import plan_toolpath
+from ..toolpath.rough import FEED, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
+from .spec import JobSpec, OperationSpec, ToolSpec
+
+__all__ = ["Operation", "plan_job", "job_stock", "PlannedJob"]
+
+
+@dataclass(frozen=True)
+class Operation:
+    """One planned operation: what it is, its tool, and its moves (tip positions, machine mm).
+
+    ``kinds`` says how the tool moves into each point (FEED, RAPID or PLUNGE
+    of :mod:`lagsym.toolpath.rough`); ``path`` is the planner's own result
+    (a :class:`~lagsym.toolpath.rough.RoughPath` or a :class:`~lagsym.toolpath.Toolpath`).
+    """
+
+    spec: OperationSpec
+    tool: ToolSpec
+    points_mm: np.ndarray
+    kinds: np.ndarray
+    path: object
+
+    def __post_init__(self):
+        freeze_fields(self, ("points_mm", "kinds"))
+
+    @property
+    def label(self) -> str:
+        """``rough T1`` and so on."""
+        return f"{self.spec.kind} T{self.tool.number}"
+
+
+@dataclass(frozen=True)
+class PlannedJob:
+    """A job planned: its spec, the surface, the block and the operations in order."""
+
+    spec: JobSpec
+    surface: object
+    stock: Stock
+    operations: tuple
+
+
+def job_stock(spec: JobSpec, surface, evaluator=None) -> Stock:
+    """The block the job file describes, in machine mm."""
+    ev = evaluator or surface_evaluator(surface)
+    place = _settings(spec).placement
+    st = spec.stock
+    box = place.box_mm(ev.bounds)
+    if "top" in st:
+        top = float(st["top"])
+    else:
+        b = ev.bounds
+        u, v = np.meshgrid(np.linspace(b[0], b[1], 201), np.linspace(b[2], b[3], 201))
+        top = float(place.height_mm(ev.fast_points(u.ravel(), v.ravel())).max()) + float(st["top_above"])
+    if "block" in st:
+        x0, x1, y0, y1 = (float(v) for v in st["block"])
+        return Stock(x0, x1, y0, y1, top)
+    return stock_around(box, top, float(st.get("margin", 0.0)))
+
+
+def _settings(spec: JobSpec, op: OperationSpec | None = None, stock_mm: float = 0.0) -> MachineSettings:
+    kw = {} if op is None else dict(feed_mm_min=op.feed_mm_min, plunge_feed_mm_min=op.plunge_feed_mm_min,
+                                    spindle_rpm=op.spindle_rpm)
+    return MachineSettings(dialect=spec.dialect, mm_per_unit=spec.mm_per_unit, origin_mm=spec.origin_mm,
+                           units=spec.units, safe_z_mm=spec.safe_z_mm, stock_to_leave_mm=stock_mm,
+                           program_number=spec.program_number, work_offset=spec.work_offset, **kw)
+
+
+def plan_job(spec: JobSpec) -> PlannedJob:
+    """Read the points, build the block and plan every operation in order."""
+    surface = lagrange_surface(read_points(spec.points))
+    ev = surface_evaluator(surface)
+    stock = job_stock(spec, surface, ev)
+    if spec.safe_z_mm <= stock.top_mm:
+        raise InputError(f"{spec.source}: safe_z = {spec.safe_z_mm:g} mm is not above the stock top {stock.top_mm:g} mm")
+    ops = []
+    for i, op in enumerate(spec.operations):
+        try:
+            ops.append(_plan(spec, op, spec.tools[op.tool], surface, ev, stock, i))
+        except ToolpathError as e:
+            raise InputError(f"{spec.source}: operations[{i}] ({op.kind}): {e}") from None
+    return PlannedJob(spec, surface, stock, tuple(ops))
+
+
+def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, i: int) -> Operation:
+    o = op.options
+    if op.kind == "rough":
+        rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
+                       step_mm=o.get("step", 0.5), stock_to_leave_mm=o.get("stock_to_leave", 0.3),
+                       direction=o.get("direction", "x"), milling=o.get("milling", "zigzag"),
+                       flute_length_mm=tool.flute_length_mm, reach_mm=tool.reach_mm)
+        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev)
+        return Operation(op, tool, rp.points_mm, rp.kinds, rp)
+    default_dir = "y" if op.kind == "cross-finish" else "x"
+    stepover = o.get("stepover", None if "scallop" in o else 0.5)
+    step = o.get("step", None if "tolerance" in o else 0.2)
+    try:
+        raster = RasterSpec(o.get("direction", default_dir), stepover, step, o.get("scallop"), o.get("tolerance"))
+    except LagsymError as e:
+        raise ToolpathError(str(e)) from None
+    tp = plan_toolpath(surface, tool.tool, raster, _settings(spec, op, o.get("stock_to_leave", 0.0)), ev)
+    _check_reach(tool, stock, tp.points_mm[:, 2].min())
+    p = tp.points_mm
+    above = stock.top_mm + 2.0
+    pts = np.vstack([[p[0, 0], p[0, 1], above], p, [p[-1, 0], p[-1, 1], above]])
+    kinds = np.concatenate([[RAPID, PLUNGE], np.full(len(p) - 1, FEED), [RAPID]])
+    return Operation(op, tool, pts, kinds, tp)
+
+
+def _check_reach(tool: ToolSpec, stock: Stock, lowest_mm: float) -> None:
+    depth = stock.top_mm - float(lowest_mm)
+    if tool.reach_mm is not None and depth > tool.reach_mm:
+        raise ToolpathError(f"tool {tool.name} cannot reach: the cut goes {depth:.3f} mm below the stock top, "
+                            f"the tool reaches {tool.reach_mm:g} mm below its holder")

@@ -1,0 +1,242 @@
+"""The job file: TOML naming the points file, units, stock, work offset, tools and operations, every key checked.
+
+An unknown key, a missing one or a bad value is refused with the file, the
+key and (for a choice) the valid values.  Example::
+
+    points = "paper-example-4.json"     # relative to the job file
+    dialect = "linuxcnc"                 # fanuc, linuxcnc or grbl
+    scale = 20                           # mm per surface unit
+    safe_z = 80
+
+    [stock]
+    top_above = 2                        # mm above the surface's highest point (or: top = 73.6)
+
+    [tools.rougher]
+    number = 1
+    shape = "flat"
+    diameter = 10
+
+    [[operations]]
+    kind = "rough"
+    tool = "rougher"
+    stepdown = 2
+    stepover = 5
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError, LagsymError
+from ..io.files import read_bytes
+from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
+from ..toolpath.rough import MILLING
+
+__all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KINDS", "COOLANTS"]
+
+KINDS = ("rough", "semi-finish", "finish", "cross-finish")
+"""Operation kinds, in the order a machinist runs them."""
+COOLANTS = {"off": None, "flood": "M08", "mist": "M07"}
+JOB_DIALECTS = ("fanuc", "linuxcnc", "grbl")
+
+_TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": list, "work_offset": str,
+        "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
+        "operations": list}
+_STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
+_TOOL = {"number": int, "shape": str, "diameter": float, "flute_length": float, "reach": float}
+_OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
+       "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
+       "stock_to_leave": float, "direction": str, "milling": str}
+_REQUIRED_OP = ("kind", "tool")
+
+
+@dataclass(frozen=True)
+class ToolSpec:
+    """A tool of the job: its pocket and length-offset number, its cutter and (optionally) its flute length and reach."""
+
+    name: str
+    number: int
+    tool: Tool
+    flute_length_mm: float | None = None
+    reach_mm: float | None = None
+
+
+@dataclass(frozen=True)
+class OperationSpec:
+    """One operation: its kind, tool, spindle, feeds, coolant and the raster or roughing options given."""
+
+    kind: str
+    tool: str
+    spindle_rpm: float = 3000.0
+    feed_mm_min: float = 600.0
+    plunge_feed_mm_min: float = 200.0
+    coolant: str = "off"
+    options: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class JobSpec:
+    """A whole job as read from its file (lengths in mm)."""
+
+    source: str
+    points: Path
+    dialect: str
+    units: str
+    mm_per_unit: float
+    origin_mm: tuple[float, float, float]
+    work_offset: str
+    program_number: int
+    safe_z_mm: float
+    rapid_mm_min: float
+    title: str
+    stock: dict
+    tools: dict
+    operations: tuple
+
+
+def read_job(path) -> JobSpec:
+    """Read and check the job file at ``path``."""
+    raw = read_bytes(path, "a job file")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+        raise InputError(f"{path}: not a valid TOML job file: {e}") from None
+    return parse_job(data, str(path), Path(path).parent)
+
+
+def _keys(table: dict, allowed: dict, where: str, source: str) -> dict:
+    """The table's values checked against ``allowed`` (key -> type): unknown keys and wrong types refused."""
+    if not isinstance(table, dict):
+        raise InputError(f"{source}: {where} must be a table")
+    for key, value in table.items():
+        if key not in allowed:
+            raise InputError(f"{source}: unknown key {where}{key!r}; valid keys: {', '.join(allowed)}")
+        want = allowed[key]
+        ok = (isinstance(value, (int, float)) and not isinstance(value, bool)) if want is float else (
+            isinstance(value, want) and not (want is int and isinstance(value, bool)))
+        if not ok:
+            raise InputError(f"{source}: {where}{key} = {value!r} must be {_NAMES[want]}")
+    return table
+
+
+_NAMES = {float: "a number", int: "a whole number", str: "a string", list: "a list", dict: "a table"}
+
+
+def _choice(value, options, key: str, source: str):
+    if value not in options:
+        raise InputError(f"{source}: {key} = {value!r} is not one of {', '.join(options)}")
+    return value
+
+
+def _positive(value, key: str, source: str, allow_zero: bool = False) -> float:
+    v = float(value)
+    if not (v == v and abs(v) != float("inf")) or v < 0 or (v == 0 and not allow_zero):
+        raise InputError(f"{source}: {key} = {value!r} must be a number {'0 or more' if allow_zero else 'above 0'}")
+    return v
+
+
+def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobSpec:
+    """A :class:`JobSpec` from the parsed TOML ``data``; ``base`` is where a relative points path starts."""
+    _keys(data, _TOP, "", source)
+    for key in ("points", "tools", "operations", "stock"):
+        if key not in data:
+            raise InputError(f"{source}: missing key {key!r}")
+    origin = data.get("origin", [0.0, 0.0, 0.0])
+    if len(origin) != 3 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in origin):
+        raise InputError(f"{source}: origin = {origin!r} must be three numbers [X, Y, Z] in mm")
+    tools = {name: _tool(name, t, source) for name, t in data["tools"].items()}
+    numbers = [t.number for t in tools.values()]
+    if len(set(numbers)) != len(numbers):
+        raise InputError(f"{source}: two tools share a number ({sorted(numbers)})")
+    ops = tuple(_operation(i, op, tools, source) for i, op in enumerate(data["operations"]))
+    if not ops:
+        raise InputError(f"{source}: operations is empty")
+    ranks = [KINDS.index(op.kind) for op in ops]
+    for i in range(1, len(ops)):
+        if ranks[i] < ranks[i - 1]:
+            raise InputError(f"{source}: operations[{i}] ({ops[i].kind}) comes after {ops[i - 1].kind}; "
+                             f"run them in the order {', '.join(KINDS)}")
+    program_number = data.get("program_number", 1000)
+    if not 1 <= program_number <= 9999:
+        raise InputError(f"{source}: program_number = {program_number} must be 1 to 9999")
+    return JobSpec(
+        source=source, points=base / data["points"],
+        dialect=_choice(data.get("dialect", "fanuc"), JOB_DIALECTS, "dialect", source),
+        units=_choice(data.get("units", "mm"), UNITS, "units", source),
+        mm_per_unit=_positive(data.get("scale", 1.0), "scale", source),
+        origin_mm=tuple(float(v) for v in origin),
+        work_offset=_choice(data.get("work_offset", "G54"), ("G54", "G55", "G56", "G57", "G58", "G59"),
+                            "work_offset", source),
+        program_number=program_number,
+        safe_z_mm=float(data.get("safe_z", 50.0)),
+        rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
+        title=data.get("title", Path(data["points"]).stem),
+        stock=_stock(data["stock"], source), tools=tools, operations=ops)
+
+
+def _stock(table: dict, source: str) -> dict:
+    _keys(table, _STOCK, "stock.", source)
+    if ("top" in table) == ("top_above" in table):
+        raise InputError(f"{source}: stock needs exactly one of top (mm) or top_above (mm above the surface)")
+    if "block" in table and "margin" in table:
+        raise InputError(f"{source}: stock takes block = [x0, x1, y0, y1] or margin, not both")
+    if "block" in table:
+        b = table["block"]
+        if len(b) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in b):
+            raise InputError(f"{source}: stock.block = {b!r} must be four numbers [x0, x1, y0, y1] in mm")
+    if "margin" in table:
+        _positive(table["margin"], "stock.margin", source, allow_zero=True)
+    if "top_above" in table:
+        _positive(table["top_above"], "stock.top_above", source, allow_zero=True)
+    return dict(table)
+
+
+def _tool(name: str, table: dict, source: str) -> ToolSpec:
+    where = f"tools.{name}."
+    _keys(table, _TOOL, where, source)
+    for key in ("number", "shape", "diameter"):
+        if key not in table:
+            raise InputError(f"{source}: missing key {where}{key}")
+    if not 1 <= table["number"] <= 99:
+        raise InputError(f"{source}: {where}number = {table['number']} must be 1 to 99")
+    shape = _choice(table["shape"], TOOL_SHAPES, where + "shape", source)
+    try:
+        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source))
+    except LagsymError as e:
+        raise InputError(f"{source}: {where}: {e}") from None
+    opt = {k: _positive(table[k], where + k, source) for k in ("flute_length", "reach") if k in table}
+    return ToolSpec(name, table["number"], tool, opt.get("flute_length"), opt.get("reach"))
+
+
+def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
+    where = f"operations[{i}]."
+    _keys(table, _OP, where, source)
+    for key in _REQUIRED_OP:
+        if key not in table:
+            raise InputError(f"{source}: missing key {where}{key}")
+    kind = _choice(table["kind"], KINDS, where + "kind", source)
+    _choice(table["tool"], tuple(tools), where + "tool", source)
+    allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling"} if kind == "rough" else \
+        {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction"}
+    opts = {}
+    for key, value in table.items():
+        if key in ("kind", "tool", "spindle", "feed", "plunge_feed", "coolant"):
+            continue
+        if key not in allowed:
+            raise InputError(f"{source}: {where}{key} does not apply to a {kind} operation; "
+                             f"its options: {', '.join(sorted(allowed))}")
+        if key == "direction":
+            opts[key] = _choice(value, DIRECTIONS, where + key, source)
+        elif key == "milling":
+            opts[key] = _choice(value, MILLING, where + key, source)
+        else:
+            opts[key] = _positive(value, where + key, source, allow_zero=key == "stock_to_leave")
+    return OperationSpec(
+        kind=kind, tool=table["tool"],
+        spindle_rpm=_positive(table.get("spindle", 3000.0), where + "spindle", source),
+        feed_mm_min=_positive(table.get("feed", 600.0), where + "feed", source),
+        plunge_feed_mm_min=_positive(table.get("plunge_feed", 200.0), where + "plunge_feed", source),
+        coolant=_choice(table.get("coolant", "off"), tuple(COOLANTS), where + "coolant", source),
+        options=opts)

@@ -1,0 +1,386 @@
+"""Z-level roughing from a rectangular block: gouge-free by construction, every level entered from the air.
+
+At each level ``z_k`` (the block's top down by the step-down, the last one no
+lower than the lowest cutter location) the tool runs a raster over the block,
+its tip at
+
+    max(z_k, CL(x, y) + stock + sag)
+
+where ``CL`` is the exact drop-cutter height of that cutter
+(:func:`~lagsym.toolpath.dropcutter.drop_cutter`), ``stock`` the material left
+for finishing and ``sag`` the most a straight move between two samples may
+dip below a path that bends no more than the surface does (twice the sampled
+curvature bound, ``2 kappa h**2 / 8``).  So no move goes below ``CL + stock``,
+and after a level the block is cut down to ``z_k`` wherever the tool fits
+that low: the material left is at most one step-down above what the cutter
+can reach, plus the stock.
+
+Beyond the control points' box there is no part.  A tool centred outside the
+box but within its radius of it is given the height at the nearest point of
+the box, which is never lower than the true one (the disc under the tool,
+cut to the box, lies inside the disc about that nearest point), and the
+samples include the box edges and the points where the tool stops touching
+the box, so no move spans a corner of that rule.
+
+Every row starts and ends outside the block by the tool radius plus a
+clearance, so the tool goes down to each level in the air beside the block
+(a flat end that does not cut at its centre is never plunged into solid
+stock) and feeds into the material from the side.  Links that stay outside
+the block stay down; a one-way (climb or conventional) raster goes back over
+the block above its top, the only way back that is clear of uncut material.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import freeze_fields
+from ..errors import ToolpathError
+from ..evaluate import SurfaceEvaluator, surface_evaluator
+from ..machine import DIRECTIONS, TOOL_SHAPES, MachineSettings, Tool
+from ..values import choice, finite, positive
+from .chordal import check_moves, crosses_box_edge, lift
+from .dropcutter import drop_cutter
+from .pattern import levels as spaced
+
+__all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around"]
+
+MILLING = ("zigzag", "climb", "conventional")
+_SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
+FEED, RAPID, PLUNGE = 0, 1, 2
+"""How the tool moves into a point: at the cutting feed, at rapid, or at the plunge feed."""
+
+
+@dataclass(frozen=True)
+class Stock:
+    """A rectangular block on the machine: ``x0..x1``, ``y0..y1`` and its top ``top_mm``, all machine mm."""
+
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+    top_mm: float
+
+    def __post_init__(self):
+        for name in ("x0", "x1", "y0", "y1", "top_mm"):
+            object.__setattr__(self, name, finite(getattr(self, name), f"stock {name}"))
+        if not (self.x0 < self.x1 and self.y0 < self.y1):
+            raise ToolpathError(f"stock block x {self.x0:g}..{self.x1:g}, y {self.y0:g}..{self.y1:g} is empty")
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        """``(x0, x1, y0, y1)``."""
+        return (self.x0, self.x1, self.y0, self.y1)
+
+
+def stock_around(box_mm, top_mm: float, margin_mm: float = 0.0) -> Stock:
+    """The block over the box ``(x0, x1, y0, y1)`` (mm) grown by ``margin_mm`` on every side."""
+    m = positive(margin_mm, "stock margin", allow_zero=True)
+    x0, x1, y0, y1 = box_mm
+    return Stock(x0 - m, x1 + m, y0 - m, y1 + m, top_mm)
+
+
+@dataclass(frozen=True)
+class RoughSpec:
+    """How to rough: step-down, side step, forward step, stock to leave and the cutting direction (all mm).
+
+    ``milling`` is ``zigzag`` (both directions, the tool stays down),
+    ``climb`` or ``conventional`` (one way, for a spindle turning clockwise,
+    M03).  ``flute_length_mm`` and ``reach_mm`` (length below the holder),
+    when given, are checked against the step-down and the depth of the cut.
+    """
+
+    stepdown_mm: float = 2.0
+    stepover_mm: float = 5.0
+    step_mm: float = 0.5
+    stock_to_leave_mm: float = 0.3
+    direction: str = "x"
+    milling: str = "zigzag"
+    clearance_mm: float = 2.0
+    flute_length_mm: float | None = None
+    reach_mm: float | None = None
+
+    def __post_init__(self):
+        for name in ("stepdown_mm", "stepover_mm", "step_mm", "clearance_mm"):
+            positive(getattr(self, name), name[:-3].replace("_", "-"))
+        positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
+        choice(self.direction, DIRECTIONS, "raster direction")
+        choice(self.milling, MILLING, "milling")
+        for name in ("flute_length_mm", "reach_mm"):
+            if getattr(self, name) is not None:
+                positive(getattr(self, name), name[:-3].replace("_", " "))
+        if self.flute_length_mm is not None and self.stepdown_mm > self.flute_length_mm:
+            raise ToolpathError(f"step-down {self.stepdown_mm:g} mm is larger than the flute length "
+                                f"{self.flute_length_mm:g} mm")
+
+
+@dataclass(frozen=True)
+class RoughPath:
+    """A roughing path: tip positions in machine mm, how the tool moves into each, and the floor under each.
+
+    Attributes
+    ----------
+    points_mm : ndarray, shape (N, 3)
+        Tip positions, work offset included; read-only.
+    kinds : ndarray, shape (N,)
+        :data:`FEED`, :data:`RAPID` or :data:`PLUNGE` for the move into each point.
+    floor_mm : ndarray, shape (N,)
+        The drop-cutter height plus the stock to leave at each point
+        (``-inf`` where the tool is clear of the part); ``points_mm[:, 2]``
+        is never below it.
+    levels_mm : ndarray
+        The Z levels, from the top down.
+    tool : Tool
+    stock : Stock
+    spec : RoughSpec
+    """
+
+    points_mm: np.ndarray
+    kinds: np.ndarray
+    floor_mm: np.ndarray
+    levels_mm: np.ndarray
+    tool: Tool
+    stock: Stock
+    spec: RoughSpec
+
+    def __post_init__(self):
+        freeze_fields(self, ("points_mm", "kinds", "floor_mm", "levels_mm"))
+
+    def __len__(self) -> int:
+        return len(self.points_mm)
+
+
+def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings,
+                   evaluator: SurfaceEvaluator | None = None) -> RoughPath:
+    """Plan z-level roughing of ``stock`` down to the surface plus the stock to leave.
+
+    Parameters
+    ----------
+    surface : LagrangeSurface
+    tool : Tool
+        Flat, ball (or any shape drop-cutter knows) end mill.
+    stock : Stock
+        The block, in machine mm; it must cover the control points' box.
+    spec : RoughSpec
+    settings : MachineSettings
+        Scale and work offset (its stock to leave is not used: ``spec`` has the roughing one).
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 4, 1), (4, 0, 1), (4, 4, 1)]))
+    >>> rp = rough_toolpath(s, Tool("flat", 2.0), Stock(0, 4, 0, 4, 4.0), RoughSpec(1.5, 1.5, 1.0, 0.5),
+    ...                     MachineSettings())
+    >>> [round(float(z), 6) for z in rp.levels_mm]
+    [2.5, 1.5]
+    >>> bool((rp.points_mm[:, 2] >= rp.floor_mm).all()), round(float(rp.points_mm[:, 2].min()), 6)
+    (True, 1.5)
+    """
+    choice(tool.shape, TOOL_SHAPES, "tool shape")
+    if tool.diameter_mm <= 0:
+        raise ToolpathError("roughing needs a cutter with a diameter above 0")
+    if spec.stepover_mm > tool.diameter_mm:
+        raise ToolpathError(f"side step {spec.stepover_mm:g} mm is wider than the tool ({tool.diameter_mm:g} mm): "
+                            "ridges would stand between the rows")
+    ev = evaluator or surface_evaluator(surface)
+    place = settings.placement
+    box = place.box_mm(ev.bounds)
+    _check_stock(stock, box, ev, place)
+    rows = _rows(stock, box, tool.radius_mm, spec)
+    sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
+    rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev, place,
+                                   tool, box, spec, sigma)
+    reachable = np.concatenate([f for f in floors])
+    low = float(reachable[np.isfinite(reachable)].min()) + sigma
+    count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
+    z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
+    depth = stock.top_mm - float(z_levels[-1])
+    if spec.reach_mm is not None and depth > spec.reach_mm:
+        raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
+                            f"the tool reaches {spec.reach_mm:g} mm below its holder")
+    pts, kinds, floor = _assemble(rows, floors, lifts, z_levels, stock, spec)
+    return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def _check_stock(stock: Stock, box, ev: SurfaceEvaluator, place) -> None:
+    """The block must cover the box and stand above the highest point of the surface."""
+    x0, x1, y0, y1 = box
+    tol = 1e-9 * max(x1 - x0, y1 - y0)
+    if stock.x0 > x0 + tol or stock.x1 < x1 - tol or stock.y0 > y0 + tol or stock.y1 < y1 - tol:
+        raise ToolpathError(f"stock block x {stock.x0:g}..{stock.x1:g}, y {stock.y0:g}..{stock.y1:g} mm does not "
+                            f"cover the surface's box x {x0:g}..{x1:g}, y {y0:g}..{y1:g} mm")
+    b = ev.bounds
+    u, v = np.meshgrid(np.linspace(b[0], b[1], 101), np.linspace(b[2], b[3], 101))
+    top = float(place.height_mm(ev.fast_points(u.ravel(), v.ravel())).max())
+    if stock.top_mm < top:
+        raise ToolpathError(f"stock top {stock.top_mm:g} mm is below the surface's highest point {top:.3f} mm")
+
+
+@dataclass(frozen=True)
+class _Row:
+    """One raster row: its cross coordinate and its along positions (mm, increasing), outside the block at both ends."""
+
+    cross: float
+    along: np.ndarray
+
+
+def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
+    """The rows over the block, each sampled at the forward step plus the corners of the nearest-point rule."""
+    along_x = spec.direction == "x"
+    c0, c1 = (stock.y0, stock.y1) if along_x else (stock.x0, stock.x1)
+    a0, a1 = (stock.x0, stock.x1) if along_x else (stock.y0, stock.y1)
+    b_a0, b_a1, b_c0, b_c1 = (box[0], box[1], box[2], box[3]) if along_x else (box[2], box[3], box[0], box[1])
+    out = spec.clearance_mm + radius
+    base = spaced(a0 - out, a1 + out, spec.step_mm)
+    rows = []
+    for c in spaced(c0, c1, spec.stepover_mm):
+        gap = max(b_c0 - c, c - b_c1, 0.0)
+        # Where the disc under the tool starts to meet a box edge or corner, the height may bend down sharply.
+        extra = [b_a0, b_a1, b_a0 + radius, b_a1 - radius]
+        for edge_gap in (abs(c - b_c0), abs(c - b_c1)):
+            if edge_gap <= radius:
+                w = math.sqrt(radius * radius - edge_gap * edge_gap)
+                extra += [b_a0 + w, b_a1 - w]
+        if gap <= radius:
+            w = math.sqrt(radius * radius - gap * gap)
+            extra += [b_a0 - w, b_a1 + w]
+        rows.append(_Row(float(c), np.unique(np.concatenate([base, extra]))))
+    return rows
+
+
+def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec) -> list[np.ndarray]:
+    """``CL + stock`` (mm) at every sample of every row, ``-inf`` where the tool does not touch the box."""
+    along_x = spec.direction == "x"
+    xs, ys = [], []
+    for r in rows:
+        xs.append(r.along if along_x else np.full(len(r.along), r.cross))
+        ys.append(np.full(len(r.along), r.cross) if along_x else r.along)
+    return floor_at(surface, ev, place, tool, box, xs, ys, spec.stock_to_leave_mm)
+
+
+def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **search) -> list[np.ndarray]:
+    """``CL + stock`` (mm) at tool positions ``xs, ys`` (lists of mm arrays) anywhere on the machine.
+
+    A position outside the box but within the tool radius of it takes the
+    height at the nearest point of the box; farther out the tool touches
+    nothing (``-inf``).  ``search`` goes to
+    :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``).
+    """
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    px, py = np.clip(x, box[0], box[1]), np.clip(y, box[2], box[3])
+    touch = np.hypot(x - px, y - py) <= tool.radius_mm * (1 + 1e-12)
+    out = np.full(x.size, -np.inf)
+    if touch.any():
+        u, v = place.to_surface(px[touch], py[touch])
+        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, evaluator=ev, **search)
+        out[touch] = place.height_mm(z) + stock_mm
+    return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
+
+
+def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float):
+    """Rows whose moves are checked against the true floor where the tool meets a box edge, and each sample's lift.
+
+    Away from the box edges the flat or ball end's height is semi-convex and
+    ``sigma`` bounds how far it rises above a move.  Where the disc under
+    the tool starts to meet an edge or a corner across the move, the height
+    can rise like a square root between two samples; there every move is
+    checked against dense drop-cutter samples
+    (:func:`~lagsym.toolpath.chordal.check_moves`), split where it dips more
+    than :data:`_SPLIT_TOL_MM` below the floor plus ``sigma``, and raised at
+    both ends by what is left.  A move with an end where the tool touches
+    nothing lies wholly in the air (the samples include where the tool
+    starts to touch the box), so it needs no check.  Returns the rows, their
+    floors and ``sigma`` plus the lift at every sample.
+    """
+    along_x = spec.direction == "x"
+
+    def cl(x, y, **search):
+        return floor_at(surface, ev, place, tool, box, [np.asarray(x, float)], [np.asarray(y, float)],
+                        spec.stock_to_leave_mm, **search)[0]
+
+    out_rows, out_floors, lifts = [], [], []
+    for r, f in zip(rows, floors):
+        cross = np.full(len(r.along), r.cross)
+        vx, vy = (r.along, cross) if along_x else (cross, r.along)
+        live = np.isfinite(f)
+        dense = crosses_box_edge(vx, vy, box, tool.radius_mm) & live[:-1] & live[1:]
+        vz = np.where(live, f, 0.0) + sigma
+        zeros = np.zeros(len(f) - 1)
+        vx, vy, vz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, zeros.copy(), dense,
+                                         _SPLIT_TOL_MM, tool.radius_mm)
+        along = vx if along_x else vy
+        floor = vz.copy()  # a point the check added has its floor there, without sigma
+        floor[np.isin(along, r.along)] = f
+        out_rows.append(_Row(r.cross, along))
+        out_floors.append(floor)
+        lifts.append(sigma + lift(sag))
+    return out_rows, out_floors, lifts
+
+
+def _climb_forward(direction: str, progress: int) -> bool:
+    """Whether a row cut forwards (along increasing coordinates) is climb milling, rows advancing by ``progress``.
+
+    With the spindle turning clockwise, climb milling keeps the uncut
+    material on the right of the direction of travel.
+    """
+    return progress < 0 if direction == "x" else progress > 0
+
+
+def _kept(z: np.ndarray) -> np.ndarray:
+    """Indices of a row's samples to emit: the middle of three samples at one height is on a straight move."""
+    flat = np.zeros(len(z), dtype=bool)
+    flat[1:-1] = (z[1:-1] == z[:-2]) & (z[1:-1] == z[2:])
+    return np.flatnonzero(~flat)
+
+
+def _assemble(rows, floors, lifts, z_levels, stock: Stock, spec: RoughSpec):
+    """The moves level by level: rows, links outside the block, and retracts above it for a one-way raster.
+
+    Long because the three kinds of link (along a row end, down between
+    levels, back above the block) are decided here together with the row
+    directions they depend on.
+    """
+    along_x = spec.direction == "x"
+    top = stock.top_mm + spec.clearance_mm
+    pts, kinds, floor = [], [], []
+
+    def add(a, c, z, kind, f=-np.inf):
+        pts.append((a, c, z) if along_x else (c, a, z))
+        kinds.append(kind)
+        floor.append(f)
+
+    toggle = 0
+    for k, zl in enumerate(z_levels):
+        order = range(len(rows)) if k % 2 == 0 else range(len(rows) - 1, -1, -1)
+        progress = 1 if k % 2 == 0 else -1
+        for i in order:
+            r, f, up = rows[i], floors[i], lifts[i]
+            if spec.milling == "zigzag":
+                fwd = toggle % 2 == 0
+                toggle += 1
+            else:
+                fwd = _climb_forward(spec.direction, progress) == (spec.milling == "climb")
+            a, ff, uu = (r.along, f, up) if fwd else (r.along[::-1], f[::-1], up[::-1])
+            z = np.maximum(zl, ff + uu)
+            if not pts:
+                add(a[0], r.cross, top, RAPID)
+                add(a[0], r.cross, float(z[0]), PLUNGE)
+            elif spec.milling == "zigzag":
+                # The row ends lie outside the block by the tool radius and the clearance: clear at any height.
+                add(a[0], r.cross, float(z[0]), PLUNGE if pts[-1][2] > z[0] else FEED)
+            else:
+                last = pts[-1]
+                add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
+                add(a[0], r.cross, top, RAPID)
+                if zl + spec.clearance_mm < top:
+                    add(a[0], r.cross, zl + spec.clearance_mm, RAPID)
+                add(a[0], r.cross, float(z[0]), PLUNGE)
+            for j in _kept(z)[1:]:
+                add(float(a[j]), r.cross, float(z[j]), FEED, float(ff[j]))
+    last = pts[-1]
+    add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
+    return pts, kinds, floor
