@@ -78,6 +78,59 @@ class Moves:
         return self.points_mm[~self.rapid]
 
 
+def _blocks(text: str):
+    """``(line number, raw line, block)`` for each block a control reads: up to the closing ``%``."""
+    percent = 0
+    for no, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if not s:
+            continue
+        if s.startswith("%"):
+            percent += 1
+            if percent == 2:
+                return  # the end of the program: anything after is not read by a control
+            continue
+        yield no, raw, s[1:] if s.startswith("/") else s  # block delete off: the block runs
+
+
+class _Modal:
+    """The modal state a point list sets: units, absolute or incremental, motion, feed."""
+
+    def __init__(self):
+        self.factor = 1.0  # mm per program unit
+        self.absolute = True
+        self.motion = None
+        self.feed = float("nan")
+
+    def read(self, words, where: str) -> dict[str, float]:
+        """Apply a block's modal words; its X, Y, Z targets (program units)."""
+        target = {}
+        for letter, value in words:
+            v = float(value)
+            if letter == "G":
+                self._g(round(v, 1), value, where)
+            elif letter in "XYZ":
+                if letter in target:
+                    raise ProgramError(f"{where}: {letter} given twice")
+                target[letter] = v
+            elif letter == "F":
+                self.feed = v
+            elif letter != "O" and letter not in _IGNORED_LETTERS:
+                raise ProgramError(f"{where}: word {letter}{value} is not part of a point-list program")
+        return target
+
+    def _g(self, g: float, value: str, where: str) -> None:
+        if g in (0, 1):
+            self.motion = int(g)
+        elif g in (20, 21):
+            self.factor = 25.4 if g == 20 else 1.0
+        elif g in (90, 91):
+            self.absolute = g == 90
+        elif g not in _IGNORED_G:
+            raise ProgramError(f"{where}: G{value} is not a straight move; "
+                               "only point-list programs (G00/G01) can be read")
+
+
 def parse_moves(text: str, source: str = "<program>") -> Moves:
     """Read the straight moves of a point-list program.
 
@@ -96,75 +149,27 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     """
     pos = [0.0, 0.0, 0.0]
     start = tuple(pos)
-    factor = 1.0  # mm per program unit
-    absolute = True
-    motion = None
-    feed = float("nan")
+    modal = _Modal()
     pts, rapid, feeds, lines, zk = [], [], [], [], []
     z_seen = False
-    percent = 0
-    for no, raw in enumerate(text.splitlines(), start=1):
-        s = raw.strip()
-        if not s:
-            continue
-        if s.startswith("%"):
-            percent += 1
-            if percent == 2:
-                break  # the end of the program: anything after is not read by a control
-            continue
-        if s.startswith("/"):
-            s = s[1:]  # block delete off: the block runs
+    for no, raw, block in _blocks(text):
         try:
-            words = numeric_words(s)
+            words = numeric_words(block)
         except WordError as e:
             raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
-        target = {}
-        new_motion = None
-        for letter, value in words:
-            v = float(value)
-            if letter == "G":
-                g = round(v, 1)
-                if g in (0, 1):
-                    new_motion = int(g)
-                elif g == 20:
-                    factor = 25.4
-                elif g == 21:
-                    factor = 1.0
-                elif g == 90:
-                    absolute = True
-                elif g == 91:
-                    absolute = False
-                elif g in _IGNORED_G:
-                    pass
-                else:
-                    raise ProgramError(f"{source}, line {no}: G{value} is not a straight move; "
-                                       "only point-list programs (G00/G01) can be read")
-            elif letter in "XYZ":
-                if letter in target:
-                    raise ProgramError(f"{source}, line {no}: {letter} given twice")
-                target[letter] = v
-            elif letter == "F":
-                feed = v
-            elif letter == "O":
-                continue
-            elif letter in _IGNORED_LETTERS:
-                continue
-            else:
-                raise ProgramError(f"{source}, line {no}: word {letter}{value} is not part of a point-list program")
-        if new_motion is not None:
-            motion = new_motion
+        target = modal.read(words, f"{source}, line {no}")
         if not target:
             continue
-        if motion is None:
+        if modal.motion is None:
             raise ProgramError(f"{source}, line {no}: a coordinate before any G00 or G01")
         z_seen = z_seen or "Z" in target
         for k, letter in enumerate("XYZ"):
             if letter in target:
-                v = target[letter] * factor
-                pos[k] = v if absolute else pos[k] + v
+                v = target[letter] * modal.factor
+                pos[k] = v if modal.absolute else pos[k] + v
         pts.append(tuple(pos))
-        rapid.append(motion == 0)
-        feeds.append(feed * factor)
+        rapid.append(modal.motion == 0)
+        feeds.append(modal.feed * modal.factor)
         lines.append(no)
         zk.append(z_seen)
     return Moves(
