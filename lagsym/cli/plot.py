@@ -49,12 +49,12 @@ def add_arguments(p) -> None:
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
                    help="surface (default), basis, compare, or 'toolpath PROGRAM'")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
-    p.add_argument("--units", default="mm", help="length unit for the axis labels (default: mm)")
+    p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1024, 768), metavar="WxH",
                    help="picture size in pixels (default: 1024x768)")
     p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
     p.add_argument("--scale", type=float, default=1.0,
-                   help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
+                   help="with --show toolpath: the --scale the program was made with (default 1)")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
 
@@ -133,13 +133,13 @@ def _toolpath_figure(plot, grid, program, args, opts):
 
     from ..gcode import move_points
     from ..io import read_program
-    from ..machine import Placement
+    from ..machine import Placement, mm_per_surface_unit
     from ._common import origin
 
     points_mm, rapid = move_points(read_program(program), source=program)
     if not len(points_mm):
         raise InputError(f"{program}: no move with a Z position to draw")
-    place = Placement(args.scale, origin(args.origin))
+    place = Placement(mm_per_surface_unit(grid.units, args.scale), origin(args.origin))
     tips = np.column_stack(place.to_surface(*points_mm.T))  # machine mm to surface units
     ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
     return plot.toolpath_figure(lagrange_surface(grid), tips, rapid=ends_rapid, **opts)

@@ -10,13 +10,13 @@ from ..errors import InputError
 from .backend import DEFAULT_WINDOW_SIZE, new_plotter
 from .checks import check_points, check_window_size
 from .meshes import polyline, scalar_mesh
-from .style import FEED_COLOR, RAPID_COLOR, SURFACE_CMAP, axis_labels, bar_args, fit, view, z_scale
+from .style import FEED_COLOR, RAPID_COLOR, SURFACE_CMAP, axis_labels, bar_args, fit, units_of, view, z_scale
 from .surface import sampled_surface
 
 __all__ = ["toolpath_figure"]
 
 
-def toolpath_figure(surface, moves, *, rapid=None, samples: int = 61, units: str = "mm", title: str | None = None,
+def toolpath_figure(surface, moves, *, rapid=None, samples: int = 61, units: str | None = None, title: str | None = None,
                     window_size: Sequence[int] = DEFAULT_WINDOW_SIZE, off_screen: bool | None = None):
     """The cutter path drawn over the surface (the paper's Figures 12 and 14).
 
@@ -54,6 +54,7 @@ def toolpath_figure(surface, moves, *, rapid=None, samples: int = 61, units: str
         if fast.shape != (len(pts),) or fast.dtype != bool:
             raise InputError(f"rapid should be a boolean array of shape ({len(pts)},), got {fast.dtype} {fast.shape}")
     xs, ys, zz = sampled_surface(surface, samples)
+    units = units_of(surface, units)
     w, h = check_window_size(window_size)
     p = new_plotter(window_size=(w, h), off_screen=off_screen)
     name = f"z ({units})"
