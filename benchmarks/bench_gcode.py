@@ -4,7 +4,7 @@ The peers, run in the same process on the same moves:
 
 * writing: one f-string a line with every word (``f"G01 X{x:.3f} ..."``), the
   way most scripts write G-code (and which may print ``-0.000``);
-* writing with :func:`lagsym.post.numbers.fixed` per number (exact decimal
+* writing with :func:`lagsym.gcode.numbers.fixed` per number (exact decimal
   rounding, slow);
 * reading: ``float()`` of every word split on spaces, without any checks.
 
@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from lagsym.gcode import parse_moves  # noqa: E402
 from lagsym.machine import MachineSettings  # noqa: E402
-from lagsym.post.numbers import fixed  # noqa: E402
+from lagsym.gcode.numbers import fixed  # noqa: E402
 from lagsym.post.program import PointProgram, write_program  # noqa: E402
 
 

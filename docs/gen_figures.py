@@ -1,4 +1,4 @@
-"""Render the pictures of docs/paper.md with lagsym itself: ``python3 docs/gen_figures.py``."""
+"""Render the pictures of the docs with lagsym itself: ``python3 docs/gen_figures.py [NAME.png ...]``."""
 
 from __future__ import annotations
 
@@ -18,9 +18,39 @@ FIGURES = {
 }
 
 
-def main() -> int:
+def export_figure(path: Path) -> None:
+    """docs/export.md: Example 2 with the control net of its exact Bezier patch, and the points it interpolates."""
+    import numpy as np
+    import pyvista as pv
+
+    from lagsym import bezier_patch, lagrange_surface, read_points
+    from lagsym.plot import save_figure, surface_figure
+
+    surface = lagrange_surface(read_points(HERE.parent / "examples" / "paper-example-2.json"))
+    net = np.array([[[float(c) for c in p] for p in row] for row in bezier_patch(surface).control_points])
+    p = surface_figure(surface, control_net=False, window_size=(800, 600),
+                       title="Example 2 and the control net of its exact Bezier patch (black), the data points (white)")
+    grid = pv.StructuredGrid(net[..., 0], net[..., 1], net[..., 2])
+    p.add_mesh(grid.extract_all_edges(), color="black", line_width=2, lighting=False)
+    p.add_mesh(pv.PolyData(net.reshape(-1, 3)), color="black", point_size=11, render_points_as_spheres=True)
+    data = np.array([[float(c) for c in pt] for pt in surface.grid.points()])
+    p.add_mesh(pv.PolyData(data), color="white", point_size=11, render_points_as_spheres=True)
+    p.reset_camera()  # the net reaches above the surface
+    p.camera.zoom(0.95)
+    save_figure(p, path)
+
+
+def main(names: list[str] | None = None) -> int:
     from lagsym.cli import main as lagsym
 
+    if names:  # only these
+        for name in names:
+            if name == "export-net.png":
+                export_figure(HERE / "images" / name)
+            elif name in FIGURES and lagsym([*FIGURES[name], "--size", "800x600", "-o", str(HERE / "images" / name)]):
+                return 1
+        return 0
+    export_figure(HERE / "images" / "export-net.png")
     size = ["--size", "800x600"]
     for name, argv in FIGURES.items():
         if lagsym([*argv, *size, "-o", str(HERE / "images" / name)]) != 0:
@@ -37,4 +67,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

@@ -28,6 +28,8 @@ _EXPORTS = {
                  "lambdify_surface"),
     "sampling": ("Sample", "SampleGrid", "sample", "sample_grid"),
     "export": ("write_sample",),
+    "cad": ("BezierPatch", "BSplinePatch", "bezier_patch", "cad_patch"),
+    "export.cad": ("write_cad",),
     "formula": ("Formula", "parse_formula"),
     "surfaces": ("make_surface", "bezier_surface", "bspline_surface", "hermite_surface"),
     "compare": ("Comparison", "DeviationMeasures", "compare_surfaces", "deviation_measures", "render_table"),
@@ -64,9 +66,11 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
                       profile, receive_program, resume_setup, send_program, transfer_segments)
     from .errors import (ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
+    from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
     from .evaluate import (SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
                            surface_evaluator)
     from .export import write_sample
+    from .export.cad import write_cad
     from .formula import Formula, parse_formula
     from .gcode import Moves, move_points, parse_moves
     from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table

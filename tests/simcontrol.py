@@ -160,6 +160,13 @@ class SimControl:
         Cut the line as soon as this many bytes have arrived.
     xon_after_s : float or None
         Send DC1 this long after starting, as a Fanuc does when READ is pressed.
+    hold_on_xoff : bool
+        A feed hold at the first XOFF: the machine stops emptying the buffer
+        (and, with ``ignore_xon``, never asks for more).  ``executed`` counts
+        the characters the machine took from the buffer.
+    discard_after_bytes : int or None
+        Keep reading the line but record nothing after this many bytes: a
+        control that stopped taking the program while its port stays up.
     pair : PtyPair
         What to hang up when cutting the line.
     """
@@ -208,7 +215,8 @@ class SimControl:
         return self._record
 
     def __getattr__(self, name):
-        if name in ("received", "overflow", "max_after_xoff", "xoffs", "dropped", "first_byte_at", "last_byte_at"):
+        if name in ("received", "overflow", "max_after_xoff", "xoffs", "dropped", "first_byte_at", "last_byte_at",
+                    "executed"):
             return self.stop()[name]
         raise AttributeError(name)
 
@@ -229,19 +237,24 @@ def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
         control.close_episode()
     results.send({"received": bytes(control.received), "overflow": control.overflow, "xoffs": control.xoffs,
                   "max_after_xoff": control.max_after_xoff, "dropped": control.dropped, "error": control.error,
-                  "first_byte_at": control.first_byte_at, "last_byte_at": control.last_byte_at})
+                  "first_byte_at": control.first_byte_at, "last_byte_at": control.last_byte_at,
+                  "executed": len(control.received) - int(control.buffered + 0.999)})
 
 
 class _Control:
     def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
                  buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
-                 drop_on_xoff=None, drop_settle_s=1.0, drop_after_bytes=None, xon_after_s=None):
+                 drop_on_xoff=None, drop_settle_s=1.0, drop_after_bytes=None, xon_after_s=None, hold_on_xoff=False,
+                 discard_after_bytes=None):
         self.cps = chars_per_s(baud, bytesize, parity, stopbits)
         self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
         self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
         self.drop_on_xoff, self.drop_settle_s, self.drop_after_bytes = drop_on_xoff, drop_settle_s, drop_after_bytes
         self.socat_pid, self.count, self.halt = socat_pid, count, halt
         self.xon_after_s = xon_after_s
+        self.hold_on_xoff, self.discard_after_bytes = hold_on_xoff, discard_after_bytes
+        self.buffered = 0.0
+        self.count_in = 0  # every character taken from the line, recorded or not
         self.port = _FdPort(path) if isinstance(path, int) else serial.Serial(path, baudrate=baud, timeout=0)
         self.received = bytearray()
         self.overflow = 0
@@ -270,7 +283,6 @@ class _Control:
                     pass
 
     def run(self) -> None:
-        buffered = 0.0
         line_t = 0.0  # when the wire will have delivered everything read so far
         was_pending = False
         drop_at = None
@@ -288,7 +300,9 @@ class _Control:
                 self.count.value = len(self.received)
                 self.cut()
                 return
-            buffered = 0.0 if self.drain_cps is None else max(0.0, buffered - self.drain_cps * gap)
+            held = self.hold_on_xoff and self.xoffs > 0
+            if not held:
+                self.buffered = 0.0 if self.drain_cps is None else max(0.0, self.buffered - self.drain_cps * gap)
             pending = self.port.in_waiting
             if pending and not was_pending:
                 line_t = max(line_t, now - gap)  # an idle line starts again when the data came, about the last look
@@ -302,11 +316,14 @@ class _Control:
                 self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
                 for byte in data:
+                    self.count_in += 1
+                    if self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes:
+                        continue
                     self.received.append(byte)
-                    buffered += 1
+                    self.buffered += 1
                     if self.xoff:
                         self.after += 1
-                    elif buffered >= self.high:
+                    elif self.buffered >= self.high:
                         crossed = self.xoff = True
                         self.after = 0
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
@@ -328,7 +345,7 @@ class _Control:
                         drop_at = time.monotonic() + self.drop_settle_s
                 if self.xoff:
                     self.max_after_xoff = max(self.max_after_xoff, self.after)
-            if self.xoff and not self.ignore_xon and drop_at is None and buffered <= self.low:
+            if self.xoff and not self.ignore_xon and drop_at is None and self.buffered <= self.low:
                 self.close_episode()
                 self.xoff = False
                 self.port.write(DC1)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from lagsym.dnc import parse_program, resume_setup
+from lagsym.dnc import find_block, parse_program, resume_setup
 from lagsym.errors import InputError
 from simcontrol import PROGRAM
 
@@ -12,8 +12,9 @@ from simcontrol import PROGRAM
 def test_resume_setup_restores_modes_retracts_and_approaches():
     p = parse_program(PROGRAM)
     setup = resume_setup(p, 11)
+    # The program plunged at F300 (block 8) and cuts at F600: the feed-down uses the plunge feed.
     assert setup == ("(RESUME AT BLOCK 11)", "G21 G17 G90 G54", "T2 M6", "S4000 M3", "G0 Z25.",
-                     "G0 X20. Y10.", "M8", "G1 Z-1. F600.", "G2")
+                     "G0 X20. Y10.", "M8", "G1 Z-1. F300.", "G2 F600.")
     assert resume_setup(p, 11, safe_z="40")[4] == "G0 Z40."
 
 
@@ -38,3 +39,21 @@ def test_resume_after_a_drilling_cycle_and_a_return_home():
             "G98 G81 X5. Y5. Z-4. R2. F80.\nX10.\nG80\nG0 Z30.\nG1 Z-1. F150.\nX20.\nX30.")
     setup = resume_setup(parse_program(text), 13)
     assert setup[1:] == ("G21 G17 G90 G54", "T3 M6", "S1200 M3", "G0 Z30.", "G0 X20. Y5.", "G1 Z-1. F150.")
+
+
+def test_resume_restores_feed_mode_and_constant_surface_speed():
+    text = ("O1\nG21 G17 G90 G54 G95\nT1 M6\nG96 S180 M3\nG0 X0. Y0. Z10.\nG1 Z-2. F0.05\n"
+            "G1 X5. F0.2\nX10.\nX15.")
+    setup = resume_setup(parse_program(text), 9)
+    assert setup == ("(RESUME AT BLOCK 9)", "G21 G17 G90 G54 G95", "T1 M6", "G96 S180 M3", "G0 Z10.",
+                     "G0 X10. Y0.", "G1 Z-2. F0.05", "F0.2")
+
+
+def test_find_block_by_what_the_control_shows():
+    p = parse_program("O1\nN10 G21 G90\nN20 G0 Z5.\nN30 G1 X1. F100.\nN30 X2.\nX3.", "p.nc")
+    assert find_block(p, "N20") == 3 and find_block(p, "N0020") == 3
+    assert find_block(p, "x3.") == 6
+    with pytest.raises(InputError, match="N30 is blocks 4, 5"):
+        find_block(p, "N30")
+    with pytest.raises(InputError, match="no block is N40"):
+        find_block(p, "N40")

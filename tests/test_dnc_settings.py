@@ -25,7 +25,7 @@ def test_settings_are_frozen_and_checked_against_their_choices():
         s.baud = 19200
     with pytest.raises(InputError, match="none, even, odd, mark, space"):
         LineSettings(parity="evn")
-    with pytest.raises(InputError, match="xonxoff, rtscts, none"):
+    with pytest.raises(InputError, match="xonxoff, rtscts, dtrdsr, none"):
         LineSettings(flow="dtr")
     assert LineSettings(bytesize=8, parity="none", stopbits=1).bits_per_char == 10
 

@@ -227,7 +227,7 @@ def test_stats_from_a_sample_are_close_to_the_full_count():
 
 
 def test_point_list_size_counts_what_fixed_would_write():
-    from lagsym.post.numbers import fixed
+    from lagsym.gcode.numbers import fixed
 
     pts = np.array([[0.0, -1.2345, 100.0], [12.5, 0.0004, -0.0004], [-3.0, 99.9996, 7.0]])
     text = "".join(f"G1 X{fixed(float(x), 3)} Y{fixed(float(y), 3)} Z{fixed(float(z), 3)}\n" for x, y, z in pts)

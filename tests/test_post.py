@@ -148,7 +148,7 @@ def test_the_dialect_modules_do_not_import_the_writer_table():
     import grimp
 
     graph = grimp.build_graph("lagsym")
-    for module in ("fanuc", "linuxcnc", "grbl", "model", "moves", "numbers"):
+    for module in ("fanuc", "linuxcnc", "grbl", "model", "moves"):
         assert not graph.find_shortest_chain(importer=f"lagsym.post.{module}", imported="lagsym.post.program")
 
 

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from lagsym.errors import ProgramError
+from lagsym.errors import InputError, ProgramError
 from lagsym.simulate import ControlAlarm, detect_dialect, moves_csv, simulate
+from lagsym.simulate.reader import read_blocks
 
 
 def feeds(stdout: str) -> np.ndarray:
@@ -229,3 +231,33 @@ def test_fix_and_fup_agree_with_rs274_for_linuxcnc(rs274, tmp_path):
 def test_unsupported_o_words_are_refused_not_skipped():
     with pytest.raises(ControlAlarm, match="outside what the simulator runs"):
         simulate("o100 sub\no100 endsub\n", "linuxcnc", 15)
+
+
+def test_a_dialect_outside_the_list_is_an_input_error():
+    with pytest.raises(InputError, match="dialect 'haas' is not one of fanuc, linuxcnc, heidenhain"):
+        simulate("G1 X1.\n", "haas")
+
+
+def test_blocks_are_frozen():
+    blocks = read_blocks("#1=1.\nWHILE [#1 LT 2.] DO1\n#1=[#1+1.]\nEND1\n", "fanuc")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        blocks[0].line = 5
+
+
+def test_linuxcnc_elseif_chain_takes_one_branch(rs274, tmp_path):
+    body = "".join(f"""#1 = {v}
+o{100 + k} if [#1 LT 1]
+  G1 X1 Y{v} Z0 F100
+o{100 + k} elseif [#1 LT 2]
+  G1 X2 Y{v} Z0 F100
+o{100 + k} elseif [#1 LT 3]
+  G1 X3 Y{v} Z0 F100
+o{100 + k} else
+  G1 X4 Y{v} Z0 F100
+o{100 + k} endif
+""" for k, v in enumerate((0.5, 1.5, 2.5, 3.5)))
+    path = tmp_path / "chain.ngc"
+    path.write_text(body + "M2\n")
+    ours = simulate(body + "M2\n", "linuxcnc", 15).feed_points()
+    assert ours[:, 0].tolist() == [1.0, 2.0, 3.0, 4.0]
+    np.testing.assert_allclose(ours, feeds(rs274.run(path).stdout), atol=1e-9)

@@ -58,6 +58,7 @@ COMMANDS = {
     "curve": "print the exact Lagrange curve y = F(x) through a set of points",
     "check": "measure degree, spacing ratio, Lebesgue constants and overshoot of a surface or curve",
     "sample": "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)",
+    "export": "write the exact surface as a CAD file: STEP or IGES B-spline surface or solid, exact JSON",
     "compare": "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)",
     "plot": "draw the surface, its basis functions or a curve (an image with -o, else a window)",
     "toolpath": "plan a raster toolpath over the exact surface and write it as G-code",
@@ -66,6 +67,7 @@ COMMANDS = {
     "simulate": "dry-run a macro program at the control's precision and write the moves it makes",
     "send": "send a program to a CNC control over RS-232 (upload to memory or drip feed)",
     "receive": "receive a program punched out by a CNC control over RS-232",
+    "dnc": "run a DNC server: ports that machines call to punch programs and to ask for them",
 }
 
 

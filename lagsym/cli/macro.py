@@ -7,7 +7,7 @@ from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
-from ..post.limits import VARIABLE_PROFILES
+from ..gcode.limits import VARIABLE_PROFILES
 from ._common import add_program_arguments, emit, program_settings
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample

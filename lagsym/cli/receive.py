@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 from ._common import emit
 from ..dnc import receive_program
 from ..errors import InputError
@@ -15,8 +17,11 @@ DESCRIPTION = """Wait for a program from a CNC control (PUNCH or OUTPUT on the c
 write it to FILE, or to standard output.  The program runs from DC2 (or its
 first character) to DC4, its closing %, ETX, or a silence of --idle-timeout
 seconds; leader and control codes are dropped and blocks end in LF.  The
-file is written only when the whole program has arrived.  Exit status 3 on a
-line fault, a timeout, or a program without its closing %.
+file is written only when the whole program has arrived, and an existing
+file only with --overwrite.  Once the port is open it says so: then press
+PUNCH.  Exit status 3 on a line fault, a busy port, a timeout, a program
+without its closing %, garbage (a baud rate or parity that does not match
+the control's), Ctrl-C, SIGTERM or SIGHUP.
 
 examples:
   lagsym receive --port /dev/ttyUSB0 --profile fanuc -o from-control.nc
@@ -26,6 +31,7 @@ examples:
 def add_arguments(p) -> None:
     add_line_arguments(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+    p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists (default: refuse)")
     p.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
                    help="how long to wait for the control to start (default 60)")
     p.add_argument("--idle-timeout", type=float, default=5.0, metavar="SECONDS",
@@ -36,11 +42,20 @@ def run(args, out, err) -> int:
     for name in ("timeout", "idle_timeout"):
         if not getattr(args, name) > 0:
             raise InputError(f"--{name.replace('_', '-')} {getattr(args, name)!r} must be a positive number of seconds")
+    to_file = args.output and args.output != "-"
+    if to_file and os.path.exists(args.output) and not args.overwrite:
+        raise InputError(f"{args.output} exists; give another -o FILE, or --overwrite to replace it")
     settings = line_settings(args)
+
+    def ready() -> None:
+        if not args.quiet:
+            err.write(f"waiting on {args.port} for {args.timeout:g} s: start the output (PUNCH) on the control now\n")
+            err.flush()
+
     with event_log(args.log) as log:
         text = receive_program(args.port, settings, start_timeout_s=args.timeout, idle_timeout_s=args.idle_timeout,
-                               log=log)
+                               log=log, ready=ready)
     emit(text, args.output, out)
-    if not args.quiet and args.output and args.output != "-":
+    if not args.quiet and to_file:
         err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
     return 0

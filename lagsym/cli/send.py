@@ -6,17 +6,22 @@ import argparse
 import contextlib
 from pathlib import Path
 
+import math
+
 from ..dnc import (
+    CARRIERS,
     FLOW_CONTROLS,
     MODES,
     PARITIES,
     PROFILES,
     LineSettings,
     parse_filler,
+    find_block,
     parse_program,
     profile,
     send_program,
 )
+from ..errors import InputError
 from ..io import event_log, read_program
 from ..machine import LINE_ENDINGS
 
@@ -35,13 +40,17 @@ plane, absolute mode, work offset, tool, spindle, coolant, a safe Z and the
 approach to where the program was), then block N onwards.
 
 The port is a device or a pyserial URL: /dev/ttyUSB0, COM3,
-socket://host:4001, rfc2217://host:4001, loop://.  Exit status 3 on a line
-fault, a stall or Ctrl-C; the message says which --start-block resumes.
+socket://host:4001, rfc2217://host:4001, loop://; a device is opened
+exclusively.  Exit status 3 on a line fault, a stall, a busy port, Ctrl-C,
+SIGTERM or SIGHUP; the message says which --start-block resumes.  Over
+XON/XOFF alone nothing proves that the control took the program: the summary
+says so unless a --carrier signal or hardware flow control watched the line.
 
 examples:
   lagsym send O1000.nc --port /dev/ttyUSB0 --baud 9600 --bytesize 7 --parity even --stopbits 2 --flow xonxoff
   lagsym send big.nc --port /dev/ttyUSB0 --mode drip --profile fanuc
   lagsym send big.nc --port socket://dnc-gateway.shop.lan:4001 --mode drip --start-block 4120
+  lagsym send big.nc --port /dev/ttyUSB0 --profile fanuc --mode drip --carrier dsr --start-at N4120
   lagsym send O1000.nc --port loop:// --profile fanuc --baud 115200 --quiet"""
 
 
@@ -62,6 +71,12 @@ def add_line_arguments(p) -> None:
     g.add_argument("--percent", action=argparse.BooleanOptionalAction, default=None,
                    help="frame the program with %% lines (default on)")
     g.add_argument("--dtr", action=argparse.BooleanOptionalAction, default=None, help="assert DTR (default on)")
+    g.add_argument("--carrier", choices=CARRIERS, help="a signal the control holds up while connected (DSR, DCD or "
+                                                       "CTS): its drop is a lost line (default none)")
+    g.add_argument("--tv-check", action=argparse.BooleanOptionalAction, default=None,
+                   help="pad blocks to an even character count, for a control with TV check (default off)")
+    g.add_argument("--iso-check", action=argparse.BooleanOptionalAction, default=None,
+                   help="only ISO 840 tape code characters, in what is sent and received (default off)")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--log", metavar="FILE", help="append a line per event (XOFF, XON, faults) to FILE")
 
@@ -70,7 +85,9 @@ def line_settings(args):
     """The :class:`~lagsym.dnc.LineSettings` the options ask for."""
     overrides = {}
     for option, field in (("baud", "baud"), ("bytesize", "bytesize"), ("parity", "parity"), ("stopbits", "stopbits"),
-                          ("flow", "flow"), ("eol", "line_ending"), ("percent", "percent"), ("dtr", "dtr")):
+                          ("flow", "flow"), ("eol", "line_ending"), ("percent", "percent"), ("dtr", "dtr"),
+                          ("carrier", "carrier"), ("tv_check", "tv_check"), ("iso_check", "iso_check"),
+                          ("buffer_chars", "buffer_chars"), ("memory_chars", "memory_chars")):
         value = getattr(args, option, None)
         if value is not None:
             overrides[field] = value
@@ -79,7 +96,7 @@ def line_settings(args):
         if value is not None:
             overrides[option] = parse_filler(value)
     if getattr(args, "stall_timeout", None) is not None:
-        overrides["stall_timeout_s"] = args.stall_timeout
+        overrides["stall_timeout_s"] = seconds_or_forever(args.stall_timeout)
     if getattr(args, "overrun_chars", None) is not None:
         overrides["overrun_chars"] = args.overrun_chars
     if getattr(args, "wait_for_xon", False):
@@ -111,6 +128,19 @@ def progress_bar(err, quiet: bool, what: str):
         yield update
 
 
+def seconds_or_forever(text: str) -> float:
+    """A ``--stall-timeout``: seconds, or ``forever``."""
+    if text.strip().lower() in ("forever", "inf", "none"):
+        return math.inf
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"--stall-timeout {text!r} must be a number of seconds or 'forever'") from None
+    if not 0 < value < math.inf:
+        raise InputError(f"--stall-timeout {text!r} must be a positive number of seconds or 'forever'")
+    return value
+
+
 def add_arguments(p) -> None:
     p.add_argument("file", help="the program (G-code or Heidenhain text)")
     add_line_arguments(p)
@@ -122,8 +152,16 @@ def add_arguments(p) -> None:
                    help="resume a drip feed at block N, after the program's modal set-up (as a fault message says)")
     t.add_argument("--safe-z", metavar="Z", help="retract height for a resume, in program units "
                                                   "(default: the highest rapid Z before block N)")
-    t.add_argument("--stall-timeout", type=float, metavar="SECONDS",
-                   help=f"give up when XOFF or CTS low lasts longer (default {d.stall_timeout_s:g})")
+    t.add_argument("--start-at", metavar="N-OR-TEXT",
+                   help="resume at the block the control shows: its N number (N4120) or its text")
+    t.add_argument("--stall-timeout", type=str, metavar="SECONDS",
+                   help=f"give up when XOFF or CTS low lasts longer; 'forever' for a long M00 or feed hold "
+                        f"(default {d.stall_timeout_s:g})")
+    t.add_argument("--buffer-chars", type=int, metavar="N",
+                   help=f"the control's drip-feed buffer, which a fault's resume block allows for "
+                        f"(default {d.buffer_chars})")
+    t.add_argument("--memory-chars", type=int, metavar="N",
+                   help="the control's program memory: a larger upload is refused (default: not checked)")
     t.add_argument("--overrun-chars", type=int, metavar="N",
                    help=f"most characters in flight, so at most N arrive after XOFF (default {d.overrun_chars}; "
                         "Fanuc tolerates ~10)")
@@ -133,10 +171,18 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     program = parse_program(read_program(args.file), source=args.file)
     settings = line_settings(args)
+    start = args.start_block
+    if args.start_at is not None:
+        if start != 1:
+            raise InputError("give --start-block or --start-at, not both")
+        start = find_block(program, args.start_at)
     with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:
-        result = send_program(args.port, program, settings, mode=args.mode, start_block=args.start_block,
+        result = send_program(args.port, program, settings, mode=args.mode, start_block=start,
                               safe_z=args.safe_z, progress=bar, log=log)
     if not args.quiet:
         out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
                   f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")
+        if not result.confirmed:
+            out.write("the control confirmed nothing: over XON/XOFF alone nothing proves it took the program; "
+                      "check it holds the last block (a --carrier signal watches the line)\n")
     return 0

@@ -9,14 +9,22 @@ no part in it: many programs have none, and some repeat them.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from ..errors import InputError
 
-__all__ = ["Program", "parse_program", "frame", "DC1", "DC2", "DC3", "DC4"]
+__all__ = ["Program", "parse_program", "frame", "check_drip", "check_iso", "tv_padded", "ISO_840", "DC1", "DC2", "DC3",
+           "DC4"]
 
 DC1, DC2, DC3, DC4 = 0x11, 0x12, 0x13, 0x14
 _CONTROL_CODES = {DC1: "DC1", DC2: "DC2", DC3: "DC3", DC4: "DC4"}
+ISO_840 = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 \t+-./%():#=[]*,&$?@;<>'\"!")
+"""The printable characters of the ISO 840 tape code as Fanuc's ISO code table lists them (no lower case)."""
+# A control reading from tape cannot jump back: loops, jumps and M99 returns need the program in memory
+# (M98 and G65 call a program that is already in memory, which a drip feed may do).
+_JUMPS = re.compile(r"\bGOTO|\bWHILE\b|\bDO\s*\d|\bEND\s*\d|\bM99\b")
+_COMMENT = re.compile(r"\([^)]*\)|;.*$")
 
 
 @dataclass(frozen=True)
@@ -100,3 +108,39 @@ def frame(blocks, eol: str, percent: bool, leader: str = "", trailer: str = "") 
     if tail:
         out.append((None, tail.encode("ascii")))
     return out
+
+
+def check_drip(program: Program) -> None:
+    """Refuse a program a control cannot run from tape (a drip feed): loops, jumps and M99 returns.
+
+    Examples
+    --------
+    >>> check_drip(parse_program("O1\\n#1=0\\nWHILE[#1LT3]DO1\\n#1=#1+1\\nEND1\\nM30", "m.nc"))
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: m.nc: block 3 (WHILE[#1LT3]DO1) loops or jumps, which a control cannot do in a program it reads from tape; upload it (--mode upload)
+    """
+    for number, block in enumerate(program.blocks, start=1):
+        if _JUMPS.search(_COMMENT.sub(" ", block.upper())):
+            raise InputError(f"{program.source}: block {number} ({block}) loops or jumps, which a control cannot "
+                             "do in a program it reads from tape; upload it (--mode upload)")
+
+
+def check_iso(program: Program) -> None:
+    """Refuse characters outside :data:`ISO_840`, naming the block (for a control that checks the tape code)."""
+    for number, block in enumerate(program.blocks, start=1):
+        bad = sorted(set(block) - ISO_840)
+        if bad:
+            raise InputError(f"{program.source}: block {number} holds {''.join(bad)!r}, outside the ISO 840 tape "
+                             "code the control checks (lower case, for one); change the program or drop --iso-check")
+
+
+def tv_padded(text: str, eol: str) -> str:
+    """``text`` with a space added where the block and its end of block would hold an odd number of characters.
+
+    Examples
+    --------
+    >>> tv_padded("G0 X1.", "\\n"), tv_padded("G0 X10.", "\\n")
+    ('G0 X1. ', 'G0 X10.')
+    """
+    return text + " " if (len(text) + len(eol)) % 2 else text

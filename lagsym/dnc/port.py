@@ -9,6 +9,9 @@ on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
 
 from __future__ import annotations
 
+import errno
+import termios
+
 import serial
 
 from ..errors import TransferError
@@ -16,7 +19,7 @@ from .settings import PARITIES, LineSettings
 
 __all__ = ["Port", "LINE_ERRORS", "WriteTimeout"]
 
-LINE_ERRORS = (serial.SerialException, OSError)
+LINE_ERRORS = (serial.SerialException, OSError, termios.error)
 WriteTimeout = serial.SerialTimeoutException
 
 
@@ -48,14 +51,18 @@ class Port:
             ser.stopbits = settings.stopbits if settings.stopbits == 1.5 else int(settings.stopbits)
             ser.xonxoff = False  # lagsym reads DC1/DC3 itself; see the module notes
             ser.rtscts = settings.flow == "rtscts"
+            ser.dsrdtr = settings.flow == "dtrdsr"
             ser.timeout = 0
-            ser.write_timeout = write_timeout
+            if "://" not in name:
+                ser.exclusive = True  # a second reader would take the control's DC1 and stall the transfer
+            if not name.lower().startswith("rfc2217://"):
+                # pyserial's RFC 2217 client refuses a write timeout when it opens (its writes wait on the
+                # network); the sender's own stall check bounds them there.
+                ser.write_timeout = write_timeout
             ser.dtr = settings.dtr
             ser.open()
         except (ValueError, *LINE_ERRORS) as e:
-            reason = str(e).strip() or type(e).__name__
-            raise TransferError(f"cannot open {name}: {reason}; check the cable, the device name or URL, "
-                                "and that no other program holds the port") from None
+            raise TransferError(_open_failure(name, e)) from None
         self._ser = ser
 
     def read(self, size: int) -> bytes:
@@ -76,10 +83,22 @@ class Port:
 
     def cts(self) -> bool:
         """Whether the control holds CTS high; True where the port cannot tell."""
+        return self.signal("cts")
+
+    def signal(self, name: str) -> bool:
+        """Whether the control holds ``cts``, ``dsr`` or ``cd`` high; True where the port cannot tell."""
         try:
-            return bool(self._ser.cts)
+            return bool(getattr(self._ser, name))
         except (AttributeError, NotImplementedError, *LINE_ERRORS):
             return True
+
+    def can_sense(self, name: str) -> bool:
+        """Whether this port reports the signal ``name`` at all (a pseudo-terminal has no modem lines)."""
+        try:
+            getattr(self._ser, name)
+        except (AttributeError, NotImplementedError, *LINE_ERRORS):
+            return False
+        return True
 
     def close(self) -> None:
         """Close the port; a line already lost needs no closing."""
@@ -87,3 +106,14 @@ class Port:
             self._ser.close()
         except LINE_ERRORS:
             pass
+
+
+def _open_failure(name: str, e: BaseException) -> str:
+    reason = str(e).strip() or type(e).__name__
+    busy = (getattr(e, "errno", None) in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK)
+            or "exclusively lock" in reason)
+    if busy:
+        return (f"cannot open {name}: the port is in use by another program (another lagsym, a terminal or a "
+                "DNC service); close it and try again")
+    return (f"cannot open {name}: {reason}; check the cable, the device name or URL, "
+            "and that no other program holds the port")

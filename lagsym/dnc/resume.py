@@ -14,12 +14,11 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import InputError
+from ..gcode.words import numeric_words, strip_comments
 from .blocks import Program
 
-__all__ = ["resume_setup"]
+__all__ = ["resume_setup", "find_block"]
 
-_WORD = re.compile(r"([A-Z])\s*([+-]?(?:\d+\.?\d*|\.\d+))")
-_COMMENT = re.compile(r"\([^)]*\)|;.*$")
 _MACRO = re.compile(r"#|\bGOTO\b|\bWHILE\b|\bIF\b|\bM98\b|\bM99\b|\bG65\b")
 
 
@@ -37,6 +36,9 @@ class _Modal:
     speed: str | None = None
     coolant: str | None = None
     feed: str | None = None
+    feed_mode: str | None = None
+    css: str | None = None
+    plunge_feed: str | None = None
     position: dict = field(default_factory=lambda: {"X": None, "Y": None, "Z": None})
     rapid_z: Decimal | None = None
     cycle: str | None = None
@@ -45,7 +47,7 @@ class _Modal:
 
 
 def _words(block: str) -> list[tuple[str, str]]:
-    return _WORD.findall(_COMMENT.sub(" ", block.upper()))
+    return numeric_words(block, strict=False)  # macro blocks are refused before modal tracking
 
 
 def _number(text: str) -> Decimal:
@@ -57,7 +59,10 @@ _TRANSFORM_ENDS = {"69": "68", "50": "51", "50.1": "51.1", "15": "16"}
 
 
 def _track(state: _Modal, block: str, where: str) -> None:
-    """Update ``state`` with one block, as a control would."""
+    """Update ``state`` with one block, as a control would.
+
+    Long because it is one table of the modal groups a control keeps, read in the order the control reads them.
+    """
     words = _words(block)
     gs = [_g(v) for k, v in words if k == "G"]
     ms = [v for k, v in words if k == "M"]
@@ -89,6 +94,10 @@ def _track(state: _Modal, block: str, where: str) -> None:
             state.cycle = "G" + code
         elif code in ("28", "30", "53"):
             homing = True
+        elif code in ("93", "94", "95"):
+            state.feed_mode = "G" + code
+        elif code in ("96", "97"):
+            state.css = "G" + code
         elif code in ("52", "92"):
             raise InputError(f"{where}: G{code} shifts the coordinate system in a way a resume cannot replay; "
                              "send the program from the start")
@@ -116,6 +125,11 @@ def _track(state: _Modal, block: str, where: str) -> None:
         elif k == "F":
             state.feed = v
     moves = {k: _number(v) for k, v in words if k in "XYZ"}
+    old_z = state.position["Z"]
+    if state.motion == "G1" and set(moves) == {"Z"} and not homing:
+        new_z = moves["Z"] + (old_z or 0) if state.distance == "G91" else moves["Z"]
+        if old_z is not None and new_z < old_z:
+            state.plunge_feed = state.feed  # the feed the program plunges at, which the set-up's feed-down uses
     if homing:
         # G28/G30 go to a reference point and G53 moves in machine coordinates: the work position of
         # the named axes (all of them when none is named) is unknown until the program sets it again.
@@ -148,12 +162,18 @@ def _fmt(value: Decimal) -> str:
 def resume_setup(program: Program, start_block: int, safe_z: str | None = None) -> tuple[str, ...]:
     """The blocks that put a control in the state block ``start_block`` expects.
 
+    Long because each state a resume cannot trust is its own check with its own message, in the order a
+    reader of the set-up would ask.
+
     The blocks before ``start_block`` are read for the modal state they leave:
     units, plane, distance mode, work offset, tool and tool length offset,
     spindle speed and direction, coolant, feed and motion mode, and the
-    position.  The set-up selects all of them, retracts to a safe Z, moves
-    over the last position and feeds down to it, so block ``start_block``
-    starts where it would have started in an uninterrupted run.
+    position, the feed mode (G93/G94/G95) and constant surface speed
+    (G96/G97).  The set-up selects all of them, retracts to a safe Z, moves
+    over the last position and feeds down to it at the feed the program
+    last plunged at (then restores the cutting feed), so block
+    ``start_block`` starts where it would have started in an uninterrupted
+    run.
 
     Parameters
     ----------
@@ -191,7 +211,7 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     for number in range(1, start_block):
         block = program.block(number)
         where = f"{program.source}: block {number}"
-        if _MACRO.search(_COMMENT.sub(" ", block.upper())):
+        if _MACRO.search(strip_comments(block).upper()):
             raise InputError(f"{where} uses macro variables, jumps or subprogram calls; a resume cannot know the "
                              "state they leave, so send the program from the start")
         try:
@@ -226,12 +246,12 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     if state.feed is None:
         raise InputError(f"{program.source}: no feed (F word) before block {start_block}; the set-up could not "
                          "feed down to the resume point")
-    modal = " ".join(v for v in (state.units, state.plane or "G17", "G90", state.offset) if v)
+    modal = " ".join(v for v in (state.units, state.plane or "G17", "G90", state.offset, state.feed_mode) if v)
     out = [f"(RESUME AT BLOCK {start_block})", modal]
     if state.tool is not None:
         out.append(f"T{state.tool} M6" if state.tool_changed else f"T{state.tool}")
     if state.speed is not None or state.spindle is not None:
-        out.append(" ".join(v for v in (f"S{state.speed}" if state.speed else None, state.spindle) if v))
+        out.append(" ".join(v for v in (state.css, f"S{state.speed}" if state.speed else None, state.spindle) if v))
     retract = f"G0 Z{_fmt(z_safe)}"
     if state.length_comp:
         retract = f"G0 {state.length_comp} Z{_fmt(z_safe)}"
@@ -239,9 +259,44 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     out.append(f"G0 X{_fmt(pos['X'])} Y{_fmt(pos['Y'])}")
     if state.coolant:
         out.append(state.coolant)
-    out.append(f"G1 Z{_fmt(pos['Z'])} F{state.feed}")
+    plunge = state.plunge_feed or state.feed
+    out.append(f"G1 Z{_fmt(pos['Z'])} F{plunge}")
     restore = [m for m in (state.motion if state.motion not in (None, "G1") else None,
-                           "G91" if state.distance == "G91" else None) if m]
+                           "G91" if state.distance == "G91" else None,
+                           f"F{state.feed}" if plunge != state.feed else None) if m]
     if restore:
         out.append(" ".join(restore))
     return tuple(out)
+
+
+_N_WORD = re.compile(r"^\s*N\s*0*(\d+)\b")
+
+
+def find_block(program: Program, spec: str) -> int:
+    """The block number of what the control shows: an N number (``N1234``) or a block's text.
+
+    Text matches ignoring case and spaces; either must name exactly one block.
+
+    Examples
+    --------
+    >>> from lagsym.dnc import parse_program
+    >>> p = parse_program("O1\\nN10 G21 G90\\nN20 G0 Z5.\\nN30 G1 X1. F100.")
+    >>> find_block(p, "N20"), find_block(p, "n30 g1 x1. f100.")
+    (3, 4)
+    """
+    key = spec.strip().upper()
+    if re.fullmatch(r"N\s*\d+", key):
+        wanted = int(re.sub(r"\D", "", key))
+        hits = [i for i, b in enumerate(program.blocks, start=1)
+                if (n := _N_WORD.match(b.upper())) and int(n.group(1)) == wanted]
+        what = f"N{wanted}"
+    else:
+        flat = key.replace(" ", "")
+        hits = [i for i, b in enumerate(program.blocks, start=1) if b.upper().replace(" ", "") == flat]
+        what = repr(spec)
+    if not hits:
+        raise InputError(f"{program.source}: no block is {what}; give the N number or the text the control shows")
+    if len(hits) > 1:
+        shown = ", ".join(map(str, hits[:10]))
+        raise InputError(f"{program.source}: {what} is blocks {shown}; give --start-block with the one you mean")
+    return hits[0]

@@ -7,6 +7,7 @@ rather than its constants.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from ..errors import InputError
@@ -14,9 +15,10 @@ from ..machine import LINE_ENDINGS, bits_per_char
 from ..values import choice, positive
 from .blocks import DC1, DC2, DC3, DC4
 
-__all__ = ["LineSettings", "PROFILES", "FLOW_CONTROLS", "PARITIES", "MODES", "profile", "parse_filler"]
+__all__ = ["LineSettings", "PROFILES", "FLOW_CONTROLS", "CARRIERS", "PARITIES", "MODES", "profile", "parse_filler"]
 
-FLOW_CONTROLS = ("xonxoff", "rtscts", "none")
+FLOW_CONTROLS = ("xonxoff", "rtscts", "dtrdsr", "none")
+CARRIERS = ("none", "dsr", "cd", "cts")
 PARITIES = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}
 MODES = ("upload", "drip")
 _FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
@@ -38,7 +40,13 @@ class LineSettings:
         1, 1.5 or 2.
     flow : str
         ``xonxoff`` (DC1/DC3 from the control, handled by lagsym), ``rtscts``
-        (hardware) or ``none``.
+        or ``dtrdsr`` (hardware: the sender pauses while CTS or DSR is low)
+        or ``none``.
+    carrier : str
+        A signal the control holds up for as long as it is connected and
+        reading: ``dsr``, ``cd`` (DCD) or ``cts``; ``none`` where the cable
+        carries none.  It dropping for :data:`CARRIER_LOSS_S` is a lost line,
+        and it is what confirms that the control took the program.
     line_ending : str
         End of block: ``lf``, ``crlf`` or ``cr`` (the characters are
         :attr:`eol`).
@@ -50,8 +58,9 @@ class LineSettings:
         Assert DTR while the port is open.
     stall_timeout_s : float
         Longest XOFF, CTS low or stopped output queue before the transfer
-        gives up.  In a drip feed it must exceed the longest time the control
-        spends on the blocks in its buffer.
+        gives up; ``math.inf`` waits for ever (a long M00 or feed hold).  In a
+        drip feed it must exceed the longest time the control spends on the
+        blocks in its buffer.
     overrun_chars : int
         Most characters on their way at any moment, so at most this many
         arrive after the control says XOFF.  Keep it below the control's
@@ -59,6 +68,18 @@ class LineSettings:
     wait_for_xon : bool
         Wait for the control's DC1 before the first character (a Fanuc sends
         it when READ is pressed).
+    buffer_chars : int
+        The control's input buffer in a drip feed: characters that may have
+        arrived but not yet run.  A fault's resume block allows for them.
+    memory_chars : int or None
+        The control's program memory; a larger upload is refused.  None:
+        not known.
+    tv_check : bool
+        Pad every block with a space so that it and its end of block have
+        an even number of characters, for a control that checks it (TV check).
+    iso_check : bool
+        Refuse characters outside the ISO 840 tape code in what is sent, and
+        report them in what is received.
     """
 
     baud: int = 9600
@@ -74,6 +95,11 @@ class LineSettings:
     stall_timeout_s: float = 120.0
     overrun_chars: int = 4
     wait_for_xon: bool = False
+    carrier: str = "none"
+    buffer_chars: int = 256
+    memory_chars: int | None = None
+    tv_check: bool = False
+    iso_check: bool = False
 
     def __post_init__(self):
         if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
@@ -88,9 +114,20 @@ class LineSettings:
             text = getattr(self, name)
             if any(ord(c) in (DC1, DC2, DC3, DC4) or ord(c) > 127 for c in text):
                 raise InputError(f"{name} {text!r} holds a character the line cannot carry or that steers it")
-        object.__setattr__(self, "stall_timeout_s", positive(self.stall_timeout_s, "stall timeout (seconds)"))
+        choice(self.carrier, CARRIERS, "carrier signal")
+        if self.stall_timeout_s != math.inf:
+            object.__setattr__(self, "stall_timeout_s", positive(self.stall_timeout_s, "stall timeout (seconds)"))
+        if not isinstance(self.buffer_chars, int) or not 0 <= self.buffer_chars <= 1_000_000:
+            raise InputError(f"control buffer {self.buffer_chars!r} must be 0 to 1000000 characters")
+        if self.memory_chars is not None and (not isinstance(self.memory_chars, int) or self.memory_chars < 1):
+            raise InputError(f"control memory {self.memory_chars!r} must be a positive number of characters")
         if not isinstance(self.overrun_chars, int) or not 1 <= self.overrun_chars <= 4096:
             raise InputError(f"overrun limit {self.overrun_chars!r} must be 1 to 4096 characters")
+
+    @property
+    def stall_text(self) -> str:
+        """The stall timeout as messages print it."""
+        return "for ever" if self.stall_timeout_s == math.inf else f"{self.stall_timeout_s:g} s"
 
     @property
     def eol(self) -> str:
@@ -125,6 +162,9 @@ class LineSettings:
         """
         return self.baud / self.bits_per_char
 
+
+CARRIER_LOSS_S = 0.5
+"""How long the carrier signal may be down before the line counts as lost (the issue's bound: within a second)."""
 
 # Sources for each profile are in docs/dnc.md.
 PROFILES: dict[str, LineSettings] = {

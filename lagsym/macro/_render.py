@@ -5,10 +5,10 @@ from __future__ import annotations
 from fractions import Fraction
 
 from ..errors import ProgramError
+from ..gcode.limits import check_axis, check_blocks, check_settings
+from ..gcode.numbers import fixed
+from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
-from ..post.limits import check_axis, check_blocks, check_settings
-from ..post.model import coolant_off, coolant_on, iso_comment, surface_comment
-from ..post.numbers import fixed
 from .model import Const, Op, Sqrt, Var, variables, written
 
 __all__ = ["number_variables", "expression", "literal", "iso_start", "iso_end", "header_comments", "check_text"]
@@ -39,7 +39,7 @@ def iso_start(loops, settings: MachineSettings, dialect_words: tuple[str, str]) 
     if settings.spindle_rpm:
         out.append(f"S{int(round(settings.spindle_rpm))} {spindle}")
     out.append(f"G43 H{settings.length_offset_number} G0 Z{_z(settings, settings.safe_z_mm)}")
-    out += coolant_on(settings)
+    out += [COOLANT_ON[settings.coolant]] if settings.coolant != "off" else []
     x0, y0, z0 = loops.start
     check_axis([x0, y0, z0, settings.safe_z_mm * uf], settings, "the first point")
     out.append(f"G0 X{fixed(x0, dp)} Y{fixed(y0, dp)}")
@@ -53,11 +53,11 @@ def iso_start(loops, settings: MachineSettings, dialect_words: tuple[str, str]) 
 
 def iso_end(settings: MachineSettings, stop: str) -> list[str]:
     """Up to the clearance plane, coolant off, spindle off, and the program end word ``stop``."""
-    return [f"G0 Z{_z(settings, settings.safe_z_mm)}", *coolant_off(settings), "M5", stop]
+    return [f"G0 Z{_z(settings, settings.safe_z_mm)}", *([] if settings.coolant == "off" else ["M09"]), "M5", stop]
 
 
 def check_text(lines, settings: MachineSettings) -> None:
-    """Refuse a block longer than the dialect's control reads (see :mod:`lagsym.post.limits`)."""
+    """Refuse a block longer than the dialect's control reads (see :mod:`lagsym.gcode.limits`)."""
     check_blocks(lines, settings.dialect)
 
 

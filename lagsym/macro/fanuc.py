@@ -1,6 +1,6 @@
 """Fanuc Custom Macro B (also Haas): ``#`` variables, ``WHILE [..] DOm .. ENDm``, ``[ ]`` brackets.
 
-Limits kept (see docs/macros.md and :mod:`lagsym.post.limits`): common
+Limits kept (see docs/macros.md and :mod:`lagsym.gcode.limits`): common
 variables ``#100-#199`` or ``#500-#999`` (``#100-#149``, ``#500-#531`` on the
 ``small`` profile); at most 3 nested ``DO`` levels (the program uses 2); at most 5
 nested brackets (expressions here use at most 2); a decimal point on every
@@ -11,7 +11,7 @@ constant, at most 8 significant digits on 8-digit controls, no exponent;
 from __future__ import annotations
 
 from ..errors import ProgramError
-from ..post.limits import variable_ranges
+from ..gcode.limits import variable_ranges
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal, number_variables
 from .model import Assign, Clamp, Loop, Move
 

@@ -10,8 +10,8 @@ runs at least once (every loop of a surface program does).  Blocks are numbered 
 from __future__ import annotations
 
 from ..errors import ProgramError
-from ..post.limits import check_axis, check_blocks, check_settings, variable_ranges
-from ..post.numbers import fixed
+from ..gcode.limits import check_axis, check_blocks, check_settings, variable_ranges
+from ..gcode.numbers import fixed
 from ._render import header_comments, literal, number_variables
 from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var
 from .model import variables as variables_of

@@ -18,7 +18,7 @@ from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..values import choice
 from . import fanuc, heidenhain, linuxcnc
-from ..post.limits import check_axis
+from ..gcode.limits import check_axis
 from .accuracy import predicted_error
 from .form import FORMS
 from .loops import MacroLoops, macro_loops
@@ -108,7 +108,7 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
         First variable number (Fanuc ``#100`` or ``#500``, Heidenhain ``Q1``).
     variables : str
         ``"full"`` or ``"small"``: the variable ranges of the control's macro
-        option (see :data:`lagsym.post.limits.LIMITS`); a program that does
+        option (see :data:`lagsym.gcode.limits.LIMITS`); a program that does
         not fit is refused.
     form : str, optional
         ``"horner"`` (shortest) or ``"lagrange"`` (tensor-product basis, the most

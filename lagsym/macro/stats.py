@@ -2,7 +2,7 @@
 
 The point-list size is an estimate, not a rendered program: one block
 ``G1 X... Y... Z...`` per raster point with the machine's decimals and line
-ending, the coordinates written as :func:`lagsym.post.numbers.fixed` writes
+ending, the coordinates written as :func:`lagsym.gcode.numbers.fixed` writes
 them, plus the same preamble and postamble as the macro.  A real point-list
 post may add block numbers or drop unchanged words; the estimate is within a
 few per cent of a plain one.

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ProgramError
+from ..gcode.limits import check_axis, check_blocks, check_settings, resolution
+from ..gcode.numbers import fixed
+from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
-from .limits import check_axis, check_blocks, check_settings, resolution
 from .moves import format_moves
-from .numbers import fixed
 
 __all__ = ["PointProgram", "point_program", "iso_comment", "body", "units_word", "surface_comment", "check_clearance",
            "coolant_on", "coolant_off", "check_blocks", "check_settings"]
@@ -74,29 +75,6 @@ def point_program(toolpath, settings: MachineSettings, title: str = "") -> Point
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
 
 
-# The characters every control lagsym writes for reads in a comment: a Fanuc 0 alarms (TH) on a comma.
-_NOT_ISO = re.compile(r"[^A-Z0-9 .+\-/]")
-
-
-def iso_comment(text: str) -> str:
-    """Comment text a control accepts: upper-case letters, digits, space and ``. + - /``; no parentheses.
-
-    Examples
-    --------
-    >>> iso_comment("Paper example 4 (5x5), scale 1:20 – Ø6 ball")
-    'PAPER EXAMPLE 4 5X5 SCALE 1 20 - 6 BALL'
-    """
-    t = text.upper().replace("\u2013", "-").replace("\u2014", "-")
-    t = _NOT_ISO.sub(" ", t)
-    return re.sub(r"\s+", " ", t).strip()
-
-
-def surface_comment(settings: MachineSettings) -> str:
-    """The header comment saying which units the surface was in and how it was scaled (ISO characters)."""
-    return iso_comment(f"surface in {settings.surface_units} {settings.mm_per_unit:g} mm per unit "
-                       f"program in {settings.units}")
-
-
 def check_clearance(settings: MachineSettings, top_mm: float) -> None:
     """The clearance plane must be a feed height above the highest cutter location ``top_mm``."""
     need = top_mm + settings.feed_height_mm
@@ -108,7 +86,7 @@ def check_clearance(settings: MachineSettings, top_mm: float) -> None:
 
 def coolant_on(settings: MachineSettings) -> list[str]:
     """``M08`` (flood) or ``M07`` (mist), nothing when the coolant is off."""
-    return {"off": [], "flood": ["M08"], "mist": ["M07"]}[settings.coolant]
+    return [COOLANT_ON[settings.coolant]] if settings.coolant != "off" else []
 
 
 def coolant_off(settings: MachineSettings) -> list[str]:

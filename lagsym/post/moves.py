@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..machine import MachineSettings
-from .numbers import fixed
+from ..gcode.numbers import fixed
 
 __all__ = ["format_moves"]
 

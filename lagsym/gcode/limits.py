@@ -1,8 +1,8 @@
-"""What each control reads: block length, digits of an axis word, tool, length and work offset numbers, variables.
+"""What each control reads: characters per block, digits of an axis word, tool and offset numbers, variables.
 
-One table, :data:`LIMITS`, one row a dialect; the point-list writers and the
-macro renderers check their settings and text against it and refuse what a
-control would alarm on, naming the limit.  The figures are the documented ones
+The point-list writers and the macro writers keep within these limits and the
+simulator raises the control's alarm past them, so all read them from here.
+:data:`LIMITS` gathers one row a dialect; the figures are the documented ones
 of the smallest control lagsym writes a dialect for (docs/controllers.md):
 
 - a Fanuc reads 8 digits in an axis word (``99999.999`` mm, ``9999.9999``
@@ -26,8 +26,29 @@ import numpy as np
 from ..errors import ProgramError
 from ..machine import MachineSettings
 
-__all__ = ["ControlLimits", "LIMITS", "VARIABLE_PROFILES", "limits", "check_settings", "check_axis",
-           "check_blocks", "variable_ranges", "resolution"]
+__all__ = ["MAX_BLOCK", "VARIABLE_RANGES", "MACRO_VARIABLES", "ControlLimits", "LIMITS", "VARIABLE_PROFILES",
+           "limits", "check_settings", "check_axis", "check_blocks", "variable_ranges", "resolution"]
+
+MAX_BLOCK = {
+    "fanuc": 128,  # characters per block the simulator accepts for a Fanuc
+    "linuxcnc": 255,  # LinuxCNC reads at most 255 characters per line (LINELEN)
+    "heidenhain": 128,
+    "grbl": 80,  # Grbl 1.1's line buffer
+}
+"""Characters per block (one line) each dialect's control reads."""
+
+VARIABLE_RANGES = {
+    "fanuc": ((1, 33), (100, 199), (500, 999)),  # local, common, common kept at power-off
+    "linuxcnc": ((1, 5602),),
+    "heidenhain": ((0, 99),),
+}
+"""Variable numbers (inclusive ranges) a program may read and write on each control."""
+
+MACRO_VARIABLES = {
+    "fanuc": ((100, 199), (500, 999)),  # common variables: the locals #1-#33 belong to a macro call
+    "heidenhain": ((0, 99),),
+}
+"""Variable numbers a generated macro may take for its own values (LinuxCNC's use named parameters)."""
 
 
 @dataclass(frozen=True)
@@ -57,11 +78,12 @@ class ControlLimits:
 
 
 LIMITS: dict[str, ControlLimits] = {
-    "fanuc": ControlLimits(128, 8, 9999, 400, r"G5[4-9]|G54\.1 P([1-9]|[1-3]\d|4[0-8])",
-                           {"full": ((100, 199), (500, 999)), "small": ((100, 149), (500, 531))}),
-    "linuxcnc": ControlLimits(255, 9, 99999, 99999, r"G5[4-9]|G59\.[1-3]", {}),
+    "fanuc": ControlLimits(MAX_BLOCK["fanuc"], 8, 9999, 400, r"G5[4-9]|G54\.1 P([1-9]|[1-3]\d|4[0-8])",
+                           {"full": MACRO_VARIABLES["fanuc"], "small": ((100, 149), (500, 531))}),
+    "linuxcnc": ControlLimits(MAX_BLOCK["linuxcnc"], 9, 99999, 99999, r"G5[4-9]|G59\.[1-3]", {}),
     "grbl": ControlLimits(80, 8, 0, 0, r"G5[4-9]", {}),
-    "heidenhain": ControlLimits(255, 9, 32767, 0, "", {"full": ((0, 99),), "small": ((0, 99),)}),
+    "heidenhain": ControlLimits(MAX_BLOCK["heidenhain"], 9, 32767, 0, "",
+                                {"full": MACRO_VARIABLES["heidenhain"], "small": MACRO_VARIABLES["heidenhain"]}),
 }
 VARIABLE_PROFILES = ("full", "small")
 

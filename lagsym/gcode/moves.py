@@ -16,18 +16,16 @@ reading, not a Fanuc's least-input-increment one).
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._arrays import freeze_fields
-from .errors import ProgramError
+from .._arrays import freeze_fields
+from ..errors import ProgramError
+from .words import WordError, numeric_words
 
 __all__ = ["Moves", "parse_moves", "move_points"]
 
-_WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
-_COMMENT = re.compile(r"\([^)]*\)")
 _IGNORED_G = {17, 40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 94, 97}
 _IGNORED_LETTERS = set("NSTMHDP")
 
@@ -116,20 +114,13 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
             continue
         if s.startswith("/"):
             s = s[1:]  # block delete off: the block runs
-        s = _COMMENT.sub(" ", s)
-        if "(" in s:
-            raise ProgramError(f"{source}, line {no}: unclosed comment in {raw.strip()!r}")
-        s = s.split(";", 1)[0]
-        if not s.strip():
-            continue
-        words = _WORD.findall(s)
-        rest = _WORD.sub("", s).strip()
-        if rest:
-            raise ProgramError(f"{source}, line {no}: cannot read {rest!r} in {raw.strip()!r}")
+        try:
+            words = numeric_words(s)
+        except WordError as e:
+            raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
         target = {}
         new_motion = None
         for letter, value in words:
-            letter = letter.upper()
             v = float(value)
             if letter == "G":
                 g = round(v, 1)

@@ -1,0 +1,62 @@
+"""``lagsym dnc serve CONFIG.toml``: a DNC server, ports that machines call to punch and to ask for programs."""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+import time
+
+from ..dnc.config import load_config
+from ..dnc.server import serve
+from ..errors import Terminated
+from ..io import event_log
+
+NAME = "dnc"
+ORDER = 90
+HELP = "run a DNC server: ports that machines call to punch programs and to ask for them"
+DESCRIPTION = """Serve one or more serial ports as a shop's DNC service, as configured in a
+TOML file (see docs/dnc.md): a program punched from a control is saved under
+its program number (O1234 as 1234.nc; an existing file is kept and the new
+one saved beside it as 1234.received-2.nc); a short program numbered as the
+port's request number (O9999 to upload, O9998 to drip-feed) whose first
+comment names a program, (PRG=1234) or (O1234), has that program sent back
+after request_delay_s.  Each port has its own log; a status line per port
+goes to standard output.  A fault on one port never stops the others.
+SIGTERM, SIGHUP or Ctrl-C stops the server within 2 s.  --check reads and
+checks the configuration and exits.
+
+examples:
+  lagsym dnc serve examples/dnc.toml --check"""
+
+
+def add_arguments(p) -> None:
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+    s = sub.add_parser("serve", help="serve the ports of CONFIG until stopped")
+    s.add_argument("config", metavar="CONFIG", help="the TOML configuration")
+    s.add_argument("--check", action="store_true", help="check the configuration and exit")
+
+
+def run(args, out, err) -> int:
+    config = load_config(args.config)
+    if args.check:
+        for port in config.ports:
+            out.write(f"{port.name}: {port.device}, {port.settings.baud} baud, programs from {port.programs}, "
+                      f"punched programs to {port.received}, log {port.log}\n")
+        return 0
+    lock = threading.Lock()
+
+    def status(name: str, text: str) -> None:
+        with lock:
+            out.write(f"{time.strftime('%H:%M:%S')} {name}: {text}\n")
+            out.flush()
+
+    stop = threading.Event()
+    with contextlib.ExitStack() as stack:
+        logs = {p.name: stack.enter_context(event_log(p.log)) for p in config.ports}
+        try:
+            serve(config, stop, lambda p: logs[p.name], status)
+        except KeyboardInterrupt as e:
+            why = signal.Signals(e.signum).name if isinstance(e, Terminated) else "Ctrl-C"
+            status("server", f"stopped by {why}")
+    return 0

@@ -1,0 +1,139 @@
+"""The configuration of ``lagsym dnc serve``: a TOML file of ports, each with its profile and folders.
+
+Every key is checked: an unknown key is refused with the keys that are
+valid, a bad value with the key that holds it, in one line.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+
+from ..errors import InputError, LagsymError
+from .settings import LineSettings, profile
+
+__all__ = ["PortConfig", "ServerConfig", "load_config"]
+
+_LINE_KEYS = {f.name for f in fields(LineSettings)}
+
+
+@dataclass(frozen=True)
+class PortConfig:
+    """One port the server listens on.
+
+    Attributes
+    ----------
+    name : str
+        For the log and the status line.
+    device : str
+        The port, as ``lagsym send --port`` takes it.
+    settings : LineSettings
+        The profile with the table's ``[port.line]`` overrides.
+    programs, received : Path
+        The folder of programs to serve, the folder punched programs go to.
+    request_upload, request_drip : int or None
+        Program numbers that ask for a program to be uploaded or drip-fed.
+    request_delay_s : float
+        Wait after a request, so the operator can switch the control to read.
+    log : Path
+        This port's log file (default: ``NAME.log`` beside the configuration).
+    """
+
+    name: str
+    device: str
+    settings: LineSettings
+    programs: Path
+    received: Path
+    request_upload: int | None = 9999
+    request_drip: int | None = 9998
+    request_delay_s: float = 5.0
+    log: Path | None = None
+
+
+@dataclass(frozen=True)
+class ServerConfig:
+    """The ports of one server, and the file they came from."""
+
+    ports: tuple[PortConfig, ...]
+    source: str
+
+
+_PORT_KEYS = ("name", "device", "profile", "programs", "received", "request_upload", "request_drip",
+              "request_delay_s", "log", "line")
+
+
+def _bad(source: str, key: str, why: str) -> InputError:
+    return InputError(f"{source}: {key}: {why}")
+
+
+def _port(source: str, index: int, table, base: Path) -> PortConfig:
+    where = f"port[{index}]"
+    if not isinstance(table, dict):
+        raise _bad(source, where, "must be a table ([[port]])")
+    for key in table:
+        if key not in _PORT_KEYS:
+            raise _bad(source, f"{where}.{key}", f"unknown key; the keys are {', '.join(_PORT_KEYS)}")
+    for key in ("name", "device", "programs", "received"):
+        if not isinstance(table.get(key), str) or not table[key]:
+            raise _bad(source, f"{where}.{key}", "is required, as a string")
+    line = table.get("line", {})
+    if not isinstance(line, dict):
+        raise _bad(source, f"{where}.line", "must be a table of line settings")
+    for key in line:
+        if key not in _LINE_KEYS:
+            raise _bad(source, f"{where}.line.{key}", f"unknown key; the keys are {', '.join(sorted(_LINE_KEYS))}")
+    try:
+        settings = profile(table.get("profile", "fanuc"))
+        settings = replace(settings, **line)
+    except (LagsymError, TypeError) as e:
+        raise _bad(source, f"{where}.{'line' if line else 'profile'}", str(e)) from None
+    numbers = {}
+    for key in ("request_upload", "request_drip"):
+        value = table.get(key, PortConfig.__dataclass_fields__[key].default)
+        if value is not None and (not isinstance(value, int) or isinstance(value, bool) or not 1 <= value <= 99999):
+            raise _bad(source, f"{where}.{key}", f"{value!r} must be a program number from 1 to 99999")
+        numbers[key] = value
+    delay = table.get("request_delay_s", 5.0)
+    if isinstance(delay, bool) or not isinstance(delay, (int, float)) or not 0 <= delay <= 3600:
+        raise _bad(source, f"{where}.request_delay_s", f"{delay!r} must be 0 to 3600 seconds")
+    programs, received = base / table["programs"], base / table["received"]
+    if not programs.is_dir():
+        raise _bad(source, f"{where}.programs", f"{programs} is not a folder")
+    log = table.get("log")
+    if log is not None and not isinstance(log, str):
+        raise _bad(source, f"{where}.log", "must be a file name")
+    return PortConfig(table["name"], table["device"], settings, programs, received, numbers["request_upload"],
+                      numbers["request_drip"], float(delay), base / (log or f"{table['name']}.log"))
+
+
+def load_config(path: str | Path) -> ServerConfig:
+    """Read and check a server configuration; relative folders are relative to the file.
+
+    Raises
+    ------
+    InputError
+        Naming the file and the key, for a file that cannot be read, is not
+        TOML, holds an unknown key or a bad value.
+    """
+    source = str(path)
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as e:
+        raise InputError(f"{source}: cannot read the configuration ({e.strerror or e})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{source}: not TOML: {e}") from None
+    for key in data:
+        if key != "port":
+            raise _bad(source, key, "unknown key; the keys are port")
+    tables = data.get("port")
+    if not isinstance(tables, list) or not tables:
+        raise _bad(source, "port", "at least one [[port]] table is required")
+    base = Path(path).resolve().parent
+    ports = tuple(_port(source, i, t, base) for i, t in enumerate(tables))
+    for key in ("name", "device"):
+        seen = [getattr(p, key) for p in ports]
+        dup = next((v for v in seen if seen.count(v) > 1), None)
+        if dup is not None:
+            raise _bad(source, f"port.{key}", f"{dup!r} is given twice")
+    return ServerConfig(ports, source)

@@ -1,0 +1,261 @@
+"""The sender's loop over an open port: pacing to the line rate, XON/XOFF, hardware signals and the accounting.
+
+The sender does its own XON/XOFF: it paces writes to the line rate
+(characters per second = baud / bits per character), keeps at most
+``LineSettings.overrun_chars`` characters on their way at any moment, and
+reads the line for DC3 (XOFF) and DC1 (XON) before every write.  The kernel's
+IXON is left off on purpose: it would swallow DC3 before lagsym could see it,
+and many USB adapters keep sending after it anyway.  A Fanuc accepts only
+about 10 characters past DC3 before alarm 087, so the default keeps 4 or
+fewer in flight, which leaves room for the DC3 to travel back.
+
+A block counts as *delivered* once all its bytes have had time to leave the
+line (by the line clock and the driver's output queue), a short settling
+time has passed, and a later look at the port found it still healthy.  In a
+drip feed a delivered block is not yet a block that ran: up to
+``LineSettings.buffer_chars`` characters may wait in the control's buffer,
+and a reset clears them.  A fault therefore names the last delivered block
+and a ``--start-block`` that is safe either way: the first block that may
+not have run, with the blocks up to the last delivered one named as those
+that may be repeated.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import time
+from collections.abc import Callable
+
+from ..errors import Terminated, TransferError
+from .blocks import DC1, DC3
+from .results import LineFault, TransferProgress, TransferResult
+from .settings import CARRIER_LOSS_S, LineSettings
+
+__all__ = ["Sender"]
+
+_POLL_S = 0.002  # longest sleep between looks at the port while the line is busy
+_PROGRESS_S = 0.1
+# A byte counts as arrived only this long after the line clock says it left: longer through a network
+# serial server, which holds what it has not yet put on its line.
+_SETTLE_S = 0.05
+_SETTLE_NETWORK_S = 0.25
+_HARDWARE = {"rtscts": "cts", "dtrdsr": "dsr"}
+_CARRIER_POLL_S = 0.1
+
+
+class Sender:
+    """One send over an open port: pacing, flow control, accounting.  Not reused."""
+
+    def __init__(self, line, segments, settings: LineSettings, mode: str, port: str,
+                 progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None):
+        self.line, self.settings, self.mode, self.port = line, settings, mode, port
+        self.progress, self.log = progress, log or (lambda _m: None)
+        self.data = b"".join(b for _, b in segments)
+        self.ends: list[tuple[int, int]] = []  # (end offset, block number) of program blocks
+        self.segment_ends: list[int] = []
+        offset = 0
+        for number, chunk in segments:
+            offset += len(chunk)
+            self.segment_ends.append(offset)
+            if number is not None:
+                self.ends.append((offset, number))
+        self.blocks_total = len(self.ends)
+        self.first_block = self.ends[0][1] if self.ends else 1
+        self.cps = settings.chars_per_s
+        network = "://" in port and not port.startswith("loop://")
+        self.settle_s = _SETTLE_NETWORK_S if network else _SETTLE_S
+        self.pos = 0  # bytes written to the port
+        self.sure = 0  # bytes surely on the control's side
+        self.line_free = 0.0  # when the last written byte will have left the line
+        self.paused = settings.wait_for_xon
+        self.pause_since = 0.0
+        self.pause_reason = "the control sent no DC1 (XON) to start the transfer within {t}"
+        self.xoffs = 0
+        self.max_in_flight = 0
+        self.queue_stuck_since: float | None = None
+        self.last_queue = 0
+        self.hardware = _HARDWARE.get(settings.flow)
+        self.carrier = None if settings.carrier == "none" else settings.carrier
+        for sig in (self.hardware, self.carrier):
+            if sig and not line.can_sense(sig):
+                raise TransferError(f"{port} reports no {sig.upper()} line, which the settings rely on "
+                                    f"({'flow ' + settings.flow if sig == self.hardware else 'carrier ' + sig}); "
+                                    "use a port with modem lines or change the setting")
+        self.carrier_down_since: float | None = None
+        self.carrier_checked = -1.0
+
+    def in_flight(self, now: float) -> int:
+        """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
+        clock = max(0.0, (self.line_free - now) * self.cps)
+        return max(math.ceil(clock), self.line.out_waiting())
+
+    def unsettled(self, now: float) -> int:
+        """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
+        return max(self.in_flight(now), self.in_flight(now - self.settle_s))
+
+    def blocks_surely_done(self) -> int:
+        done = 0
+        for end, _number in self.ends:
+            if end > self.sure:
+                break
+            done += 1
+        return done
+
+    def last_sure_block(self) -> int:
+        done = self.blocks_surely_done()
+        return self.ends[done - 1][1] if done else self.first_block - 1
+
+    def last_sent_block(self) -> int:
+        sent = [number for end, number in self.ends if end <= self.pos]
+        return sent[-1] if sent else self.first_block - 1
+
+    def report(self, start: float, now: float) -> None:
+        if self.progress:
+            self.progress(TransferProgress(self.blocks_surely_done(), self.blocks_total, self.sure, len(self.data),
+                                           now - start, self.paused))
+
+    def last_run_block(self) -> int:
+        """The last block that surely ran: delivered, with the control's buffer's worth of characters behind it."""
+        ran = self.sure - (self.settings.buffer_chars if self.mode == "drip" else 0)
+        done = [number for end, number in self.ends if end <= ran]
+        return done[-1] if done else self.first_block - 1
+
+    def fault(self, what: str, todo: str) -> LineFault:
+        """The fault, with the last block that surely arrived and (drip) the block that resumes safely."""
+        last = self.last_sure_block()
+        where = f"block {last} surely reached the control" if last else "no block surely reached the control"
+        sent = self.last_sent_block()
+        if sent > last:
+            where += f" (blocks {last + 1} to {sent} were on their way and may have arrived too)"
+        repeat = None
+        if self.mode == "drip":
+            resume = self.last_run_block() + 1
+            if resume <= last:
+                repeat = (max(resume, self.first_block), last)
+                where += (f"; the control's buffer ({self.settings.buffer_chars} characters) may still hold blocks "
+                          f"{repeat[0]} to {last} unexecuted")
+            hint = (f"{todo}, then resume with --start-block {resume}" if resume > 1
+                    else f"{todo}, then send again")
+            if repeat:
+                hint += (f" (safe whether or not a reset cleared the buffer: blocks {repeat[0]} to {last} are "
+                         "repeated if they had already run)")
+            if last and last >= self.ends[-1][1] and repeat is None:
+                resume = None
+                hint = f"{todo}; every block arrived, only the closing framing may be missing"
+            message = f"{what} on {self.port}; {where}; {hint}"
+        else:
+            resume = None
+            message = (f"{what} on {self.port}; {where}; the upload is incomplete: {todo}, "
+                       "then send the whole program again")
+        self.log(f"fault: {message}")
+        return LineFault(message, last, resume, sent, repeat)
+
+    def interrupted(self, e: KeyboardInterrupt) -> LineFault:
+        """The fault for Ctrl-C, SIGTERM or SIGHUP."""
+        what = (f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated)
+                else "stopped by the user")
+        return self.fault(what, "when the control is ready")
+
+    def poll(self, now: float) -> None:
+        """Read what the control sent; a read that fails is a lost line."""
+        incoming = self.line.read(4096)
+        # Everything that had left the line before this look is on the far side.
+        self.sure = max(self.sure, self.pos - self.unsettled(now))
+        for byte in incoming:
+            if byte == DC3 and self.settings.flow == "xonxoff":
+                if not self.paused:
+                    self.paused, self.pause_since = True, now
+                    self.pause_reason = "the control held XOFF (DC3) for more than {t}"
+                    self.xoffs += 1
+                    self.max_in_flight = max(self.max_in_flight, self.in_flight(now))
+                    self.log(f"XOFF after {self.pos} bytes")
+            elif byte == DC1 and self.settings.flow == "xonxoff":
+                if self.paused:
+                    self.log(f"XON after {now - self.pause_since:.3f} s")
+                self.paused = False
+        if self.hardware:
+            ready = self.line.signal(self.hardware)
+            reason = f"{self.hardware.upper()} stayed low (control not ready) for more than {{t}}"
+            if not ready and not self.paused:
+                self.paused, self.pause_since, self.pause_reason = True, now, reason
+            elif ready and self.paused and self.pause_reason == reason:
+                self.paused = False
+        if self.carrier and now - self.carrier_checked >= _CARRIER_POLL_S:
+            self.carrier_checked = now  # a network port may wait on the server to tell its modem lines
+            self.check_carrier(now)
+
+    def check_carrier(self, now: float) -> None:
+        """The carrier signal down for :data:`CARRIER_LOSS_S` is a lost line, whatever the port still says."""
+        if self.line.signal(self.carrier):
+            self.carrier_down_since = None
+        elif self.carrier_down_since is None:
+            self.carrier_down_since = now
+        elif now - self.carrier_down_since >= CARRIER_LOSS_S:
+            raise self.fault(f"the control dropped {self.carrier.upper()} (the line or the control went away)",
+                             "check the cable and that the control is on and in DNC or READ mode")
+
+    def check_queue(self, now: float) -> None:
+        """An output queue that does not shrink means nothing reads the line."""
+        queued = self.line.out_waiting()
+        if queued and queued >= self.last_queue:
+            if self.queue_stuck_since is None:
+                self.queue_stuck_since = now
+            elif now - self.queue_stuck_since > self.settings.stall_timeout_s:
+                raise self.fault(f"nothing read the line for {self.settings.stall_text} "
+                                 f"({queued} bytes stuck in the output queue)",
+                                 "check the cable and that the control is reading")
+        else:
+            self.queue_stuck_since = None
+        self.last_queue = queued
+
+    def run(self) -> TransferResult:
+        """Send everything; Long because the pacing loop reads, checks and writes in one place, in order."""
+        start = time.monotonic()
+        self.pause_since = start
+        self.line_free = start
+        last_report = -1.0
+        limit = self.settings.overrun_chars
+        low = limit - 1  # top up as soon as a character has left: the most margin against late wake-ups
+        seg = 0
+        total = len(self.data)
+        self.log(f"sending {total} bytes, {self.blocks_total} blocks, at {self.cps:.1f} characters/s")
+        while True:
+            now = time.monotonic()
+            self.poll(now)
+            if now - last_report >= _PROGRESS_S:
+                self.report(start, now)
+                last_report = now
+            self.check_queue(now)
+            if self.paused:
+                if now - self.pause_since > self.settings.stall_timeout_s:
+                    raise self.fault(self.pause_reason.format(t=self.settings.stall_text),
+                                     "clear the control (reset any alarm) and put it back in DNC or READ mode")
+                time.sleep(_POLL_S)
+                continue
+            in_flight = self.in_flight(now)
+            if self.pos >= total:
+                if in_flight == 0:
+                    finished = now  # the last byte has left the line
+                    break
+                time.sleep(min(_POLL_S, in_flight / self.cps))
+                continue
+            if in_flight > low:
+                time.sleep(min(_POLL_S, (in_flight - low) / self.cps))
+                continue
+            while self.segment_ends[seg] <= self.pos:
+                seg += 1
+            n = min(limit - in_flight, self.segment_ends[seg] - self.pos)
+            written = self.line.write(self.data[self.pos:self.pos + n])
+            self.line_free = max(self.line_free, now) + written / self.cps
+            self.pos += written
+        # A healthy look once the last byte has settled, so the last block counts as delivered.
+        time.sleep(self.settle_s)
+        now = time.monotonic()
+        self.poll(now)
+        self.sure = self.pos
+        self.report(start, now)
+        elapsed = finished - start
+        self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF")
+        return TransferResult(self.blocks_total, total, elapsed, self.xoffs, self.max_in_flight, self.cps,
+                              confirmed=bool(self.carrier or self.hardware))

@@ -1,0 +1,15 @@
+"""Word-address G-code read back: the one word tokenizer, and the moves of a point-list program.
+
+:mod:`lagsym.gcode.words` splits blocks into words for every reader in
+lagsym; :mod:`lagsym.gcode.moves` reads the straight moves of a point-list
+program on top of it; :mod:`lagsym.gcode.limits` holds what each control
+reads (block length, variable numbers).
+"""
+
+from __future__ import annotations
+
+from .moves import Moves, move_points, parse_moves
+from .words import FUNCTIONS, WordError, numeric_words, strip_comments, words
+
+__all__ = ["Moves", "parse_moves", "move_points", "WordError", "FUNCTIONS", "strip_comments",
+           "numeric_words", "words"]

@@ -1,0 +1,42 @@
+"""A dry run of a macro program on the PC, with the control's arithmetic and the control's alarms.
+
+:func:`simulate` executes the dialects lagsym writes -- Fanuc Custom Macro B,
+LinuxCNC O-words, Heidenhain FN/Q parameters -- in decimal arithmetic of a
+chosen number of significant digits (8 for a Fanuc 16/18-class control, 15
+for IEEE double), rounding after every operation and on reading every
+constant.  It returns the moves the control would make, or raises
+:class:`ControlAlarm` where the control would stop:
+
+* unbalanced ``WHILE .. DOm`` / ``ENDm`` or ``o.. while`` / ``o.. endwhile``, ``DO`` beyond 3 levels;
+* ``[ ]`` nested deeper than 5 (Fanuc alarm 118);
+* a constant with more digits than the control reads (Fanuc alarm 003);
+* a constant on an axis word without a decimal point (a Fanuc reads ``X12`` as
+  0.012 mm; lagsym refuses it rather than guess);
+* a variable outside the range the dialect allows;
+* a block longer than the control reads; division by zero, the square root of
+  a negative number, a jump to a missing sequence number or label, a runaway loop.
+
+The simulator covers what lagsym emits plus the common core of each language
+(``IF [..] GOTO n``, ``IF [..] THEN``, ``GOTO``, the functions every Macro B
+control has); it is not a full interpreter of any control.
+
+The steps, one module each: :mod:`~lagsym.simulate.reader` turns the text
+into typed :mod:`~lagsym.simulate.blocks` with one parser per dialect
+(:mod:`~lagsym.simulate.fanuc`, :mod:`~lagsym.simulate.linuxcnc`,
+:mod:`~lagsym.simulate.heidenhain`) and the expressions of
+:mod:`~lagsym.simulate.expressions`; :mod:`~lagsym.simulate.executor` runs
+them on the arithmetic and variables of :mod:`~lagsym.simulate.control`;
+:mod:`~lagsym.simulate.result` holds what comes back.
+"""
+
+from __future__ import annotations
+
+from ..gcode.limits import MAX_BLOCK, VARIABLE_RANGES
+from .alarms import ControlAlarm
+from .executor import MAX_DO, simulate
+from .expressions import MAX_BRACKETS
+from .reader import SIM_DIALECTS, detect_dialect
+from .result import SimMove, Simulation, moves_csv
+
+__all__ = ["ControlAlarm", "SimMove", "Simulation", "simulate", "detect_dialect", "moves_csv",
+           "SIM_DIALECTS", "VARIABLE_RANGES", "MAX_BLOCK", "MAX_BRACKETS", "MAX_DO"]

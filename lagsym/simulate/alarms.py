@@ -1,0 +1,28 @@
+"""The control's alarms: :class:`ControlAlarm` for the caller, :class:`BlockAlarm` inside one block."""
+
+from __future__ import annotations
+
+from ..errors import ProgramError
+
+__all__ = ["ControlAlarm", "BlockAlarm"]
+
+
+class ControlAlarm(ProgramError):
+    """The control would stop here: ``alarm`` names the condition, ``line`` the block (1-based)."""
+
+    def __init__(self, alarm: str, message: str, line: int = 0, block: str = ""):
+        self.alarm, self.line, self.block = alarm, line, block
+        where = f" at line {line}: {block.strip()[:60]!r}" if line else ""
+        super().__init__(f"alarm {alarm}: {message}{where}")
+
+
+class BlockAlarm(Exception):
+    """An alarm found while reading or running one block, before the line is known.
+
+    The reader and the executor catch it and raise :class:`ControlAlarm`
+    with the line and text of the block.
+    """
+
+    def __init__(self, alarm: str, message: str):
+        super().__init__(alarm, message)
+        self.alarm, self.message = alarm, message

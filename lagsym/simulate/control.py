@@ -1,0 +1,113 @@
+"""The control's arithmetic and variables: a decimal context, variable ranges, rounding and modal state.
+
+Every stored value and every operation's result is rounded to the chosen
+number of significant digits (8 for a Fanuc 16/18-class control, 15 for
+IEEE double), and every constant is rounded as it is read, as a control does.
+"""
+
+from __future__ import annotations
+
+import math
+from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND_UP, Context, Decimal
+
+from .alarms import BlockAlarm
+from .result import SimMove
+
+__all__ = ["Control"]
+
+class Control:
+    """Variables, modal state and arithmetic of one run."""
+
+    def __init__(self, dialect: str, precision: int, ranges):
+        self.dialect, self.precision, self.ranges = dialect, precision, ranges
+        self.ctx = Context(prec=precision, Emin=-99, Emax=99)
+        self.vars: dict[int, Decimal] = {}
+        self.constants: dict[str, Decimal] = {}
+        self.names: dict[str, Decimal] = {}
+        self.pos = [Decimal(0)] * 3
+        self.motion = "G0"
+        self.feed = Decimal(0)
+        self.absolute = True
+        self.moves: list[SimMove] = []
+
+    def const(self, text: str) -> Decimal:
+        value = self.constants.get(text)
+        if value is None:
+            if self.dialect == "fanuc":
+                whole, _, frac = text.lstrip("+-").partition(".")
+                digits = len(whole.lstrip("0")) + len(frac)
+                if digits > self.precision:
+                    raise BlockAlarm("003", f"{text} has {digits} digits, "
+                                         f"more than the {self.precision} the control reads")
+            value = self.constants[text] = self.ctx.create_decimal(text)
+        return value
+
+    def check(self, n: int) -> int:
+        if not any(lo <= n <= hi for lo, hi in self.ranges):
+            allowed = ", ".join(f"{lo}-{hi}" for lo, hi in self.ranges)
+            raise BlockAlarm("115", f"variable {n} is outside the allowed ranges {allowed}")
+        return n
+
+    def index(self, value: Decimal) -> int:
+        """A computed variable or sequence number, rounded to the nearest integer as the control does."""
+        return int(value.to_integral_value(rounding=ROUND_HALF_UP))
+
+    def get(self, n: int) -> Decimal:
+        if n == 0 and self.dialect == "fanuc":
+            return Decimal(0)  # #0 is always vacant; vacant reads as 0 in arithmetic
+        self.check(n)
+        return self.vars.get(n, Decimal(0))
+
+    def set(self, n: int, value: Decimal) -> None:
+        self.vars[self.check(n)] = self.ctx.plus(value)
+
+    def named(self, name: str) -> Decimal:
+        if name not in self.names:
+            raise BlockAlarm("named", f"named parameter #<{name}> is used before it is set")
+        return self.names[name]
+
+    def divide(self, a: Decimal, b: Decimal) -> Decimal:
+        if b == 0:
+            raise BlockAlarm("112", "division by zero")
+        return self.ctx.divide(a, b)
+
+    def func(self, name: str, a: Decimal) -> Decimal:
+        c = self.ctx
+        if name == "SQRT":
+            if a < 0:
+                raise BlockAlarm("111", f"square root of {a}")
+            return c.sqrt(a)
+        if name == "ABS":
+            return c.abs(a)
+        if name == "FIX":  # Fanuc drops the fraction (toward zero); LinuxCNC rounds down
+            return a.to_integral_value(rounding=ROUND_DOWN if self.dialect == "fanuc" else ROUND_FLOOR)
+        if name == "FUP":  # Fanuc raises the magnitude (away from zero); LinuxCNC rounds up
+            return a.to_integral_value(rounding=ROUND_UP if self.dialect == "fanuc" else ROUND_CEILING)
+        if name == "ROUND":
+            return a.to_integral_value(rounding=ROUND_HALF_UP)
+        if name == "EXP":
+            return c.exp(a)
+        if name == "LN":
+            if a <= 0:
+                raise BlockAlarm("111", f"logarithm of {a}")
+            return c.ln(a)
+        x = float(a)
+        try:
+            value = {"SIN": lambda: math.sin(math.radians(x)), "COS": lambda: math.cos(math.radians(x)),
+                     "TAN": lambda: math.tan(math.radians(x)), "ATAN": lambda: math.degrees(math.atan(x)),
+                     "ASIN": lambda: math.degrees(math.asin(x)), "ACOS": lambda: math.degrees(math.acos(x))}[name]()
+        except ValueError:
+            raise BlockAlarm("111", f"{name} of {a}") from None
+        return c.create_decimal(repr(value))
+
+    def atan2(self, a: Decimal, b: Decimal) -> Decimal:
+        return self.ctx.create_decimal(repr(math.degrees(math.atan2(float(a), float(b))) % 360.0))
+
+    def move(self, line: int, words: dict[str, Decimal]) -> None:
+        for axis, letter in enumerate("XYZ"):
+            if letter in words:
+                v = words[letter]
+                self.pos[axis] = v if self.absolute else self.ctx.add(self.pos[axis], v)
+        if any(k in words for k in "XYZ"):
+            self.moves.append(SimMove(line, self.motion, float(self.pos[0]), float(self.pos[1]),
+                                      float(self.pos[2]), float(self.feed)))

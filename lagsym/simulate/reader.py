@@ -1,0 +1,58 @@
+"""Program text to blocks: the lines a control skips, the block-length alarm, one parser per dialect."""
+
+from __future__ import annotations
+
+import re
+
+from ..gcode.limits import MAX_BLOCK
+from . import fanuc, heidenhain, linuxcnc
+from .alarms import BlockAlarm, ControlAlarm
+from .blocks import Block, Nop
+
+__all__ = ["SIM_DIALECTS", "PARSERS", "detect_dialect", "read_blocks"]
+
+PARSERS = {"fanuc": fanuc.parse_block, "linuxcnc": linuxcnc.parse_block, "heidenhain": heidenhain.parse_block}
+SIM_DIALECTS = tuple(PARSERS)
+
+
+def detect_dialect(text: str) -> str:
+    """Guess the dialect of a program: ``BEGIN PGM`` is Heidenhain, ``o100 while`` LinuxCNC, else Fanuc.
+
+    Examples
+    --------
+    >>> detect_dialect("0 BEGIN PGM 1 MM\\n1 END PGM 1 MM\\n"), detect_dialect("o100 while [1 LT 2]\\n")
+    ('heidenhain', 'linuxcnc')
+    """
+    if re.search(r"^\s*\d*\s*BEGIN\s+PGM", text, re.M | re.I):
+        return "heidenhain"
+    if re.search(r"^[ \t]*o[ \t]*[\d<]\S*[ \t]+(while|if|do|sub|repeat)\b", text, re.M | re.I) or "#<" in text:
+        return "linuxcnc"
+    return "fanuc"
+
+
+def read_blocks(text: str, dialect: str) -> list[Block]:
+    """The blocks of ``text`` in order, without blank, ``%`` and block-delete (``/``) lines.
+
+    Raises
+    ------
+    ControlAlarm
+        For a line longer than the control reads, or one its parser cannot read.
+    """
+    limit = MAX_BLOCK[dialect]
+    parse = PARSERS[dialect]
+    blocks = []
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    for n, raw in enumerate(lines, start=1):
+        if len(raw) > limit:
+            raise ControlAlarm("block", f"block of {len(raw)} characters, more than the {limit} the control reads",
+                               n, raw)
+        t = raw.strip()
+        if t == "%" or not t or t.startswith("/"):
+            continue
+        try:
+            b = parse(n, raw, t)
+        except BlockAlarm as e:
+            raise ControlAlarm(e.alarm, e.message, n, raw) from None
+        if not isinstance(b, Nop) or b.sequence is not None:
+            blocks.append(b)
+    return blocks

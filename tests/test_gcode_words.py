@@ -1,0 +1,82 @@
+"""The one word tokenizer: what it splits, what it refuses, and that its comments are LinuxCNC's."""
+
+from __future__ import annotations
+
+import pytest
+
+from lagsym.errors import ProgramError
+from lagsym.gcode import WordError, numeric_words, parse_moves, strip_comments, words
+from lagsym.gcode import limits
+from lagsym.macro import fanuc, heidenhain, linuxcnc
+
+from gcheck import interpret
+
+
+def test_numeric_words_in_block_order_with_upper_case_letters():
+    assert numeric_words("n10 g1 x-.5 Y 2. F+200") == [("N", "10"), ("G", "1"), ("X", "-.5"), ("Y", "2."),
+                                                      ("F", "+200")]
+    assert numeric_words("G01 X1.0 (FEED) Y2.0") == [("G", "01"), ("X", "1.0"), ("Y", "2.0")]
+    assert numeric_words("(ONLY A COMMENT)") == []
+
+
+@pytest.mark.parametrize("block, match", [
+    ("G1 X#1", "cannot read 'X#1'"),
+    ("G1 X[1+2]", "cannot read"),
+    ("G1 X1 $", "cannot read '\\$'"),
+    ("G1 X1 (open", "unclosed comment"),
+    ("G1 X1 (open ; x", "unclosed comment"),
+])
+def test_numeric_words_refuses_anything_else(block, match):
+    with pytest.raises(WordError, match=match):
+        numeric_words(block)
+
+
+def test_lenient_numeric_words_pass_over_what_is_not_a_number():
+    assert numeric_words("G1 X#1 Y2.", strict=False) == [("G", "1"), ("Y", "2.")]
+    assert numeric_words("t1 m6 $", strict=False) == [("T", "1"), ("M", "6")]
+
+
+def test_the_first_comment_to_start_wins():
+    assert strip_comments("G1 X1. ; note (open").strip() == "G1 X1."
+    assert strip_comments("G1 (a;b) X1.").split() == ["G1", "X1."]
+    assert numeric_words("G1 X1. ; note (open") == [("G", "1"), ("X", "1.")]
+
+
+def test_a_fanuc_semicolon_is_not_a_comment():
+    assert strip_comments("#1=2. ;", semicolon=False) == "#1=2. ;"
+    with pytest.raises(WordError):
+        numeric_words("G1 X1. ;", semicolon=False)
+
+
+def test_words_keep_variables_expressions_and_functions_whole():
+    assert words("G1 X#112 Y[#1 + [2.*#2]] Z-#3 F#<feed>") == [
+        ("G", "1"), ("X", "#112"), ("Y", "[#1 + [2.*#2]]"), ("Z", "-#3"), ("F", "#<feed>")]
+    assert words("x sqrt[#1] y-ABS[#2]") == [("X", "sqrt[#1]"), ("Y", "-ABS[#2]")]
+    assert words("G1 X") == [("G", "1"), ("X", "")]
+
+
+@pytest.mark.parametrize("block, match", [("G1 $1", "cannot read"), ("G1 X#<feed", "'#<' without its '>'")])
+def test_words_refuse_what_is_not_a_word(block, match):
+    with pytest.raises(WordError, match=match):
+        words(block)
+
+
+def test_comments_are_read_as_rs274_reads_them(rs274):
+    # A ';' comment hides a '(' after it; a comment between the digits of a number ends the number.
+    good = "G21 G90\nG1 X1.5 F100. ; to the corner (open\nM2\n"
+    feeds, _ = interpret(rs274, good)
+    assert parse_moves(good).feeds.tolist() == feeds.tolist() == [[1.5, 0.0, 0.0]]
+    bad = "G21 G90\nG1 X1.(c)5 F100.\nM2\n"
+    with pytest.raises(AssertionError, match="rs274 refused"):
+        interpret(rs274, bad)
+    with pytest.raises(ProgramError, match="line 2: cannot read '5'"):
+        parse_moves(bad)
+
+
+def test_the_macro_writers_keep_the_controls_limits():
+    assert fanuc.MAX_BLOCK == limits.MAX_BLOCK["fanuc"]
+    assert linuxcnc.MAX_BLOCK == limits.MAX_BLOCK["linuxcnc"]
+    assert fanuc.VARIABLE_RANGES == limits.MACRO_VARIABLES["fanuc"]
+    assert heidenhain.VARIABLE_RANGES == limits.MACRO_VARIABLES["heidenhain"]
+    for dialect, ranges in limits.MACRO_VARIABLES.items():
+        assert all(any(lo <= a and b <= hi for lo, hi in limits.VARIABLE_RANGES[dialect]) for a, b in ranges)
