@@ -8,22 +8,45 @@ the one :class:`Placement` (``mm_per_unit`` and ``origin_mm``).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 
-from .errors import ToolpathError
+from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
-__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "UNITS", "DIRECTIONS"]
+__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
+           "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit"]
 
 DIALECTS = ("fanuc", "linuxcnc", "heidenhain", "grbl")
 TOOL_SHAPES = ("ball", "flat")
 LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
+# A program ends its blocks with LF or CR LF: with CR alone rs274 and ISO tape readers see one block.
+PROGRAM_LINE_ENDINGS = ("lf", "crlf")
 UNITS = ("mm", "inch")
+COOLANTS = ("off", "flood", "mist")  # M08 flood, M07 mist, M09 off at the end
+_WORK_OFFSET = re.compile(r"G5[4-9]|G59\.[1-3]|G54\.1 P[1-9]\d{0,2}")
 DIRECTIONS = ("x", "y")
 MM_PER_INCH = Fraction(254, 10)
+MM_PER = {"mm": Fraction(1), "inch": MM_PER_INCH}
+
+
+def mm_per_surface_unit(surface_units: str | None, scale: float = 1.0) -> float:
+    """Millimetres per surface unit: the model ``scale`` times the length of one unit of the surface.
+
+    ``scale`` is dimensionless (2: the part is twice the size the points
+    describe); a surface in inches is 25.4 mm per unit at scale 1.  A surface
+    whose file names no units is taken to be in millimetres.
+
+    Examples
+    --------
+    >>> mm_per_surface_unit("inch"), mm_per_surface_unit("mm", 10), mm_per_surface_unit(None, 2.5)
+    (25.4, 10.0, 2.5)
+    """
+    units = "mm" if surface_units is None else choice(surface_units, UNITS, "surface units")
+    return float(as_exact(positive(scale, "scale"), "scale") * MM_PER[units])
 
 
 def bits_per_char(bytesize: int, parity: str, stopbits: float) -> float:
@@ -160,22 +183,48 @@ class MachineSettings:
     line_ending: str = "lf"
     decimals: int | None = None  # None: 3 for mm, 4 for inch
     tool_number: int = 1
+    length_offset: int | None = None  # None: the tool number
+    feed_height_mm: float = 2.0
+    coolant: str = "off"
+    surface_units: str = "mm"
 
     def __post_init__(self):
         choice(self.dialect, DIALECTS, "dialect")
         choice(self.units, UNITS, "units")
-        choice(self.line_ending, tuple(LINE_ENDINGS), "line ending")
+        choice(self.surface_units, UNITS, "surface units")
+        choice(self.coolant, COOLANTS, "coolant")
+        if self.line_ending not in PROGRAM_LINE_ENDINGS:
+            raise InputError(f"line ending {self.line_ending!r} is not one of {', '.join(PROGRAM_LINE_ENDINGS)}: "
+                             "with CR alone rs274 and ISO readers see the whole program as one block")
         positive(self.feed_mm_min, "feed")
         positive(self.plunge_feed_mm_min, "plunge feed")
         positive(self.spindle_rpm, "spindle speed", allow_zero=True)
         positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
+        positive(self.feed_height_mm, "feed height")
+        finite(self.safe_z_mm, "safe Z")
         place = Placement(self.mm_per_unit, self.origin_mm)  # checks both, once
         object.__setattr__(self, "mm_per_unit", place.mm_per_unit)
         object.__setattr__(self, "origin_mm", place.origin_mm)
+        for name in ("program_number", "tool_number", "length_offset", "decimals"):
+            v = getattr(self, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))):
+                raise InputError(f"{name.replace('_', ' ')} {v!r} must be a whole number")
         if not (1 <= int(self.program_number) <= 9999):
             raise ToolpathError(f"program number {self.program_number} must be 1 to 9999")
+        if self.tool_number < 1:
+            raise InputError(f"tool number {self.tool_number} must be 1 or more")
+        if self.length_offset is not None and self.length_offset < 1:
+            raise InputError(f"length offset H{self.length_offset} must be 1 or more")
         if self.decimals is not None and not (0 <= self.decimals <= 6):
             raise ToolpathError(f"decimals {self.decimals} must be 0 to 6")
+        if not isinstance(self.work_offset, str) or not _WORK_OFFSET.fullmatch(self.work_offset):
+            raise InputError(f"work offset {self.work_offset!r} is not one of G54 to G59, G59.1 to G59.3 "
+                             "or G54.1 P1 to P300")
+
+    @property
+    def length_offset_number(self) -> int:
+        """The H number of ``G43``: the length offset, by default the tool number."""
+        return self.tool_number if self.length_offset is None else int(self.length_offset)
 
     @property
     def placement(self) -> Placement:

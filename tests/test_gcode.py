@@ -49,7 +49,8 @@ def test_reads_every_dialect_lagsym_writes(rs274, dialect):
     moves = parse_moves(text)
     feeds, _ = interpret(rs274, text)
     np.testing.assert_allclose(moves.feeds, feeds, atol=1e-4 * 25.4)
-    assert np.count_nonzero(moves.rapid) == 3  # over the start, down to safe Z, back up at the end
+    # up to safe Z, over the start, down to the feed height, back up at the end
+    assert np.count_nonzero(moves.rapid) == 4
 
 
 @pytest.mark.parametrize("text, match", [

@@ -127,7 +127,7 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
                                                                          direction, dialect):
     x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
     raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
-    settings = machine(dialect=dialect, mm_per_unit=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=1e6)
+    settings = machine(dialect=dialect, mm_per_unit=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=9e4)
     program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
     if dialect == "linuxcnc":
         path = tmp_path_factory.mktemp("any") / "any.ngc"
@@ -329,7 +329,8 @@ def test_heidenhain_program_shape():
 
 
 def test_safe_z_below_the_path_is_refused():
-    with pytest.raises(ToolpathError, match=r"safe Z 50 mm is not above the highest point of the path, 71.38\d mm"):
+    with pytest.raises(ToolpathError, match=r"safe Z 50 mm is less than the feed height 2 mm above the highest point "
+                                            r"of the path, 71.38\d mm"):
         macro_program(surface("paper-example-4"), MachineSettings(mm_per_unit=20.0), RasterSpec("x", 5.0, 5.0), FLAT)
 
 
@@ -497,8 +498,136 @@ def test_ball_end_gouge_is_refused_with_a_suggestion():
         macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
 
 
-def test_flat_tool_and_zero_diameter_program_the_surface():
+# ---------------------------------------------------------------- issue 13: programs a machinist can trust
+
+def _disc_max(coeffs, x0, y0, radius, box, n=81):
+    """Brute force: the highest point of the exact polynomial under a flat disc, over an n x n lattice in the box."""
+    xs = np.linspace(x0 - radius, x0 + radius, n)
+    gx, gy = np.meshgrid(xs, np.linspace(y0 - radius, y0 + radius, n))
+    inside = (np.hypot(gx - x0, gy - y0) <= radius) & (gx >= box[0]) & (gx <= box[1]) & (gy >= box[2]) & (gy <= box[3])
+    z = sum(float(c) * gx[inside] ** a * gy[inside] ** b for a, row in enumerate(coeffs) for b, c in enumerate(row))
+    return float(z.max())
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc", "heidenhain"])
+def test_a_flat_end_is_refused_naming_the_point_list_path(dialect):
     s = surface("paper-example-1")
-    a = macro_program(s, machine(), RasterSpec(), Tool("flat", 10.0)).text
-    b = macro_program(s, machine(), RasterSpec(), Tool("ball", 0.0)).text
-    assert a == b and "SQRT" not in a
+    settings = machine(dialect=dialect, mm_per_unit=10.0)
+    with pytest.raises(ToolpathError, match=r"flat-end cutter \(diameter 6 mm\).*lagsym toolpath --tool-shape flat"):
+        macro_program(s, settings, RasterSpec("x", 5.0, 5.0), Tool("flat", 6.0))
+    # Why: the height at the centre (what the program would have cut) lies far below the flat end's
+    # cutter location, the maximum of the exact polynomial under its disc (brute force, surface units).
+    box = [float(v) for v in s.grid.bounds]
+    x, y = (box[0] + box[1]) / 2, (box[2] + box[3]) / 2
+    centre = sum(float(c) * x ** a * y ** b for a, row in enumerate(s.coefficients) for b, c in enumerate(row))
+    worst = max(_disc_max(s.coefficients, px, py, 0.3, box) - sum(
+        float(c) * px ** a * py ** b for a, row in enumerate(s.coefficients) for b, c in enumerate(row))
+        for px in np.linspace(box[0], box[1], 9) for py in np.linspace(box[2], box[3], 9))
+    assert worst * 10.0 > 25.0 and np.isfinite(centre)  # 29 mm on this 9 x 9 sample
+
+
+def test_cli_flat_end_macro_exits_2(run_cli):
+    status, out, err = run_cli("macro", EXAMPLES / "paper-example-1.json", "--scale", 10, "--tool-shape", "flat",
+                               "--tool-diameter", 6, "--safe-z", 500)
+    assert status == 2 and out == "" and "lagsym toolpath" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("coolant, on", [("off", None), ("flood", "FLOOD_ON"), ("mist", "MIST_ON")])
+def test_macro_start_clearance_first_then_feed_height(rs274, tmp_path, coolant, on):
+    s = surface("paper-example-4")
+    settings = machine(dialect="linuxcnc", mm_per_unit=20.0, safe_z_mm=100.0, coolant=coolant,
+                       work_offset="G56", tool_number=3, length_offset=7, feed_height_mm=1.5)
+    program = macro_program(s, settings, RasterSpec("x", 5.0, 5.0), FLAT)
+    path = tmp_path / "m.ngc"
+    path.write_text(program.text)
+    r = rs274.run(path, tool_table="T3 P3 Z0 D6\nT7 P7 Z0.5 D6\n")
+    assert r.returncode == 0, r.stderr[-400:]
+    canon = [ln.split("N..... ", 1)[1] for ln in r.stdout.splitlines() if "N..... " in ln]
+    travs = [c for c in canon if c.startswith("STRAIGHT_TRAVERSE")]
+    first = [float(v) for v in travs[0][18:].split(",")[:3]]
+    assert first[:2] == [0.0, 0.0] and first[2] == 100.0  # Z first, straight up from where the machine is
+    want = planned_points(s, settings, RasterSpec("x", 5.0, 5.0), FLAT)
+    down = [float(v) for v in travs[2][18:].split(",")[:3]]
+    np.testing.assert_allclose(down, want[0] + [0, 0, 1.5], atol=1e-3)  # rapid to 1.5 mm above the first point
+    assert "SET_G5X_OFFSET(3," in r.stdout  # G56
+    assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 12.7000" in r.stdout  # H7, not H3
+    assert (on in r.stdout) if on else ("FLOOD_ON" not in r.stdout and "MIST_ON" not in r.stdout)
+    if on:
+        assert canon.index(next(c for c in canon if c.startswith(("FLOOD_OFF", "MIST_OFF")))) > canon.index(travs[-1])
+
+
+@pytest.mark.parametrize("options, match", [
+    (dict(work_offset="G54\nM30"), "work offset"),
+    (dict(tool_number=-1), "tool number -1"),
+    (dict(length_offset=0), "length offset H0"),
+    (dict(line_ending="cr"), "one block"),
+    (dict(coolant="water"), "coolant"),
+])
+def test_program_settings_are_validated(options, match):
+    with pytest.raises(InputError, match=match):
+        machine(**options)
+
+
+def test_safe_z_needs_a_feed_height_above_the_path():
+    s, raster = surface("paper-example-4"), RasterSpec("x", 5.0, 5.0)
+    with pytest.raises(ToolpathError, match=r"safe Z 71.5 mm is less than the feed height 2 mm above"):
+        macro_program(s, MachineSettings(mm_per_unit=20.0, safe_z_mm=71.5), raster, FLAT)
+
+
+@pytest.mark.parametrize("dialect, options, match", [
+    ("fanuc", dict(work_offset="G59.1"), "not one a fanuc control has"),
+    ("heidenhain", dict(work_offset="G55"), "active preset"),
+    ("fanuc", dict(length_offset=401), "H400"),
+    ("fanuc", dict(safe_z_mm=150000.0), r"beyond the 99999.999"),
+])
+def test_what_the_control_does_not_have_is_refused_with_the_limit(dialect, options, match):
+    with pytest.raises(ProgramError, match=match):
+        macro_program(surface("paper-example-1"), machine(dialect=dialect, **options), RasterSpec("x", 5.0, 5.0), FLAT)
+
+
+def test_constants_keep_8_digits_leading_zeros_counted():
+    """Every constant of an 8-digit Fanuc program has at most 8 digits, leading zeros included (a 0i's limit)."""
+    text = macro_program(rough_grid(7, seed=7), machine(), RasterSpec("x", 1.0, 1.0), FLAT).text
+    body = [ln for ln in text.splitlines() if ln.startswith("#")]
+    numbers = re.findall(r"(?<![#\w])(\d*\.\d*)", "\n".join(body))
+    assert numbers and max(len(n.replace(".", "")) for n in numbers) <= 8
+    assert not re.search(r"\b0\.\d{8}", text)  # the 9-digit 0.66666667 of old
+
+
+def test_comments_are_iso_840_without_commas():
+    for d in ("fanuc", "linuxcnc"):
+        text = macro_program(surface("paper-example-1"), machine(dialect=d), RasterSpec("x", 5.0, 5.0), FLAT).text
+        for comment in re.findall(r"\(([^)]*)\)", text):
+            assert re.fullmatch(r"[A-Z0-9 .+\-/]*", comment), comment
+
+
+def test_the_small_variable_profile_refuses_what_does_not_fit():
+    s = surface("paper-example-4")
+    ok = macro_program(s, machine(mm_per_unit=20.0), RasterSpec("x", 5.0, 5.0), FLAT, variables="small")
+    assert max(int(v) for v in re.findall(r"#(\d+)", ok.text)) <= 149
+    big = rough_grid(7, seed=7, zmax=1)
+    with pytest.raises(ProgramError, match=r"51 needed.*#100-#149, #500-#531"):
+        macro_program(big, machine(), RasterSpec("x", 1.0, 1.0), Tool("ball", 2.0), variables="small")
+    macro_program(big, machine(), RasterSpec("x", 1.0, 1.0), Tool("ball", 2.0), variables="full")
+
+
+def test_a_step_below_the_resolution_is_refused():
+    with pytest.raises(ToolpathError, match=r"forward step 0.0005 is below the program's resolution 0.001"):
+        macro_program(surface("paper-example-1"), machine(), RasterSpec("x", 5.0, 0.0005), FLAT)
+
+
+def test_an_inch_surface_is_25_4_mm_a_unit_and_the_header_says_so(run_cli, tmp_path):
+    f = tmp_path / "inch.json"
+    data = json.loads((EXAMPLES / "paper-example-4.json").read_text())
+    data["units"] = "inch"
+    f.write_text(json.dumps(data))
+    status, out, err = run_cli("macro", f, "--dialect", "linuxcnc", "--tool-diameter", 0, "--safe-z", 100)
+    assert status == 0, err
+    assert "(SURFACE IN INCH 25.4 MM PER UNIT PROGRAM IN MM)" in out
+    mm = run_cli("macro", EXAMPLES / "paper-example-4.json", "--dialect", "linuxcnc", "--tool-diameter", 0,
+                 "--scale", 25.4, "--safe-z", 100)[1]
+    assert out.replace("INCH", "MM") == mm  # the same part, said to be in inches
+    data["units"] = "furlongs"
+    f.write_text(json.dumps(data))
+    status, out, err = run_cli("macro", f, "--tool-diameter", 0, "--safe-z", 100)
+    assert status == 2 and "mm" in err and "inch" in err

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import re
+import tempfile
+from pathlib import Path
 from fractions import Fraction
 
 import numpy as np
@@ -19,7 +21,7 @@ from lagsym.post.program import PointProgram, format_moves, iso_comment, point_p
 from lagsym.toolpath import plan_toolpath
 
 from conftest import EXAMPLES
-from gcheck import check_feeds, interpret
+from gcheck import check_feeds, interpret, resolution_mm
 
 POINT_DIALECTS = ("fanuc", "linuxcnc", "grbl")
 NUMBER_WORD = re.compile(r"([XYZF])(-?[0-9.]+)")
@@ -43,8 +45,13 @@ def test_interpreter_feeds_are_the_planned_cutter_locations(rs274, path4, dialec
     text, s = program_text(path4, dialect=dialect, units=units, line_ending=line_ending)
     feeds, travs = interpret(rs274, text)
     check_feeds(feeds, path4.points_mm, s)
-    # Up to safe Z at the start and at the end only: the zig-zag keeps the tool down between rows.
-    assert np.count_nonzero(np.isclose(travs[:, 2], 80.0, atol=0.01)) == 2
+    # Straight up to the clearance plane first, over the first point, rapid down to the feed height (2 mm)
+    # above it, up again at the end only: the zig-zag keeps the tool down between rows.
+    first = path4.points_mm[0]
+    np.testing.assert_allclose(travs[0], [0.0, 0.0, 80.0], atol=resolution_mm(s))
+    np.testing.assert_allclose(travs[1], [first[0], first[1], 80.0], atol=resolution_mm(s))
+    np.testing.assert_allclose(travs[2], first + [0.0, 0.0, 2.0], atol=2 * resolution_mm(s))
+    assert len(travs) == 4 and np.isclose(travs[3, 2], 80.0, atol=1e-3)
     assert text.count("\r\n") == (text.count("\n") if line_ending == "crlf" else 0)
 
 
@@ -143,3 +150,68 @@ def test_the_dialect_modules_do_not_import_the_writer_table():
     graph = grimp.build_graph("lagsym")
     for module in ("fanuc", "linuxcnc", "grbl", "model", "moves"):
         assert not graph.find_shortest_chain(importer=f"lagsym.post.{module}", imported="lagsym.post.program")
+
+
+@pytest.mark.parametrize("dialect", POINT_DIALECTS)
+def test_program_start_and_end_as_a_machinist_expects(rs274, path4, dialect):
+    """rs274's canonical calls: clearance Z before any XY move, coolant on after it and off after the retract,
+    the plunge feed only over the feed height, the work offset and length offset asked for."""
+    options = dict(coolant="flood", work_offset="G55", feed_height_mm=3.0)
+    if dialect != "grbl":
+        options.update(tool_number=3, length_offset=7)
+    text, s = program_text(path4, dialect=dialect, **options)
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "p.ngc"
+        path.write_text(text)
+        r = rs274.run(path, tool_table="T1 P1 Z0 D6\nT3 P3 Z0 D6\nT7 P7 Z0.5 D6\n")
+    assert r.returncode == 0, r.stderr[-400:]
+    canon = [ln.split("N..... ", 1)[1] for ln in r.stdout.splitlines() if "N..... " in ln]
+    moves = [c for c in canon if c.startswith(("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"))]
+    xyz = np.array([[float(v) for v in c[c.index("(") + 1:].split(",")[:3]] for c in moves])
+    assert moves[0].startswith("STRAIGHT_TRAVERSE") and xyz[0].tolist() == [0.0, 0.0, 80.0]
+    plunge = xyz[3] - xyz[2]
+    assert moves[3].startswith("STRAIGHT_FEED") and plunge[:2].tolist() == [0.0, 0.0]
+    assert -plunge[2] == pytest.approx(3.0, abs=2e-3)  # 3 mm at plunge feed, not the 60 from safe Z
+    assert canon.index("FLOOD_ON()") < canon.index(moves[1]) and canon.index("FLOOD_OFF()") > canon.index(moves[-1])
+    assert "SET_G5X_OFFSET(2," in r.stdout
+    if dialect != "grbl":
+        assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 12.7000" in r.stdout and "SELECT_TOOL(3)" in r.stdout
+
+
+@pytest.mark.parametrize("options, error, match", [
+    (dict(safe_z_mm=None), ProgramError, r"less than the feed height 2 mm above the highest cutter location"),
+    (dict(work_offset="G54 (X)"), InputError, "work offset"),
+    (dict(tool_number=-1), InputError, "tool number -1"),
+    (dict(line_ending="cr"), InputError, "one block"),
+    (dict(dialect="fanuc", work_offset="G59.2"), ProgramError, "not one a fanuc control has"),
+    (dict(dialect="grbl", length_offset=2), ProgramError, "no tool length offset"),
+    (dict(origin_mm=(0.0, 0.0, 149900.0), safe_z_mm=150000.0), ProgramError, r"beyond the 99999.999"),
+])
+def test_what_a_control_would_refuse_is_refused_with_the_limit(path4, options, error, match):
+    if options.get("safe_z_mm", 1) is None:  # 57 um above the highest cutter location
+        options["safe_z_mm"] = float(path4.points_mm[:, 2].max()) + 0.057
+    with pytest.raises(error, match=match):
+        program_text(path4, **options)
+
+
+def test_the_header_says_the_surface_units():
+    p = PointProgram(np.array([[0.0, 0.0, 1.0], [2.0, 0.0, 1.0]]),
+                     MachineSettings(mm_per_unit=25.4, surface_units="inch", units="inch"))
+    assert "(SURFACE IN INCH 25.4 MM PER UNIT PROGRAM IN INCH)" in write_program(p)
+
+
+def test_cli_inch_surface_is_programmed_at_25_4_mm_a_unit(rs274, run_cli, tmp_path):
+    import json
+
+    data = json.loads((EXAMPLES / "paper-example-4.json").read_text())
+    data["units"] = "inch"
+    f = tmp_path / "inch.json"
+    f.write_text(json.dumps(data))
+    args = ("--stepover", 5, "--step", 5, "--safe-z", 120, "--dialect", "linuxcnc")
+    status, text, err = run_cli("toolpath", f, *args)
+    assert status == 0, err
+    same = run_cli("toolpath", EXAMPLES / "paper-example-4.json", "--scale", 25.4, *args)[1]
+    assert text.replace("INCH 25.4", "MM 25.4").replace("INCH.JSON", "PAPER-EXAMPLE-4.JSON") == same
+    feeds, _ = interpret(rs274, text)
+    x0, x1, y0, y1 = (float(v) for v in read_points(EXAMPLES / "paper-example-4.json").bounds)
+    assert feeds[:, 0].min() == pytest.approx(x0 * 25.4, abs=1e-3) and feeds[:, 0].max() == pytest.approx(x1 * 25.4, abs=1e-3)

@@ -57,3 +57,40 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
     if f.snapped is not None:
         err.write(f.snapped.text(str(path)) + "\n")
     return f.points
+
+
+def add_program_arguments(g) -> None:
+    """The program start and end options a point-list and a macro program share (argument group ``g``)."""
+    from ..machine import COOLANTS, PROGRAM_LINE_ENDINGS
+
+    g.add_argument("--scale", type=float, default=1.0,
+                   help="model scale: the part is SCALE times the size the points describe, in their units "
+                        "(a file in inches is 25.4 mm per unit at scale 1; default 1)")
+    g.add_argument("--work-offset", default="G54", metavar="G5x",
+                   help="work offset: G54 (default) to G59, G54.1 Pn (Fanuc), G59.1-G59.3 (LinuxCNC)")
+    g.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool number T (default 1)")
+    g.add_argument("--length-offset", type=int, metavar="H",
+                   help="tool length offset number for G43 H (default: the tool number)")
+    g.add_argument("--feed-height", type=float, default=2.0, metavar="MM",
+                   help="height above the first point where the rapid down ends and the plunge feed begins "
+                        "(default 2); --safe-z must be at least this far above the path")
+    g.add_argument("--coolant", choices=COOLANTS, default="off",
+                   help="off (default), flood (M08) or mist (M07); M09 at the end")
+    g.add_argument("--line-ending", choices=PROGRAM_LINE_ENDINGS, default="lf", help="lf (default) or crlf")
+
+
+def program_settings(args, grid, **kw):
+    """The :class:`~lagsym.machine.MachineSettings` of the program options, for a surface read from ``grid``.
+
+    The surface's units (from its file; millimetres if it names none) and
+    ``--scale`` give the millimetres per surface unit.
+    """
+    from ..machine import MachineSettings, mm_per_surface_unit
+
+    units = grid.units or "mm"
+    return MachineSettings(
+        mm_per_unit=mm_per_surface_unit(units, args.scale), surface_units=units, origin_mm=origin(args.origin),
+        units=args.units, feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
+        safe_z_mm=args.safe_z, program_number=args.program, work_offset=args.work_offset,
+        line_ending=args.line_ending, decimals=args.decimals, tool_number=args.tool_number,
+        length_offset=args.length_offset, feed_height_mm=args.feed_height, coolant=args.coolant, **kw)

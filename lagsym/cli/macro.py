@@ -7,7 +7,8 @@ from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
-from ._common import emit, origin
+from ..gcode.limits import VARIABLE_PROFILES
+from ._common import add_program_arguments, emit, program_settings
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
@@ -47,16 +48,18 @@ def add_arguments(p) -> None:
                    help="largest arithmetic error accepted on the control, mm (default 0.001)")
     p.add_argument("--variable-base", type=int, metavar="N",
                    help="first variable number: Fanuc #100 (default) or #500, Heidenhain Q1 (default)")
-    p.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    p.add_argument("--variables", choices=VARIABLE_PROFILES, default="full",
+                   help="the control's variable ranges: full (Fanuc #100-#199, #500-#999; default) or small "
+                        "(#100-#149, #500-#531, smaller Fanuc controls); a program that does not fit is refused")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added, mm")
     p.add_argument("--units", choices=("mm", "inch"), default="mm", help="program units (default mm)")
     p.add_argument("--direction", choices=("x", "y"), default="x", help="rows run along x (default) or y")
     p.add_argument("--stepover", type=float, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
     p.add_argument("--step", type=float, default=0.2, metavar="MM", help="forward step along a row, mm (default 0.2)")
-    p.add_argument("--tool-shape", choices=("ball", "flat"), default="ball", help="cutter shape (default ball)")
+    p.add_argument("--tool-shape", choices=("ball", "flat"), default="ball",
+                   help="cutter shape (default ball); a flat end is refused: use lagsym toolpath for it")
     p.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
                    help="cutter diameter, mm; 0 programs the surface itself (default 6)")
-    p.add_argument("--tool-number", type=int, default=1, metavar="T")
     p.add_argument("--feed", type=float, default=600.0, metavar="MM_MIN", help="cutting feed (default 600)")
     p.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM_MIN", help="plunge feed (default 200)")
     p.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
@@ -64,31 +67,25 @@ def add_arguments(p) -> None:
                    help="clearance height for rapid moves, above the whole path (default 50)")
     p.add_argument("--stock", type=float, default=0.0, metavar="MM", help="stock to leave (default 0)")
     p.add_argument("--program", type=int, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
-    p.add_argument("--work-offset", default="G54", help="work offset (default G54)")
-    p.add_argument("--line-ending", choices=("lf", "crlf", "cr"), default="lf")
     p.add_argument("--decimals", type=int, metavar="N", help="decimals in positions (default 3 mm, 4 inch)")
+    add_program_arguments(p.add_argument_group("machine and program"))
     p.add_argument("--stats", action="store_true",
                    help="compare the program's size with the equivalent point list, and their 9600-baud transfer times")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
 
 
-def settings_from(args) -> tuple[MachineSettings, RasterSpec, Tool]:
-    """The machine, raster and tool the arguments describe."""
-    settings = MachineSettings(
-        dialect=args.dialect, mm_per_unit=args.scale, origin_mm=origin(args.origin), units=args.units,
-        feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
-        safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock, program_number=args.program,
-        work_offset=args.work_offset, line_ending=args.line_ending, decimals=args.decimals,
-        tool_number=args.tool_number)
+def settings_from(args, grid) -> tuple[MachineSettings, RasterSpec, Tool]:
+    """The machine, raster and tool the arguments describe, for the surface read from ``grid``."""
+    settings = program_settings(args, grid, dialect=args.dialect, stock_to_leave_mm=args.stock)
     raster = RasterSpec(direction=args.direction, stepover_mm=args.stepover, step_mm=args.step)
     return settings, raster, Tool(shape=args.tool_shape, diameter_mm=args.tool_diameter)
 
 
 def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.file))
-    settings, raster, tool = settings_from(args)
-    program = macro_program(surface, settings, raster, tool, precision=args.precision,
-                            tolerance_mm=args.tolerance, variable_base=args.variable_base, form=args.form)
+    settings, raster, tool = settings_from(args, surface.grid)
+    program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,
+                            variable_base=args.variable_base, form=args.form, variables=args.variables)
     emit(program.text, args.output, out)
     if args.stats:
         counted = program.loops.raster

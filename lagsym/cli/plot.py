@@ -57,7 +57,7 @@ def add_arguments(p) -> None:
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
                    help="surface (default), basis, compare, 'toolpath PROGRAM' or 'growth FORMULA'")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
-    p.add_argument("--units", default="mm", help="length unit for the axis labels (default: mm)")
+    p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
                    help="picture size in pixels (default: 1280x960)")
     p.add_argument("--z-exaggeration", type=float, metavar="K",
@@ -66,7 +66,7 @@ def add_arguments(p) -> None:
                         "proportions")
     p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
     p.add_argument("--scale", type=float, default=None,
-                   help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
+                   help="with --show toolpath: the --scale the program was made with (default 1)")
     p.add_argument("--origin", default=None, metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
 
@@ -104,7 +104,8 @@ def run(args, out, err) -> int:
         raise InputError("no display to open a window on: give -o FILE to write the picture to a file")
     points = read_any_points(file)
     _check_options(what, isinstance(points, CurvePoints), args)
-    opts = dict(units=args.units, window_size=args.size, off_screen=True if args.output else None)
+    units = args.units or getattr(points, "units", None) or "mm"  # the points file's units unless told
+    opts = dict(units=units, window_size=args.size, off_screen=True if args.output else None)
     if args.samples is not None:
         opts["samples"] = args.samples
     if args.z_exaggeration is not None:
@@ -134,7 +135,7 @@ def _check_options(what: str, curve: bool, args) -> None:
         raise InputError(f"--show {what} needs a surface: a file of x, y, z points")
     if what != "toolpath" and (args.scale is not None or args.origin is not None):
         raise InputError("--scale and --origin place a program on the machine: they go with --show toolpath PROGRAM")
-    if what == "toolpath" and args.units != "mm":
+    if what == "toolpath" and args.units not in (None, "mm"):
         raise InputError(f"--units {args.units}: a toolpath is drawn in the machine's millimetres")
     if args.z_exaggeration is not None and (curve or what in ("basis", "growth")):
         raise InputError("--z-exaggeration applies to a surface, --show compare and --show toolpath")
@@ -172,13 +173,14 @@ def _toolpath_figure(plot, grid, program, args, opts):
 
     from ..gcode import move_points
     from ..io import read_program
-    from ..machine import Placement
+    from ..machine import Placement, mm_per_surface_unit
     from ._common import origin
 
     points_mm, rapid = move_points(read_program(program), source=program)
     if not len(points_mm):
         raise InputError(f"{program}: no move with a Z position to draw")
+    place = Placement(mm_per_surface_unit(grid.units, 1.0 if args.scale is None else args.scale),
+                      origin(args.origin or "0,0,0"))
     ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
     opts = {k: v for k, v in opts.items() if k != "units"}  # checked in run: the machine's mm
-    return plot.toolpath_figure(lagrange_surface(grid), points_mm, rapid=ends_rapid,
-                                placement=Placement(1.0 if args.scale is None else args.scale, origin(args.origin or "0,0,0")), **opts)
+    return plot.toolpath_figure(lagrange_surface(grid), points_mm, rapid=ends_rapid, placement=place, **opts)

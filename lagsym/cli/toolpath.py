@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
-from ..machine import DIRECTIONS, LINE_ENDINGS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
+from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
 from ..post.program import point_program, write_program
 
-from ._common import origin
+from ._common import add_program_arguments, program_settings
 
 NAME = "toolpath"
 ORDER = 60
@@ -44,9 +44,8 @@ def add_arguments(p) -> None:
     t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
     t.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
                    help="cutter diameter (default 6; 0 gives the uncompensated path on the surface)")
-    t.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool and length offset number (default 1)")
-    m = p.add_argument_group("machine")
-    m.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    m = p.add_argument_group("machine and program")
+    add_program_arguments(m)
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
     m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
     m.add_argument("--feed", type=float, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
@@ -55,25 +54,20 @@ def add_arguments(p) -> None:
     m.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="retract height (default 50)")
     m.add_argument("--stock-to-leave", type=float, default=0.0, metavar="MM", help="material left on the surface")
     m.add_argument("--program", type=int, default=1000, metavar="N", help="program number O N (default 1000)")
-    m.add_argument("--line-ending", choices=tuple(LINE_ENDINGS), default="lf", help="lf (default), crlf or cr")
     m.add_argument("--decimals", type=int, metavar="N", help="decimals in coordinates (default 3 for mm, 4 for inch)")
     m.add_argument("--title", help="comment at the top of the program (default: the points file's name)")
 
 
-def settings_from(args, dialect: str) -> MachineSettings:
-    """The machine settings the arguments describe."""
-    return MachineSettings(
-        dialect=dialect, mm_per_unit=args.scale, origin_mm=origin(args.origin), units=args.units,
-        feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed, spindle_rpm=args.spindle,
-        safe_z_mm=args.safe_z, stock_to_leave_mm=args.stock_to_leave, program_number=args.program,
-        line_ending=args.line_ending, decimals=args.decimals, tool_number=args.tool_number)
+def settings_from(args, dialect: str, grid) -> MachineSettings:
+    """The machine settings the arguments describe, for the surface read from ``grid``."""
+    return program_settings(args, grid, dialect=dialect, stock_to_leave_mm=args.stock_to_leave)
 
 
 def run(args, out, err) -> int:
     from ..toolpath import plan_toolpath
 
     grid = read_points(args.file)
-    settings = settings_from(args, args.dialect)
+    settings = settings_from(args, args.dialect, grid)
     tool = Tool(args.tool_shape, args.tool_diameter)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)

@@ -6,7 +6,7 @@ from ..errors import ExitStatus, InputError
 from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
-from ..machine import TOOL_SHAPES, Placement, Tool
+from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ._common import origin
 
 NAME = "verify"
@@ -31,7 +31,7 @@ def add_arguments(p) -> None:
     p.add_argument("program", help="G-code program (point list: G00/G01 moves)")
     p.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
     p.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM", help="cutter diameter (default 6)")
-    p.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    p.add_argument("--scale", type=float, default=1.0, help="model scale, as for toolpath: a points file in inches is 25.4 mm per unit at scale 1 (default 1)")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset the program was made with, mm")
     p.add_argument("--cell", type=float, metavar="MM", help="height-map cell size (default: box side / 400)")
     p.add_argument("--gouge-limit", type=float, metavar="MM",
@@ -42,8 +42,8 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     from ..verify import simulate_cut
 
-    place = Placement(args.scale, origin(args.origin))
     surface = lagrange_surface(read_points(args.surface))
+    place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
     report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), place, cell_mm=args.cell, gouge_limit_mm=args.gouge_limit)

@@ -31,7 +31,7 @@ from .form import RowForm, row_form
 from .model import Assign, add, const, div, mul, sqrt, sub, var
 from .raster import MacroRaster, sample_positions
 
-__all__ = ["is_ball", "ball_offsets", "contact_form", "offset_points", "offset_statements", "TIP_OUTPUTS",
+__all__ = ["is_ball", "refuse_flat_end", "ball_offsets", "contact_form", "offset_points", "offset_statements", "TIP_OUTPUTS",
            "check_gouge", "check_gouge_over", "tip_points", "derivatives"]
 
 TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is computed into
@@ -40,6 +40,23 @@ TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is c
 def is_ball(tool: Tool | None) -> bool:
     """True for a ball-end cutter with a diameter: one that is offset along the normal."""
     return tool is not None and tool.shape == "ball" and tool.diameter_mm > 0
+
+
+def refuse_flat_end(tool: Tool | None) -> None:
+    """Refuse a flat-end cutter with a diameter: its cutter location is not a height the control can compute.
+
+    A flat end of radius ``R`` rests on the highest point of the surface under
+    its disc, ``max Z`` over the disc, which has no closed form; the height at
+    the centre (what a zero diameter programs) lies below it wherever the
+    surface slopes and the cutter would cut into the part (30.4 mm on paper
+    example 1 at scale 10 with a 6 mm cutter).
+    """
+    if tool is not None and tool.shape == "flat" and tool.diameter_mm > 0:
+        raise ToolpathError(
+            f"a flat-end cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
+            "which a macro cannot compute on the control: use the point-list toolpath "
+            "(lagsym toolpath --tool-shape flat), which drops the flat end onto the exact surface, "
+            "or a ball end (--tool-shape ball), or --tool-diameter 0 for the surface itself")
 
 
 def ball_offsets(settings: MachineSettings, tool: Tool) -> tuple[float, float]:

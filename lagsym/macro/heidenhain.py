@@ -10,14 +10,14 @@ runs at least once (every loop of a surface program does).  Blocks are numbered 
 from __future__ import annotations
 
 from ..errors import ProgramError
-from ..gcode import limits
+from ..gcode.limits import check_axis, check_blocks, check_settings, variable_ranges
 from ..gcode.numbers import fixed
-from ._render import literal, number_variables
-from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var, variables
+from ._render import header_comments, literal, number_variables
+from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var
+from .model import variables as variables_of
 
-__all__ = ["render", "VARIABLE_RANGES", "DEFAULT_BASE", "MAX_LABEL"]
+__all__ = ["render", "DEFAULT_BASE", "MAX_LABEL"]
 
-VARIABLE_RANGES = limits.MACRO_VARIABLES["heidenhain"]
 DEFAULT_BASE = 1
 MAX_LABEL = 254
 _FN = {"+": 1, "-": 2, "*": 3, "/": 4}
@@ -50,7 +50,7 @@ class _Blocks:
     def operand(self, e) -> str:
         if isinstance(e, Var):
             return "+" + self.q(e)
-        return _signed(literal(e.value, self.precision))
+        return _signed(literal(e.value, self.precision, leading_zero=True))
 
     def assign(self, target: Var, e, depth: int = 0) -> None:
         # One FN block per operation.  The left operand is built in the target itself
@@ -103,28 +103,42 @@ class _Blocks:
                 out.append(f"L X+{q(s.x)} Y+{q(s.y)} Z+{q(s.z)} R0 {self.feed}")
 
 
-def render(loops, settings, precision: int = 8, variable_base: int | None = None) -> str:
-    """The Heidenhain program for ``loops``: ``FN`` arithmetic on Q parameters, labels and jumps."""
+def render(loops, settings, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> str:
+    """The Heidenhain program for ``loops``: ``FN`` arithmetic on Q parameters, labels and jumps.
+
+    The datum is the control's active preset (a TNC has no G-code work
+    offset); ``M30`` at the end also stops the spindle and the coolant.
+    """
+    check_settings(settings)
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
-    names = variables(loops.body) + [f"h{n}" for n in range(SCRATCH)]
-    number = number_variables([Assign(Var(n), Const(0)) for n in names], base, VARIABLE_RANGES, letter="Q")
-    dp = settings.digits
+    names = variables_of(loops.body) + [f"h{n}" for n in range(SCRATCH)]
+    number = number_variables([Assign(Var(n), Const(0)) for n in names], base,
+                              variable_ranges("heidenhain", variables), letter="Q")
+    dp, uf = settings.digits, settings.unit_factor
     unit = "MM" if settings.units == "mm" else "INCH"
 
     def pos(v) -> str:
         return _signed(fixed(v, dp))
 
-    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}",
-                      f"; lagsym surface macro, {loops.form.shape[0]}x{loops.form.shape[1]}, "
-                      f"normalized {loops.form.kind} form",
-                      f"; {loops.raster.size} points, rows along {loops.raster.direction}, {precision}-digit arithmetic",
-                      f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
-                      f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M3"]
+    safe = pos(settings.safe_z_mm * uf)
+    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}", "; LAGSYM SURFACE MACRO"]
+    out += [f"; {c}" for c in header_comments(loops, settings, precision)]
+    out += [f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
+            f"L Z{safe} R0 FMAX M3"]
     x0, y0, z0 = loops.start
-    out.append(f"L X{pos(x0)} Y{pos(y0)} R0 FMAX")
-    out.append(f"L Z{pos(z0)} R0 F{int(round(settings.plunge_feed_mm_min * settings.unit_factor))}")
-    feed = f"F{int(round(settings.feed_mm_min * settings.unit_factor))}"
+    check_axis([x0, y0, z0, settings.safe_z_mm * uf], settings, "the first point")
+    cool = {"off": "", "flood": " M8", "mist": " M7"}[settings.coolant]
+    out.append(f"L X{pos(x0)} Y{pos(y0)} R0 FMAX{cool}")
+    approach = float(z0) + settings.feed_height_mm * uf
+    if approach < settings.safe_z_mm * uf:
+        out.append(f"L Z{pos(approach)} R0 FMAX")
+    out.append(f"L Z{pos(z0)} R0 F{int(round(settings.plunge_feed_mm_min * uf))}")
+    feed = f"F{int(round(settings.feed_mm_min * uf))}"
     _Blocks(number, precision, feed, out).emit(loops.body)
-    out.append(f"L Z{pos(settings.safe_z_mm * settings.unit_factor)} R0 FMAX M30")
+    if settings.coolant != "off":
+        out.append(f"L Z{safe} R0 FMAX M9")
+    out.append(f"L Z{safe} R0 FMAX M30")
     out.append(f"END PGM {settings.program_number} {unit}")
-    return settings.eol.join(f"{n} {line}" for n, line in enumerate(out)) + settings.eol
+    lines = [f"{n} {line}" for n, line in enumerate(out)]
+    check_blocks(lines, "heidenhain")
+    return settings.eol.join(lines) + settings.eol

@@ -31,7 +31,7 @@ import numpy as np
 from ..lagrange import LagrangeSurface, horner2
 from ..machine import MachineSettings, RasterSpec, Tool
 from .ballend import TIP_OUTPUTS, ball_offsets, check_gouge_over, contact_form, is_ball, offset_points, \
-    offset_statements
+    offset_statements, refuse_flat_end
 from .form import RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, mul, sub, var
 from .raster import MacroRaster, macro_raster
@@ -123,8 +123,11 @@ def macro_loops(surface: LagrangeSurface, settings: MachineSettings, raster: Ras
                 tool: Tool | None = None, form: str = "horner") -> MacroLoops:
     """The loops for ``surface``: counted rows and points and the statements of the height (``form``).
 
-    A ball-end ``tool`` with a diameter gets the normal offset of :mod:`lagsym.macro.ballend`.
+    A ball-end ``tool`` with a diameter gets the normal offset of :mod:`lagsym.macro.ballend`;
+    a zero diameter programs the surface itself.  A flat end with a diameter is
+    refused (:func:`~lagsym.macro.ballend.refuse_flat_end`).
     """
+    refuse_flat_end(tool)
     counted = macro_raster(surface, settings, raster)
     if is_ball(tool):
         return _ball_loops(surface, settings, counted, tool, form)

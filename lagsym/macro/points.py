@@ -14,7 +14,7 @@ from ..evaluate import evaluate_points
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ._placement import placement
-from .ballend import is_ball, tip_points
+from .ballend import is_ball, refuse_flat_end, tip_points
 from .raster import macro_raster, raster_positions
 
 __all__ = ["points_at", "planned_points"]
@@ -28,6 +28,7 @@ def points_at(surface: LagrangeSurface, settings: MachineSettings, tool: Tool | 
     tip of a ball whose centre sits one radius (plus stock) off the surface
     along its normal.
     """
+    refuse_flat_end(tool)
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if is_ball(tool):
         return tip_points(surface, settings, tool, x, y)

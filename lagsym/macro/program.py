@@ -18,6 +18,7 @@ from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..values import choice
 from . import fanuc, heidenhain, linuxcnc
+from ..gcode.limits import check_axis
 from .accuracy import predicted_error
 from .form import FORMS
 from .loops import MacroLoops, macro_loops
@@ -42,10 +43,14 @@ def _check_clearance(surface, settings, tool, loops: MacroLoops) -> None:
     """
     uf = settings.unit_factor
     z = points_at(surface, settings, tool, *sample_positions(loops.raster))[:, 2]
+    check_axis(z, settings, "the height of the path")
     top = (float(z.max()) + 0.01 * float(np.ptp(z))) / uf
-    if settings.safe_z_mm <= top:
-        raise ToolpathError(f"safe Z {settings.safe_z_mm:g} mm is not above the highest point of the path, "
-                            f"{float(z.max()) / uf:.3f} mm: the rapid moves would hit the part; raise --safe-z")
+    if settings.safe_z_mm < top + settings.feed_height_mm:
+        raise ToolpathError(f"safe Z {settings.safe_z_mm:g} mm is less than the feed height "
+                            f"{settings.feed_height_mm:g} mm above the highest point of the path, "
+                            f"{float(z.max()) / uf:.3f} mm (with 1 % of the height range for what lies between "
+                            f"the raster points): raise --safe-z to at least {top + settings.feed_height_mm:.3f} mm "
+                            f"or lower --feed-height")
 
 
 @dataclass(frozen=True)
@@ -81,7 +86,7 @@ class MacroProgram:
 
 def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: RasterSpec,
                   tool: Tool | None = None, *, precision: int | None = None, tolerance_mm: float = 0.001,
-                  variable_base: int | None = None, form: str | None = None) -> MacroProgram:
+                  variable_base: int | None = None, form: str | None = None, variables: str = "full") -> MacroProgram:
     """A parametric program that evaluates ``surface`` on the control while it cuts the raster.
 
     Parameters
@@ -101,6 +106,10 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
         Largest arithmetic error accepted; a program predicted to exceed it is refused.
     variable_base : int, optional
         First variable number (Fanuc ``#100`` or ``#500``, Heidenhain ``Q1``).
+    variables : str
+        ``"full"`` or ``"small"``: the variable ranges of the control's macro
+        option (see :data:`lagsym.gcode.limits.LIMITS`); a program that does
+        not fit is refused.
     form : str, optional
         ``"horner"`` (shortest) or ``"lagrange"`` (tensor-product basis, the most
         accurate); by default Lagrange for 8 digits and Horner for 15.
@@ -110,7 +119,11 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
     InputError
         If the dialect, precision or form is not one of its choices.
     ProgramError
-        If the predicted error exceeds ``tolerance_mm`` or the variables do not fit.
+        If the predicted error exceeds ``tolerance_mm``, the variables do not fit, or
+        a block, number or step is beyond what the dialect's control reads.
+    ToolpathError
+        For a flat-end cutter with a diameter (see :func:`lagsym.macro.loops.macro_loops`),
+        or a safe Z less than the feed height above the path.
     """
     dialect = choice(settings.dialect, MACRO_DIALECTS, "macro dialect")
     precision = DEFAULT_PRECISION[dialect] if precision is None else choice(int(precision), PRECISIONS, "precision")
@@ -125,5 +138,5 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
             f"more than the tolerance {tolerance_mm:g} mm; use a control with 15-digit arithmetic "
             f"(--precision 15){', the lagrange form' if form == 'horner' else ''}, fewer control points, "
             f"or the point-list toolpath")
-    text = RENDERERS[dialect](loops, settings, precision=precision, variable_base=variable_base)
+    text = RENDERERS[dialect](loops, settings, precision=precision, variable_base=variable_base, variables=variables)
     return MacroProgram(text=text, dialect=dialect, precision=precision, predicted_error_mm=err_mm, loops=loops)

@@ -108,6 +108,11 @@ def macro_raster(surface: LagrangeSurface, settings: MachineSettings, raster: Ra
     ya = (y0 * s + oy, y1 * s + oy)
     side = as_exact(raster.stepover_mm, "side step") * place.per_mm
     forward = as_exact(raster.step_mm, "forward step") * place.per_mm
+    unit = Fraction(1, 10 ** settings.digits)
+    for what, step in (("side step", side), ("forward step", forward)):
+        if step < unit:  # the control would repeat the previous block, to the program's last decimal
+            raise ToolpathError(f"{what} {float(step):g} is below the program's resolution {float(unit):g} "
+                                f"({settings.digits} decimals in {settings.units}): use a larger step or --decimals")
     if raster.direction == "x":
         return MacroRaster("x", rows=_axis("Y", *ya, side), points=_axis("X", *xa, forward))
     return MacroRaster("y", rows=_axis("X", *xa, side), points=_axis("Y", *ya, forward))

@@ -60,6 +60,12 @@ def bar_column(p, row: int, col: int, mapper, title: str, height_px: int) -> Non
                                                position_y=0.08))
 
 
+def units_of(surface, units: str | None) -> str:
+    """The label unit: ``units`` if given, else the units the surface's points file names, else mm."""
+    source = getattr(surface, "grid", None) or getattr(surface, "points", None)
+    return units or getattr(source, "units", None) or "mm"
+
+
 def axis_labels(plotter, units: str, font_size: int = 10, **extra) -> None:
     """A grid with x, y and z titled in ``units`` (``extra`` goes to ``show_grid``, e.g. ``axes_ranges``)."""
     plotter.show_grid(xtitle=f"x ({units})", ytitle=f"y ({units})", ztitle=f"z ({units})", color="black",

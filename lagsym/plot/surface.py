@@ -25,6 +25,7 @@ from .style import (
     POINT_COLOR,
     SURFACE_CMAP,
     axis_labels,
+    units_of,
     bar_args,
     bar_column,
     chart_text,
@@ -48,7 +49,7 @@ def sampled_surface(surface, samples: int) -> tuple[np.ndarray, np.ndarray, np.n
     return g.xs, g.ys, evaluate_grid(surface, g.xs, g.ys)
 
 
-def surface_figure(surface, *, samples: int = 61, units: str = "mm", title: str | None = None,
+def surface_figure(surface, *, samples: int = 61, units: str | None = None, title: str | None = None,
                    cmap: str = SURFACE_CMAP, control_net: bool = True, scalar_bar: bool = True,
                    z_exaggeration: float | None = None, window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
                    off_screen: bool | None = None):
@@ -85,6 +86,7 @@ def surface_figure(surface, *, samples: int = 61, units: str = "mm", title: str 
     pyvista.Plotter
     """
     xs, ys, zz = sampled_surface(surface, samples)
+    units = units_of(surface, units)
     w, h = check_window_size(window_size)
     p = new_plotter(window_size=(w, h), off_screen=off_screen)
     name = f"z ({units})"
@@ -111,7 +113,7 @@ def _add_control(p, x, y, z, size: float = 12.0) -> None:
                render_points_as_spheres=True)
 
 
-def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | None = None,
+def curve_figure(curve, *, samples: int = 401, units: str | None = None, title: str | None = None,
                  window_size: Sequence[int] = DEFAULT_WINDOW_SIZE, off_screen: bool | None = None):
     """The 1-D interpolant with the points it passes through (the paper's Figures 2-3).
 
@@ -141,6 +143,7 @@ def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | N
     xs = axis_lines(curve.points.x[0], curve.points.x[-1], n)
     ys = evaluate_curve(curve, xs)
     p = new_plotter(window_size=window_size, off_screen=off_screen)
+    units = units_of(curve, units)
     chart = pv.Chart2D(x_label=f"x ({units})", y_label=f"y ({units})")
     chart.title = title if title is not None else title_for(curve)
     chart.line(xs, ys, color="tab:blue", width=3.0, label="F(x)")
@@ -153,7 +156,7 @@ def curve_figure(curve, *, samples: int = 401, units: str = "mm", title: str | N
     return p
 
 
-def curve_basis_figure(curve, *, samples: int = 401, units: str = "mm",
+def curve_basis_figure(curve, *, samples: int = 401, units: str | None = None,
                        window_size: Sequence[int] = DEFAULT_WINDOW_SIZE, off_screen: bool | None = None):
     """The basis polynomials ``L_i(x)`` of a curve's nodes, each 1 at its own node and 0 at the others.
 
@@ -181,6 +184,7 @@ def curve_basis_figure(curve, *, samples: int = 401, units: str = "mm",
     xs = axis_lines(curve.points.x[0], curve.points.x[-1], n)
     lx = basis_matrix(nodes, xs)
     p = new_plotter(window_size=window_size, off_screen=off_screen)
+    units = units_of(curve, units)
     chart = pv.Chart2D(x_label=f"x ({units})", y_label="L_i(x)")
     chart.title = f"Lagrange basis polynomials of degree {curve.degree} on {len(nodes)} nodes"
     for i in range(len(nodes)):
@@ -195,7 +199,7 @@ def curve_basis_figure(curve, *, samples: int = 401, units: str = "mm",
     return p
 
 
-def basis_figure(surface, *, samples: int = 25, units: str = "mm", window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
+def basis_figure(surface, *, samples: int = 25, units: str | None = None, window_size: Sequence[int] = DEFAULT_WINDOW_SIZE,
                  off_screen: bool | None = None):
     """The tensor-product basis functions ``L_i(x) L_k(y)`` as small multiples (the paper's Figure 4).
 
@@ -231,6 +235,7 @@ def basis_figure(surface, *, samples: int = 25, units: str = "mm", window_size: 
     values = np.einsum("ai,bk->ikab", lx, ly)  # values[i, k] = L_i(xs) L_k(ys) on the sample grid
     bound = float(np.abs(values).max())
     scale = max(np.ptp(xs), np.ptp(ys)) / 3 / bound
+    units = units_of(surface, units)
     w, h = check_window_size(window_size)
     p = new_plotter(shape=(ny, nx + 1), window_size=(w, h), off_screen=off_screen,
                     col_weights=[1.0] * nx + [BAR_COLUMN])

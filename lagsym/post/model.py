@@ -17,11 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ProgramError
+from ..gcode.limits import check_axis, check_blocks, check_settings, resolution
+from ..gcode.numbers import fixed
+from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
 from .moves import format_moves
-from ..gcode.numbers import fixed
 
-__all__ = ["PointProgram", "point_program", "iso_comment", "body", "units_word"]
+__all__ = ["PointProgram", "point_program", "iso_comment", "body", "units_word", "surface_comment", "check_clearance",
+           "coolant_on", "coolant_off", "check_blocks", "check_settings"]
 
 
 @dataclass(frozen=True)
@@ -68,41 +71,61 @@ class PointProgram:
 def point_program(toolpath, settings: MachineSettings, title: str = "") -> PointProgram:
     """The program model of a :class:`~lagsym.toolpath.Toolpath` for one machine."""
     t = toolpath.tool
-    tool = f"T{settings.tool_number} {t.shape.upper()} END D{fixed(t.diameter_mm, 3, trim=True)} MM"
+    tool = f"T{settings.tool_number} {t.shape.upper()} END D{t.diameter_mm:g} MM"
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
 
 
-_NOT_ISO = re.compile(r"[^A-Z0-9 .,:=+\-/*#_]")
+def check_clearance(settings: MachineSettings, top_mm: float) -> None:
+    """The clearance plane must be a feed height above the highest cutter location ``top_mm``."""
+    need = top_mm + settings.feed_height_mm
+    if settings.safe_z_mm < need:
+        raise ProgramError(f"safe Z {settings.safe_z_mm:g} mm is less than the feed height "
+                           f"{settings.feed_height_mm:g} mm above the highest cutter location {top_mm:.3f} mm: "
+                           f"raise --safe-z to at least {need:.3f} mm or lower --feed-height")
 
 
-def iso_comment(text: str) -> str:
-    """Comment text a control accepts: upper-case ISO characters, no parentheses.
+def coolant_on(settings: MachineSettings) -> list[str]:
+    """``M08`` (flood) or ``M07`` (mist), nothing when the coolant is off."""
+    return [COOLANT_ON[settings.coolant]] if settings.coolant != "off" else []
 
-    Examples
-    --------
-    >>> iso_comment("Paper example 4 (5x5) – Ø6 ball")
-    'PAPER EXAMPLE 4 5X5 - 6 BALL'
-    """
-    t = text.upper().replace("\u2013", "-").replace("\u2014", "-")
-    t = _NOT_ISO.sub(" ", t)
-    return re.sub(r"\s+", " ", t).strip()
+
+def coolant_off(settings: MachineSettings) -> list[str]:
+    """``M09`` when a coolant was turned on."""
+    return [] if settings.coolant == "off" else ["M09"]
 
 
 def body(program: PointProgram, tool_length: bool = True) -> list[str]:
-    """The moves every dialect shares: over the first point, down to it, along the points, up to safe Z."""
+    """The moves every dialect shares, in the order a machinist expects.
+
+    Up to the clearance plane first (with the tool length offset), coolant on,
+    over the first point at that height, down at rapid to a feed height above
+    it, the last of the way at plunge feed, along the points at the cutting
+    feed, and up to the clearance plane; then coolant off.  The rapid down
+    cannot touch the part: the first point is a cutter location, so the tool
+    is clear of the part anywhere above it.
+    """
     s = program.settings
     p = program.points_mm
-    safe = s.safe_z_mm
-    if safe <= float(p[:, 2].max()):
-        raise ProgramError(f"safe Z {safe:g} mm is not above the highest cutter location {float(p[:, 2].max()):.3f} mm")
-    out = [f"G00 X{program.num(p[0, 0])} Y{program.num(p[0, 1])}"]
-    out.append(f"G43 H{s.tool_number} Z{program.num(safe)}" if tool_length else f"G00 Z{program.num(safe)}")
-    out.extend(format_moves(p[:1], s, previous=(p[0, 0], p[0, 1], safe), first_feed=s.plunge_feed_mm_min))
+    check_clearance(s, float(p[:, 2].max()))
+    check_axis(np.append(p.ravel(), s.safe_z_mm) * s.unit_factor, s, "the program")
+    if s.feed_height_mm * s.unit_factor < resolution(s):
+        raise ProgramError(f"feed height {s.feed_height_mm:g} mm is below the program's resolution")
+    safe = program.num(s.safe_z_mm)
+    out = [f"G00 G43 H{s.length_offset_number} Z{safe}" if tool_length else f"G00 Z{safe}"]
+    out += coolant_on(s)
+    out.append(f"G00 X{program.num(p[0, 0])} Y{program.num(p[0, 1])}")
+    approach = float(p[0, 2]) + s.feed_height_mm
+    above = (p[0, 0], p[0, 1], s.safe_z_mm)
+    if approach < s.safe_z_mm:
+        out.append(f"Z{program.num(approach)}")
+        above = (p[0, 0], p[0, 1], approach)
+    out.extend(format_moves(p[:1], s, previous=above, first_feed=s.plunge_feed_mm_min))
     rest = format_moves(p[1:], s, previous=p[0], first_feed=s.feed_mm_min, motion="") if len(p) > 1 else []
     if rest:
         rest[0] = rest[0].lstrip()
     out.extend(rest)
-    out.append(f"G00 Z{program.num(safe)}")
+    out.append(f"G00 Z{safe}")
+    out += coolant_off(s)
     return out
 
 
