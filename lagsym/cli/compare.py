@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..formula import parse_formula
 from ..io import read_points
 from ..surfaces import HERMITE_KINDS, METHODS
-from ._common import emit
+from ._common import count, emit, number
 
 NAME = "compare"
 ORDER = 45
@@ -53,16 +53,6 @@ def _methods(text: str) -> list[str]:
     return names
 
 
-def _tolerance(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"tolerance {text!r} should be a number >= 0 (mm)")
-    return value
-
-
 def add_arguments(p) -> None:
     p.add_argument("file", help="control points file: JSON or CSV with x,y,z")
     p.add_argument("--reference", default="lagrange", metavar="REF",
@@ -72,14 +62,14 @@ def add_arguments(p) -> None:
                    help=f"sample grid over the control box (default {DEFAULT_SAMPLES[0]}x{DEFAULT_SAMPLES[1]})")
     p.add_argument("--methods", type=_methods, default=list(METHODS), metavar="LIST",
                    help=f"comma-separated columns, from {','.join(METHODS)} (default all)")
-    p.add_argument("--degree", type=int, default=3, metavar="P",
+    p.add_argument("--degree", type=count(1, 30), default=3, metavar="P",
                    help="B-spline degree in each direction (default 3, capped at n-1)")
     p.add_argument("--hermite", choices=HERMITE_KINDS, default="corner",
                    help="corner: one patch on the 4 corners (default; the paper does not state its Hermite "
                         "rule, and on an evenly spaced net this patch equals the Bezier surface, which the "
                         "paper's Table 1 does not show); "
                         "piecewise: C1 patches through every point")
-    p.add_argument("--tolerance", type=_tolerance, default=DEFAULT_TOLERANCE_MM, metavar="MM",
+    p.add_argument("--tolerance", type=number(0.0, 1_000.0, "mm"), default=DEFAULT_TOLERANCE_MM, metavar="MM",
                    help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")
     p.add_argument("--format", choices=TABLE_FORMATS, default="text", help="table format (default text)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the table to FILE instead of standard output")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..equation import FORMATS, render, rounding_miss
 from ..lagrange import lagrange_surface
-from ._common import add_points_arguments, emit, load_points
+from ._common import DIGITS, add_points_arguments, emit, load_points
 
 NAME = "equation"
 ORDER = 10
@@ -30,7 +30,7 @@ def add_arguments(p) -> None:
 def add_format_arguments(p) -> None:
     p.add_argument("--format", choices=FORMATS, default="sympy",
                    help="sympy (default, parseable by sympy.sympify), latex, json, horner (nested), python")
-    p.add_argument("--digits", type=int, metavar="N",
+    p.add_argument("--digits", type=DIGITS, metavar="N",
                    help="round coefficients to N significant digits, as the paper prints them")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of standard output")
 

@@ -8,6 +8,7 @@ from ..errors import InputError
 from ..grid import CurvePoints
 from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
+from ._common import SCALE, count
 
 NAME = "plot"
 ORDER = 50
@@ -52,8 +53,8 @@ def add_arguments(p) -> None:
     p.add_argument("--units", default="mm", help="length unit for the axis labels (default: mm)")
     p.add_argument("--size", type=_size, default=(1024, 768), metavar="WxH",
                    help="picture size in pixels (default: 1024x768)")
-    p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
-    p.add_argument("--scale", type=float, default=1.0,
+    p.add_argument("--samples", type=count(2, 2_000), metavar="N", help="samples along each axis")
+    p.add_argument("--scale", type=SCALE, default=1.0,
                    help="with --show toolpath: millimetres per surface unit the program was made with (default 1)")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
