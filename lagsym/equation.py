@@ -156,9 +156,12 @@ def _python(obj) -> str:
         else f"Lagrange curve of degree {obj.degree}"
     )
     src = getattr(obj.grid if isinstance(obj, LagrangeSurface) else obj.points, "source", "")
+    # The file name is the user's text: written through repr, it is a string literal whatever it holds
+    # (quotes, backslashes, newlines), never code.
+    doc = f"{_lhs(obj)} = F({args}): {what} through the points of {src}."
     return (
         f"def F({args}):\n"
-        f'    """{_lhs(obj)} = F({args}): {what} through the points of {src}."""\n'
+        f"    {doc!r}\n"
         f"    return {nested_form(obj)}\n"
     )
 

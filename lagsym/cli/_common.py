@@ -8,7 +8,7 @@ from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
-from ..values import as_exact, in_range, whole
+from ..values import as_exact, in_range, whole, work_offset
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:
@@ -121,3 +121,11 @@ DECIMALS = count(0, 6)
 PROGRAM_NUMBER = count(1, 9999)
 TOOL_NUMBER = count(0, 9999)
 DIGITS = count(1, 1000)
+
+
+def WORK_OFFSET(text: str) -> str:  # noqa: N802 - named as the other option types
+    """An argparse ``type=`` for ``--work-offset``: the word goes into the program as a block, so only a work offset."""
+    try:
+        return work_offset(text, "")
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e).strip()) from None

@@ -6,9 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..compare import DEFAULT_SAMPLES, DEFAULT_TOLERANCE_MM, TABLE_FORMATS, compare_surfaces, render_table
-from ..errors import InputError
 from ..formula import parse_formula
-from ..io import read_points
+from ..io import TABLE_SUFFIXES, read_points
 from ..surfaces import HERMITE_KINDS, METHODS
 from ._common import count, emit, number
 
@@ -21,7 +20,8 @@ deviation measures (Table 1), one column per method.
 
 The reference z_f is the Lagrange surface (default), a formula in x and y
 (numbers, x, y, pi, + - * / ** ( ) and sin cos tan exp log sqrt abs), or a
-points file of measurements, compared at the measured positions.
+points file of measurements (a name ending in .json, .csv, .tsv, .txt, .xyz,
+.dat or .asc), compared at the measured positions.
 
 examples:
   lagsym compare examples/paper-example-4.json
@@ -77,20 +77,21 @@ def add_arguments(p) -> None:
 
 
 def _reference(text: str):
+    """'lagrange', a points file (named by its extension: .json, .csv, ...), or else a formula.
+
+    Only the extension decides, never whether a file of that name happens to exist: ``--reference x``
+    is the formula x even where a file called x lies in the current folder.
+    """
     if text == "lagrange":
         return text
-    try:
-        is_file = Path(text).suffix.lower() in (".json", ".csv") or Path(text).is_file()
-    except (OSError, ValueError):
-        is_file = False
-    return read_points(text) if is_file else parse_formula(text)
+    if Path(text).suffix.lower() in (".json",) + TABLE_SUFFIXES:
+        return read_points(text)
+    return parse_formula(text)
 
 
 def run(args, out, err) -> int:
     grid = read_points(args.file)
     reference = _reference(args.reference)
-    if args.degree < 1:
-        raise InputError(f"--degree {args.degree}: a B-spline degree should be 1 or more")
     if args.plot:
         from ..plot import image_format
 

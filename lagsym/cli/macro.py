@@ -8,7 +8,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ._common import (DECIMALS, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SCALE, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
-                      TOOL_MM, TOOL_NUMBER, count, emit, origin)
+                      TOOL_MM, TOOL_NUMBER, WORK_OFFSET, count, emit, origin)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
@@ -65,7 +65,7 @@ def add_arguments(p) -> None:
                    help="clearance height for rapid moves, above the whole path (default 50)")
     p.add_argument("--stock", type=STOCK_MM, default=0.0, metavar="MM", help="stock to leave (default 0)")
     p.add_argument("--program", type=PROGRAM_NUMBER, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
-    p.add_argument("--work-offset", default="G54", help="work offset (default G54)")
+    p.add_argument("--work-offset", type=WORK_OFFSET, default="G54", help="work offset (default G54)")
     p.add_argument("--line-ending", choices=("lf", "crlf", "cr"), default="lf")
     p.add_argument("--decimals", type=DECIMALS, metavar="N", help="decimals in positions (default 3 mm, 4 inch)")
     p.add_argument("--stats", action="store_true",
