@@ -6,6 +6,7 @@ import contextlib
 
 from ..conditioning import FLOAT_ERROR_LIMIT, float_error_bound
 from ..export import FORMATS, MESH_MAX_POINTS, format_of, write_csv, write_sample
+from ..errors import InputError
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..sampling import MAX_AXIS_POINTS, MAX_POINTS, Box, iter_blocks, sample_grid
@@ -52,6 +53,8 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help=f"output file, format by extension: {', '.join(FORMATS)}")
     p.add_argument("--max-points", type=count(1, 10**15), default=MAX_POINTS, metavar="N",
                    help=f"refuse a sample of more than N points (default {MAX_POINTS:.0e})")
+    p.add_argument("--accept-rounding", action="store_true",
+                   help="write the samples even when their rounding error may exceed the data range")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
@@ -91,6 +94,10 @@ def run(args, out, err) -> int:
                   f"(x {float(b[0]):g}..{float(b[1]):g}, y {float(b[2]):g}..{float(b[3]):g}): "
                   f"the surface there is extrapolated and follows no data\n")
     rel = float_error_bound(surface, grid.box.floats())
+    if rel > 1 and not args.accept_rounding:
+        raise InputError(f"{args.file}: rounding error of the samples may reach {rel:.1e} times the data range, so the "
+                         f"heights could be anything; use fewer or Chebyshev-spaced nodes, exact values from "
+                         f"'lagsym equation', or --accept-rounding to write them anyway")
     if rel > FLOAT_ERROR_LIMIT:
         err.write(f"lagsym: warning: rounding error of the samples may reach {rel:.1e} of the data range "
                   f"(trusted limit {FLOAT_ERROR_LIMIT:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "
