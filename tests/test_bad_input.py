@@ -214,3 +214,24 @@ def test_verify_of_an_empty_program_is_refused(run_cli, flat, tmp_path):
     prog = tmp_path / "empty.nc"
     prog.write_text("%\nO1000\nM30\n%\n")
     one_line_error(*run_cli("verify", flat, prog), "no move")
+
+
+def test_the_documented_limits_are_the_ones_in_force():
+    from lagsym.equation import MAX_TERMS
+    from lagsym.formula import MAX_DEPTH, MAX_HEIGHT, MAX_LENGTH
+    from lagsym.io.table import MAX_CELL
+    from lagsym.sampling import MAX_POINTS
+    from lagsym.toolpath.plan import MAX_PLAN_POINTS
+    from lagsym.values import MAX_EXPONENT
+    from lagsym.verify import MAX_CELLS, MAX_CONTACTS
+
+    cli = " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    formats = (ROOT / "docs" / "formats.md").read_text()
+    assert (MAX_POINTS, MAX_PLAN_POINTS, MAX_CELLS, MAX_CONTACTS, MAX_TERMS) == (10**8, 2 * 10**7, 16 * 10**6,
+                                                                                3 * 10**9, 2500)
+    for text in ("`sample --max-points` (default 1e8 points)", "`toolpath --max-points` (2e7 fine",
+                 "`verify --max-cells` (1.6e7 height-map cells)", "(3e9 tool positions", "(2500 terms)"):
+        assert text in cli
+    assert f"at most {MAX_EXPONENT} digits and a decimal exponent within +-{MAX_EXPONENT}" in formats
+    assert f"at most {MAX_CELL} characters" in formats
+    assert f"at most {MAX_LENGTH} characters, {MAX_DEPTH} levels of brackets, {MAX_HEIGHT} chained" in formats
