@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._arrays import power_of_two_scale
 from ._arrays import readonly as _readonly
 from .errors import InputError
 from .grid import ControlGrid, _fmt
@@ -158,7 +159,7 @@ def deviation_measures(z_f, z_a, tolerance: float = DEFAULT_TOLERANCE_MM) -> Dev
     coincided = int(np.count_nonzero(np.abs(z_f - z_a) <= tolerance)) if np.isfinite(z_f - z_a).all() else None
     # Heights near the float range (1e300) would overflow the sums and squares: measure in units of a
     # power of two (an exact scaling) and scale back; a result beyond the float range is refused.
-    k = _power_of_two_scale(z_f, z_a)
+    k = power_of_two_scale(z_f, z_a)
     z_f, z_a = z_f / k, z_a / k
     d = z_f - z_a
     a = np.abs(d)
@@ -179,26 +180,12 @@ def deviation_measures(z_f, z_a, tolerance: float = DEFAULT_TOLERANCE_MM) -> Dev
         max_abs_deviation=float(a.flat[iabs]) * k,
         max_abs_location=_location(iabs, d.shape),
         mean_abs_deviation=float(a.mean()) * k,
-        rms_deviation=_rms(d, float(a.flat[iabs])) * k,
+        rms_deviation=float(np.sqrt(np.mean(d * d))) * k,
     )
     if not all(math.isfinite(v) for v in (m.max_deviation, m.min_deviation, m.deviation_percentage, m.rms_deviation)):
         raise InputError(f"deviations of {float(a.flat[iabs]):.3g} x {k:.3g} are beyond the range of a float; "
                          f"check the reference and the heights")
     return m
-
-
-def _power_of_two_scale(*arrays) -> float:
-    """1, or the power of two that brings the largest magnitude near 1 when it is beyond 2**500."""
-    big = max(float(np.max(np.abs(a))) for a in arrays)
-    return 1.0 if big < 2.0**500 else math.ldexp(1.0, math.frexp(big)[1] - 1)
-
-
-def _rms(d: np.ndarray, largest: float) -> float:
-    """Root mean square of ``d``, scaled by its largest magnitude first so that squares of 1e300 do not overflow."""
-    if largest == 0 or not math.isfinite(largest):
-        return largest
-    s = d / largest
-    return largest * float(np.sqrt(np.mean(s * s)))
 
 
 @dataclass(frozen=True)

@@ -220,7 +220,7 @@ def sample_grid(
     extrapolate : bool
         Allow a box reaching outside the control box.
     max_points : int or None
-        Refuse a grid of more points than this (``--max-points``); None for no limit.
+        Refuse more points than this (``--max-points``); None: no limit.
 
     Raises
     ------
@@ -247,8 +247,7 @@ def sample_grid(
     if not y0 < y1:
         raise InputError(f"y0 = {_show(y0)} should be less than y1 = {_show(y1)}")
     region = Box(x0, x1, y0, y1)
-    control_box = Box(cx0, cx1, cy0, cy1)
-    if not extrapolate and not control_box.contains(region):
+    if not extrapolate and not Box(cx0, cx1, cy0, cy1).contains(region):
         raise InputError(
             f"the box x {_show(x0)}..{_show(x1)}, y {_show(y0)}..{_show(y1)} reaches outside the control points "
             f"(x {_show(cx0)}..{_show(cx1)}, y {_show(cy0)}..{_show(cy1)}); that is extrapolation: "
@@ -266,11 +265,14 @@ def sample_grid(
         nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
         sx = as_exact(step if step is not None else dx, nxname)
         sy = as_exact(step if step is not None else dy, nyname)
-        g = SampleGrid(region, _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname))
-    elif nx is None or ny is None:
+        counts = _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname)
+        return _within(SampleGrid(region, *counts), max_points)
+    if nx is None or ny is None:
         raise InputError("give both nx and ny (or a spacing)")
-    else:
-        g = SampleGrid(region, _count(nx, "nx"), _count(ny, "ny"))
+    return _within(SampleGrid(region, _count(nx, "nx"), _count(ny, "ny")), max_points)
+
+
+def _within(g: SampleGrid, max_points: int | None) -> SampleGrid:
     if max_points is not None and g.size > max_points:
         raise InputError(f"a {g.nx} x {g.ny} sample is {g.size:.3g} points, more than the limit of {max_points:.3g}; "
                          f"use a coarser grid or raise the limit (--max-points)")

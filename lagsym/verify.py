@@ -147,15 +147,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
         Depth from which a cut counts as a gouge; by default the program
         resolution plus the simulation's.
     max_cells, max_contacts : int or None
-        Refuse, before any work, a height map of more cells than
-        ``max_cells`` (``--max-cells``), or a simulation of more tool
-        positions times cells under the tool than ``max_contacts``
-        (``--max-contacts``); None for no limit.
-
-    Raises
-    ------
-    InputError
-        For a program without a move to simulate, or work beyond the limits.
+        Refuse, before any work, more cells (``--max-cells``) or tool
+        positions times cells under the tool (``--max-contacts``); None: no limit.
     """
     ox, oy, oz = (float(v) for v in origin_mm)
     x0, x1, y0, y1 = (float(v) * scale for v in surface.grid.bounds)
@@ -164,11 +157,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
         cell_mm = max(x1 - x0, y1 - y0) / 400.0
     if not cell_mm > 0:
         raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
-    nx = max(int(math.ceil((x1 - x0) / cell_mm)) + 1, 2)
-    ny = max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
-    if max_cells is not None and nx * ny > max_cells:
-        raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
-                         f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
+    nx, ny = _cells(x1 - x0, y1 - y0, cell_mm, max_cells)
     xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     surf = evaluate_grid(surface, (xs - ox) / scale, (ys - oy) / scale) * scale + oz
@@ -214,6 +203,16 @@ def simulate_cut(surface, moves: Moves, tool: Tool, scale: float = 1.0, origin_m
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=gouge, gouge_at=at(gi),
                      scallop_mm=scallop, scallop_at=at(si), unreached_mm2=float((~reached).sum() * hx * hy),
                      resolution_mm=resolution, gouge_limit_mm=limit, positions=positions)
+
+
+def _cells(width: float, depth: float, cell_mm: float, max_cells: int | None) -> tuple[int, int]:
+    """Cells of the height map in x and y, refused beyond ``max_cells``."""
+    nx = max(int(math.ceil(width / cell_mm)) + 1, 2)
+    ny = max(int(math.ceil(depth / cell_mm)) + 1, 2)
+    if max_cells is not None and nx * ny > max_cells:
+        raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
+                         f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
+    return nx, ny
 
 
 def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_contacts: int | None) -> None:
