@@ -53,7 +53,7 @@ def page() -> str:
         "run away is estimated before it starts and refused beyond a limit that an option lifts:",
         "`sample --max-points` (default 1e8 points), `toolpath --max-points` (2e7 fine",
         "drop-cutter samples), `verify --max-cells` (1.6e7 height-map cells) and `--max-contacts`",
-        "(3e9 tool positions times cells under the tool), `equation --max-terms` (2500 terms).",
+        "(2e10 tool positions times cells under the tool), `equation --max-terms` (2500 terms).",
         "Input files are limited as docs/formats.md says.\n",
         "```",
         help_text([]).rstrip(),

@@ -39,7 +39,7 @@ __all__ = ["CutReport", "simulate_cut", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
-MAX_CONTACTS = 3_000_000_000  # tool positions times the cells under the tool, by default: a few minutes
+MAX_CONTACTS = 20_000_000_000  # tool positions (all, before those far from the box are dropped) times cells under the tool
 
 
 @dataclass(frozen=True)
