@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._arrays import power_of_two_scale
 from ._arrays import readonly as _readonly
 from .errors import InputError
 from .grid import ControlGrid, _fmt
@@ -155,27 +156,36 @@ def deviation_measures(z_f, z_a, tolerance: float = DEFAULT_TOLERANCE_MM) -> Dev
         raise ValueError(f"reference shape {z_f.shape} and approximation shape {z_a.shape} should match, non-empty")
     if not (tolerance >= 0 and math.isfinite(tolerance)):
         raise InputError(f"tolerance {tolerance!r} should be a finite number >= 0")
+    coincided = int(np.count_nonzero(np.abs(z_f - z_a) <= tolerance)) if np.isfinite(z_f - z_a).all() else None
+    # Heights near the float range (1e300) would overflow the sums and squares: measure in units of a
+    # power of two (an exact scaling) and scale back; a result beyond the float range is refused.
+    k = power_of_two_scale(z_f, z_a)
+    z_f, z_a = z_f / k, z_a / k
     d = z_f - z_a
     a = np.abs(d)
     n = d.size
     imax, imin, iabs = int(np.argmax(d)), int(np.argmin(d)), int(np.argmax(a))
-    return DeviationMeasures(
+    m = DeviationMeasures(
         samples=n,
-        deviation_mean=float(d.mean()),
+        deviation_mean=float(d.mean()) * k,
         deviation_rate=_ratio(float(z_a.sum()), float(z_f.sum())),
-        max_deviation=float(d.flat[imax]),
+        max_deviation=float(d.flat[imax]) * k,
         max_location=_location(imax, d.shape),
-        min_deviation=float(d.flat[imin]),
+        min_deviation=float(d.flat[imin]) * k,
         min_location=_location(imin, d.shape),
-        coincided=int(np.count_nonzero(a <= tolerance)),
+        coincided=coincided if coincided is not None else int(np.count_nonzero(a <= tolerance / k)),
         tolerance=float(tolerance),
-        deviation_percentage=float(100.0 * a.sum() / n),
+        deviation_percentage=float(100.0 * a.mean()) * k,
         relative_percentage=100.0 * _ratio(float(a.sum()), float(np.abs(z_f).sum())),
-        max_abs_deviation=float(a.flat[iabs]),
+        max_abs_deviation=float(a.flat[iabs]) * k,
         max_abs_location=_location(iabs, d.shape),
-        mean_abs_deviation=float(a.mean()),
-        rms_deviation=float(np.sqrt(np.mean(d * d))),
+        mean_abs_deviation=float(a.mean()) * k,
+        rms_deviation=float(np.sqrt(np.mean(d * d))) * k,
     )
+    if not all(math.isfinite(v) for v in (m.max_deviation, m.min_deviation, m.deviation_percentage, m.rms_deviation)):
+        raise InputError(f"deviations of {float(a.flat[iabs]):.3g} x {k:.3g} are beyond the range of a float; "
+                         f"check the reference and the heights")
+    return m
 
 
 @dataclass(frozen=True)

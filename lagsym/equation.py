@@ -19,9 +19,10 @@ from .errors import InputError
 from .lagrange import LagrangeCurve, LagrangeSurface, horner2
 
 __all__ = ["FORMATS", "render", "nested_form", "decimal_text", "round_significant", "rounded_coefficients",
-           "RoundingMiss", "rounding_miss"]
+           "RoundingMiss", "rounding_miss", "MAX_TERMS"]
 
 FORMATS = ("sympy", "latex", "json", "horner", "python")
+MAX_TERMS = 2_500  # terms SymPy prints by default: a 50 x 50 grid, a few seconds (each term costs about 2 ms)
 
 
 def _lhs(obj) -> str:
@@ -156,26 +157,37 @@ def _python(obj) -> str:
         else f"Lagrange curve of degree {obj.degree}"
     )
     src = getattr(obj.grid if isinstance(obj, LagrangeSurface) else obj.points, "source", "")
+    # The file name is the user's text: written through repr, it is a string literal whatever it holds
+    # (quotes, backslashes, newlines), never code.
+    doc = f"{_lhs(obj)} = F({args}): {what} through the points of {src}."
     return (
         f"def F({args}):\n"
-        f'    """{_lhs(obj)} = F({args}): {what} through the points of {src}."""\n'
+        f"    {doc!r}\n"
         f"    return {nested_form(obj)}\n"
     )
 
 
-def render(obj, fmt: str = "sympy", digits: int | None = None) -> str:
+def render(obj, fmt: str = "sympy", digits: int | None = None, max_terms: int | None = MAX_TERMS) -> str:
     """The equation of a surface or curve as text in format ``fmt`` (one of :data:`FORMATS`).
 
     ``digits`` rounds the coefficients to that many significant digits (``sympy``
-    and ``latex`` formats only), the way the paper prints them.
+    and ``latex`` formats only), the way the paper prints them.  An equation of
+    more than ``max_terms`` terms (``--max-terms``) is refused before SymPy
+    builds it, except the rounded ``sympy`` text, which is written straight
+    from the exact coefficients; None for no limit.
     """
     if fmt not in FORMATS:
         raise InputError(f"unknown format {fmt!r}; choose one of {', '.join(FORMATS)}")
     lhs = _lhs(obj)
+    if digits is not None and fmt == "sympy":
+        return f"{lhs} = {decimal_text(obj, digits)}"
+    terms = len(_coeff_dict(obj))
+    if max_terms is not None and terms > max_terms:
+        raise InputError(f"the equation has {terms} terms, more than the limit of {max_terms} (about "
+                         f"{terms * 0.002:.0f} s to print); use --digits N with the sympy format, or raise the "
+                         f"limit (--max-terms)")
     if digits is not None:
         rhs = decimal_text(obj, digits)
-        if fmt == "sympy":
-            return f"{lhs} = {rhs}"
         if fmt == "latex":
             names = {str(v): v for v in _symbols(obj)}
             return f"{lhs} = {sympy.latex(sympy.sympify(rhs, locals=names))}"

@@ -37,6 +37,7 @@ __all__ = ["FUNCTIONS", "Formula", "parse_formula"]
 FUNCTIONS = ("sin", "cos", "tan", "exp", "log", "sqrt", "abs")
 MAX_LENGTH = 2000
 MAX_DEPTH = 60  # nesting of brackets and unary signs; deeper text is refused, not a RecursionError
+MAX_HEIGHT = 200  # operations one inside another in the parsed tree (a chain of 200 terms), for the same reason
 MAX_EXACT_EXPONENT = 64
 
 _NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "sqrt": np.sqrt, "abs": np.abs}
@@ -102,6 +103,9 @@ class _Parser:
         kind, text, col = self.peek()
         if kind != "end":
             raise self.error(f"unexpected {text!r}", col)
+        if _height(tree) > MAX_HEIGHT:
+            raise FormulaError(f"formula {self.text!r}: more than {MAX_HEIGHT} operations in a chain; "
+                               f"group the terms in brackets or simplify it")
         return tree
 
     def sum(self):
@@ -170,6 +174,16 @@ class _Parser:
             return inner
         found = "the end of the formula" if kind == "end" else repr(text)
         raise self.error(f"expected a number, x, y, a function or '(', found {found}", col)
+
+
+def _height(tree) -> int:
+    """Operations one inside another in ``tree``, counted without recursion (the tree may be deep)."""
+    best, stack = 0, [(tree, 1)]
+    while stack:
+        node, h = stack.pop()
+        best = max(best, h)
+        stack.extend((c, h + 1) for c in node[1:] if isinstance(c, tuple))
+    return best
 
 
 def _numeric(tree, x: np.ndarray, y: np.ndarray) -> np.ndarray:

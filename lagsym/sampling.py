@@ -29,6 +29,7 @@ from .values import as_exact
 
 __all__ = [
     "MAX_AXIS_POINTS",
+    "MAX_POINTS",
     "BLOCK_POINTS",
     "Box",
     "SampleGrid",
@@ -41,6 +42,7 @@ __all__ = [
 ]
 
 MAX_AXIS_POINTS = 10_000_000  # grid lines per axis; the coordinates alone then take 80 MB
+MAX_POINTS = 100_000_000  # points of one sample by default: minutes of work and gigabytes of CSV
 BLOCK_POINTS = 1 << 20  # points per streamed block: about 24 MB of x, y, z
 
 
@@ -181,7 +183,7 @@ def _count_for(step: Fraction, length: Fraction, name: str) -> int:
     n = math.ceil(length / step) + 1
     if n > MAX_AXIS_POINTS:
         raise InputError(
-            f"{name} = {_show(step)} gives {n} grid lines over a length of {_show(length)}, "
+            f"{name} = {_show(step)} gives {n:.3g} grid lines over a length of {_show(length)}, "
             f"more than {MAX_AXIS_POINTS}; use a larger step"
         )
     return max(n, 2)
@@ -197,6 +199,7 @@ def sample_grid(
     dy=None,
     box=None,
     extrapolate: bool = False,
+    max_points: int | None = MAX_POINTS,
 ) -> SampleGrid:
     """The regular sample grid asked for, checked against the control points.
 
@@ -216,6 +219,8 @@ def sample_grid(
         ``(x0, x1, y0, y1)``; any item may be None for the control box's edge.
     extrapolate : bool
         Allow a box reaching outside the control box.
+    max_points : int or None
+        Refuse more points than this (``--max-points``); None: no limit.
 
     Raises
     ------
@@ -242,8 +247,7 @@ def sample_grid(
     if not y0 < y1:
         raise InputError(f"y0 = {_show(y0)} should be less than y1 = {_show(y1)}")
     region = Box(x0, x1, y0, y1)
-    control_box = Box(cx0, cx1, cy0, cy1)
-    if not extrapolate and not control_box.contains(region):
+    if not extrapolate and not Box(cx0, cx1, cy0, cy1).contains(region):
         raise InputError(
             f"the box x {_show(x0)}..{_show(x1)}, y {_show(y0)}..{_show(y1)} reaches outside the control points "
             f"(x {_show(cx0)}..{_show(cx1)}, y {_show(cy0)}..{_show(cy1)}); that is extrapolation: "
@@ -261,10 +265,18 @@ def sample_grid(
         nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
         sx = as_exact(step if step is not None else dx, nxname)
         sy = as_exact(step if step is not None else dy, nyname)
-        return SampleGrid(region, _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname))
+        counts = _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname)
+        return _within(SampleGrid(region, *counts), max_points)
     if nx is None or ny is None:
         raise InputError("give both nx and ny (or a spacing)")
-    return SampleGrid(region, _count(nx, "nx"), _count(ny, "ny"))
+    return _within(SampleGrid(region, _count(nx, "nx"), _count(ny, "ny")), max_points)
+
+
+def _within(g: SampleGrid, max_points: int | None) -> SampleGrid:
+    if max_points is not None and g.size > max_points:
+        raise InputError(f"a {g.nx} x {g.ny} sample is {g.size:.3g} points, more than the limit of {max_points:.3g}; "
+                         f"use a coarser grid or raise the limit (--max-points)")
+    return g
 
 
 def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: SampleGrid | None = None,

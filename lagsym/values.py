@@ -22,10 +22,12 @@ from fractions import Fraction
 
 from .errors import InputError
 
-__all__ = ["as_exact", "exact_number", "finite", "positive", "choice", "NotANumber", "MAX_EXPONENT"]
+__all__ = ["as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice", "work_offset",
+           "NotANumber", "MAX_EXPONENT"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
+_WORK_OFFSET = re.compile(r"^G5[4-9]$|^G59\.[1-3]$|^G54\.1 ?P([1-9]\d?|[12]\d\d|300)$")
 _DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
 
 
@@ -101,6 +103,11 @@ def as_exact(value, where: str) -> Fraction:
     return as_exact(f, where)
 
 
+def _subject(what: str, value) -> str:
+    """How a message names the value: ``--feed = '0'``, or the value alone where the caller names it."""
+    return f"{what} = {value!r}" if what else repr(value)
+
+
 def finite(value, what: str, *, low: float | None = None, high: float | None = None) -> float:
     """``value`` as a finite float within ``[low, high]`` (either bound optional).
 
@@ -114,17 +121,68 @@ def finite(value, what: str, *, low: float | None = None, high: float | None = N
     lagsym.errors.InputError: --gouge-limit = inf is not a finite number
     """
     if isinstance(value, bool):
-        raise InputError(f"{what} = {value!r} is not a number")
+        raise InputError(f"{_subject(what, value)} is not a number")
+    if isinstance(value, str) and not value.strip().isascii():
+        raise InputError(f"{_subject(what, value)} is not a number (only ASCII digits count)")
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError, InvalidOperation):
-        raise InputError(f"{what} = {value!r} is not a number") from None
+        raise InputError(f"{_subject(what, value)} is not a number") from None
     if not math.isfinite(v):
-        raise InputError(f"{what} = {value!r} is not a finite number")
+        raise InputError(f"{_subject(what, value)} is not a finite number")
     if low is not None and v < low:
-        raise InputError(f"{what} = {value!r} is below {low:g}")
+        raise InputError(f"{_subject(what, value)} is below {low:g}")
     if high is not None and v > high:
-        raise InputError(f"{what} = {value!r} is above {high:g}")
+        raise InputError(f"{_subject(what, value)} is above {high:g}")
+    return v
+
+
+def in_range(value, what: str, low: float, high: float, *, above: bool = False, unit: str = "") -> float:
+    """``value`` as a finite float from ``low`` (or, with ``above``, greater than it) to ``high``.
+
+    The message gives the range, so the user sees at once what to type.
+
+    Examples
+    --------
+    >>> in_range("600", "--feed", 1, 100_000, unit="mm/min")
+    600.0
+    >>> in_range("1e-308", "--feed", 1, 100_000, unit="mm/min")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: --feed = '1e-308' is out of range: give a number from 1 to 100000 mm/min
+    """
+    v = finite(value, what)
+    if v < low or (above and v == low) or v > high:
+        span = f"above {low:g}, up to {high:g}" if above else f"from {low:g} to {high:g}"
+        raise InputError(f"{_subject(what, value)} is out of range: give a number {span}{' ' + unit if unit else ''}")
+    return v
+
+
+def whole(value, what: str, low: int, high: int) -> int:
+    """``value`` as a whole number from ``low`` to ``high``; text must be ASCII digits.
+
+    Examples
+    --------
+    >>> whole("12", "--digits", 1, 1000)
+    12
+    >>> whole("999999999999999999", "--digits", 1, 1000)
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: --digits = '999999999999999999' is out of range: give a whole number from 1 to 1000
+    """
+    if isinstance(value, bool):
+        raise InputError(f"{_subject(what, value)} is not a whole number")
+    if isinstance(value, str):
+        text = value.strip()
+        if not (text.isascii() and text.lstrip("+-").isdigit()):
+            raise InputError(f"{_subject(what, value)} is not a whole number")
+        v = int(text) if len(text) <= 30 else (high + 1 if text[0] != "-" else low - 1)
+    elif isinstance(value, int):
+        v = int(value)
+    else:
+        raise InputError(f"{_subject(what, value)} is not a whole number")
+    if not low <= v <= high:
+        raise InputError(f"{_subject(what, value)} is out of range: give a whole number from {low} to {high}")
     return v
 
 
@@ -142,7 +200,7 @@ def positive(value, what: str, *, allow_zero: bool = False, high: float | None =
     """
     v = finite(value, what, high=high)
     if not (v > 0 or (allow_zero and v == 0)):
-        raise InputError(f"{what} {value!r} must be {'zero or ' if allow_zero else ''}a positive number")
+        raise InputError(f"{what + ' ' if what else ''}{value!r} must be {'zero or ' if allow_zero else ''}a positive number")
     return v
 
 
@@ -162,3 +220,23 @@ def choice(value, options: Iterable, what: str):
     if value not in options:
         raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
     return value
+
+
+def work_offset(text: str, what: str = "work offset") -> str:
+    """A work-offset word written as a block of its own: G54-G59, G59.1-G59.3 or G54.1 P1-P300, nothing else.
+
+    The word goes into the program as it is, so anything else (a second block, a comment, an M word) is refused.
+
+    Examples
+    --------
+    >>> work_offset("g55"), work_offset("G54.1 P12")
+    ('G55', 'G54.1 P12')
+    >>> work_offset("G54 M30")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: work offset 'G54 M30' is not one of G54-G59, G59.1-G59.3 or G54.1 P1-P300
+    """
+    word = str(text).strip().upper()
+    if not _WORK_OFFSET.match(word):
+        raise InputError(f"{what} {text!r} is not one of G54-G59, G59.1-G59.3 or G54.1 P1-P300")
+    return word

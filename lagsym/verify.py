@@ -30,14 +30,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import freeze_fields
-from .errors import ToolpathError
+from .errors import InputError, ToolpathError
 from .evaluate import evaluate_grid
 from .gcode import Moves
 from .machine import Placement, Tool
 
-__all__ = ["CutReport", "simulate_cut"]
+__all__ = ["CutReport", "simulate_cut", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 20_000
+MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
+MAX_CONTACTS = 20_000_000_000  # tool positions (all, before those far from the box are dropped) times cells under the tool
 
 
 @dataclass(frozen=True)
@@ -123,7 +125,8 @@ def _samples(a: np.ndarray, b: np.ndarray, ds: float, dz: float) -> np.ndarray:
 
 def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Placement(),
                  cell_mm: float | None = None, dz_mm: float = 0.01, program_resolution_mm: float = 0.0005,
-                 gouge_limit_mm: float | None = None) -> CutReport:
+                 gouge_limit_mm: float | None = None, max_cells: int | None = MAX_CELLS,
+                 max_contacts: int | None = MAX_CONTACTS) -> CutReport:
     """Simulate the moves with the tool on a height map over the surface's box and compare with the surface.
 
     Parameters
@@ -145,14 +148,16 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     gouge_limit_mm : float, optional
         Depth from which a cut counts as a gouge; by default the program
         resolution plus the simulation's.
+    max_cells, max_contacts : int or None
+        Refuse, before any work, more cells (``--max-cells``) or tool
+        positions times cells under the tool (``--max-contacts``); None: no limit.
     """
     x0, x1, y0, y1 = placement.box_mm(surface.grid.bounds)
     if cell_mm is None:
         cell_mm = max(x1 - x0, y1 - y0) / 400.0
     if not cell_mm > 0:
         raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
-    nx = max(int(math.ceil((x1 - x0) / cell_mm)) + 1, 2)
-    ny = max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
+    nx, ny = _cells(x1 - x0, y1 - y0, cell_mm, max_cells)
     xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
@@ -169,6 +174,9 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     path = moves.path_mm
     use = known & np.concatenate([[False], known[:-1]]) if len(moves) else known
     a_all, b_all = path[:-1][use], path[1:][use]
+    if not len(a_all):
+        raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
+    _check_work(a_all, b_all, ds, dz_mm, r, hx, hy, max_contacts)
     # A few thousand moves at a time, so a long program never needs all its samples in memory at once.
     for s in range(0, len(a_all), _MOVES_PER_PASS):
         pts = _samples(a_all[s:s + _MOVES_PER_PASS], b_all[s:s + _MOVES_PER_PASS], ds, dz_mm)
@@ -196,6 +204,30 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=gouge, gouge_at=at(gi),
                      scallop_mm=scallop, scallop_at=at(si), unreached_mm2=float((~reached).sum() * hx * hy),
                      resolution_mm=resolution, gouge_limit_mm=limit, positions=positions)
+
+
+def _cells(width: float, depth: float, cell_mm: float, max_cells: int | None) -> tuple[int, int]:
+    """Cells of the height map in x and y, refused beyond ``max_cells``."""
+    nx = max(int(math.ceil(width / cell_mm)) + 1, 2)
+    ny = max(int(math.ceil(depth / cell_mm)) + 1, 2)
+    if max_cells is not None and nx * ny > max_cells:
+        raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
+                         f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
+    return nx, ny
+
+
+def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_contacts: int | None) -> None:
+    """Refuse a simulation whose tool positions times cells under the tool would exceed ``max_contacts``."""
+    if max_contacts is None:
+        return
+    d = b - a
+    positions = float(np.maximum(np.ceil(np.maximum(np.hypot(d[:, 0], d[:, 1]) / ds, np.abs(d[:, 2]) / dz)), 1).sum())
+    footprint = (2 * math.ceil(r / hx) + 3) * (2 * math.ceil(r / hy) + 3)
+    if positions * footprint > max_contacts:
+        raise InputError(
+            f"simulating {positions:.3g} tool positions over {footprint:.3g} cells under the tool each is "
+            f"{positions * footprint:.3g} contacts, more than the limit of {max_contacts:.3g}; check the program's "
+            f"moves and the tool diameter, use a larger cell (--cell), or raise the limit (--max-contacts)")
 
 
 def _press(cut, pts, xs, ys, r, ball):

@@ -18,7 +18,7 @@ CURVE3 = EXAMPLES / "paper-curve-3rd.json"
     (["equation", str(CURVE3)], "point 1 [1, 1] has 2 values"),
     (["curve", str(EX1)], "point 1 [1, 2, 7] has 3 values"),
     (["equation", str(EX1), "--format", "xml"], "invalid choice: 'xml'"),
-    (["equation", str(EX1), "--digits", "0"], "--digits 0"),
+    (["equation", str(EX1), "--digits", "0"], "argument --digits: '0' is out of range"),
 ])
 def test_bad_input_is_one_line_and_exit_2(run_cli, argv, needle):
     status, out, err = run_cli(*argv)

@@ -281,8 +281,8 @@ def test_cli_measured_points_and_methods(run_cli):
         (["--format", "html"], "choose from 'text', 'markdown', 'csv', 'json'"),
         (["--samples", "41by41"], "should be NX or NXxNY"),
         (["--samples", "1x5"], "counts from 2 to 10000"),
-        (["--tolerance", "-1"], "should be a number >= 0"),
-        (["--degree", "0"], "--degree 0"),
+        (["--tolerance", "-1"], "is out of range: give a number from 0 to 1000 mm"),
+        (["--degree", "0"], "argument --degree: '0' is out of range"),
         (["--reference", PARABOLA, "--samples", "5x5"], "measured points fix the samples"),
     ],
 )

@@ -204,8 +204,8 @@ def test_cli_one_count_sets_both(run_cli):
 @pytest.mark.parametrize(
     ("args", "words"),
     [
-        (["--nx", "1"], "nx = 1 is too few"),
-        (["--step", "0"], "step = 0 should be positive"),
+        (["--nx", "1"], "argument --nx: '1' is out of range"),
+        (["--step", "0"], "argument --step: '0' is out of range"),
         (["--x0", "0"], "extrapolation"),
         (["--x0", "x"], "'x' is not a number"),
         (["--nx", "5", "--step", "1"], "not both"),

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import argparse
+from fractions import Fraction
 from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
+from ..values import as_exact, in_range, whole, work_offset
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:
@@ -20,13 +23,10 @@ def emit(text: str, output: str | None, out: IO[str]) -> None:
 
 def origin(text: str) -> tuple[float, float, float]:
     """``X,Y,Z`` in millimetres."""
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != 3 or not all(v == v and abs(v) != float("inf") for v in values):
+    parts = text.split(",")
+    if len(parts) != 3:
         raise InputError(f"--origin {text!r} must be three numbers X,Y,Z in mm")
-    return values
+    return tuple(in_range(v, f"--origin {'XYZ'[i]}", -LENGTH_MM, LENGTH_MM, unit="mm") for i, v in enumerate(parts))
 
 
 COLUMNS_HELP = ("which columns of a table are x, y, z: every column named in order (id,x,y,z) "
@@ -59,19 +59,91 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
     return f.points
 
 
+# Every numeric option is checked here, once, as argparse reads it: finite and within a range that
+# the message states, so no command sees NaN, an infinity or a figure no machine or file can hold.
+def number(low: float, high: float, unit: str = "", *, above: bool = False):
+    """An argparse ``type=`` for a float option from ``low`` (or above it) to ``high``."""
+    def parse(text: str) -> float:
+        try:
+            return in_range(text, "", low, high, above=above, unit=unit)
+        except InputError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+    parse.__name__ = "number"
+    return parse
+
+
+def count(low: int, high: int):
+    """An argparse ``type=`` for a whole-number option from ``low`` to ``high``."""
+    def parse(text: str) -> int:
+        try:
+            return whole(text, "", low, high)
+        except InputError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+    parse.__name__ = "count"
+    return parse
+
+
+def exact(low: float | None = None, high: float | None = None, *, above: bool = False):
+    """An argparse ``type=`` for an exact decimal or rational (``0.05``, ``1/3``), within the range if given."""
+    def parse(text: str) -> Fraction:
+        try:
+            v = as_exact(text, "")
+        except InputError as e:
+            raise argparse.ArgumentTypeError(str(e).lstrip(": ")) from None
+        if low is not None:
+            try:
+                in_range(float(v), "", low, high, above=above)
+            except InputError:
+                span = f"above {low:g}, up to {high:g}" if above else f"from {low:g} to {high:g}"
+                raise argparse.ArgumentTypeError(f"{text!r} is out of range: give a number {span}") from None
+        return v
+    parse.__name__ = "exact"
+    return parse
+
+
+# The ranges, in the units the options are given in.  Wide enough for any real machine and part,
+# narrow enough that every figure fits a program word and a float with room to spare.
+LENGTH_MM = 100_000.0  # 100 m: no machine travels further
+SCALE = number(1e-6, 1e6, "(a scale factor)", above=True)
+STEP_MM = number(1e-4, LENGTH_MM, "mm")
+SMALL_MM = number(1e-6, 1_000.0, "mm", above=True)  # tolerances and cusp heights
+TOOL_MM = number(0.0, 1_000.0, "mm")
+FEED_MM_MIN = number(1.0, 100_000.0, "mm/min")
+_RPM = number(1.0, 200_000.0, "rpm, or 0 for the spindle off")
+
+
+def SPINDLE_RPM(text: str) -> float:  # noqa: N802 - named as the other option types
+    """0 (spindle off) or a speed an S word can say: a fraction of a turn a minute would be written S0."""
+    return 0.0 if text.strip() in ("0", "0.0", "0.") else _RPM(text)
+HEIGHT_MM = number(-LENGTH_MM, LENGTH_MM, "mm")
+STOCK_MM = number(0.0, 100.0, "mm")
+DECIMALS = count(0, 6)
+PROGRAM_NUMBER = count(1, 9999)
+TOOL_NUMBER = count(0, 9999)
+DIGITS = count(1, 1000)
+
+
+def WORK_OFFSET(text: str) -> str:  # noqa: N802 - named as the other option types
+    """An argparse ``type=`` for ``--work-offset``: the word goes into the program as a block, so only a work offset."""
+    try:
+        return work_offset(text, "")
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e).strip()) from None
+
+
 def add_program_arguments(g) -> None:
     """The program start and end options a point-list and a macro program share (argument group ``g``)."""
     from ..machine import COOLANTS, PROGRAM_LINE_ENDINGS
 
-    g.add_argument("--scale", type=float, default=1.0,
+    g.add_argument("--scale", type=SCALE, default=1.0,
                    help="model scale: the part is SCALE times the size the points describe, in their units "
                         "(a file in inches is 25.4 mm per unit at scale 1; default 1)")
-    g.add_argument("--work-offset", default="G54", metavar="G5x",
+    g.add_argument("--work-offset", type=WORK_OFFSET, default="G54", metavar="G5x",
                    help="work offset: G54 (default) to G59, G54.1 Pn (Fanuc), G59.1-G59.3 (LinuxCNC)")
-    g.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool number T (default 1)")
-    g.add_argument("--length-offset", type=int, metavar="H",
+    g.add_argument("--tool-number", type=TOOL_NUMBER, default=1, metavar="N", help="tool number T (default 1)")
+    g.add_argument("--length-offset", type=TOOL_NUMBER, metavar="H",
                    help="tool length offset number for G43 H (default: the tool number)")
-    g.add_argument("--feed-height", type=float, default=2.0, metavar="MM",
+    g.add_argument("--feed-height", type=STOCK_MM, default=2.0, metavar="MM",
                    help="height above the first point where the rapid down ends and the plunge feed begins "
                         "(default 2); --safe-z must be at least this far above the path")
     g.add_argument("--coolant", choices=COOLANTS, default="off",

@@ -6,11 +6,10 @@ import argparse
 from pathlib import Path
 
 from ..compare import DEFAULT_SAMPLES, DEFAULT_TOLERANCE_MM, TABLE_FORMATS, compare_surfaces, render_table
-from ..errors import InputError
 from ..formula import parse_formula
-from ..io import read_points
+from ..io import TABLE_SUFFIXES, read_points
 from ..surfaces import HERMITE_KINDS, METHODS
-from ._common import emit
+from ._common import count, emit, number
 
 NAME = "compare"
 ORDER = 45
@@ -21,7 +20,8 @@ deviation measures (Table 1), one column per method.
 
 The reference z_f is the Lagrange surface (default), a formula in x and y
 (numbers, x, y, pi, + - * / ** ( ) and sin cos tan exp log sqrt abs), or a
-points file of measurements, compared at the measured positions.
+points file of measurements (a name ending in .json, .csv, .tsv, .txt, .xyz,
+.dat or .asc), compared at the measured positions.
 
 examples:
   lagsym compare examples/paper-example-4.json
@@ -53,16 +53,6 @@ def _methods(text: str) -> list[str]:
     return names
 
 
-def _tolerance(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"tolerance {text!r} should be a number >= 0 (mm)")
-    return value
-
-
 def add_arguments(p) -> None:
     p.add_argument("file", help="control points file: JSON or CSV with x,y,z")
     p.add_argument("--reference", default="lagrange", metavar="REF",
@@ -72,14 +62,14 @@ def add_arguments(p) -> None:
                    help=f"sample grid over the control box (default {DEFAULT_SAMPLES[0]}x{DEFAULT_SAMPLES[1]})")
     p.add_argument("--methods", type=_methods, default=list(METHODS), metavar="LIST",
                    help=f"comma-separated columns, from {','.join(METHODS)} (default all)")
-    p.add_argument("--degree", type=int, default=3, metavar="P",
+    p.add_argument("--degree", type=count(1, 30), default=3, metavar="P",
                    help="B-spline degree in each direction (default 3, capped at n-1)")
     p.add_argument("--hermite", choices=HERMITE_KINDS, default="corner",
                    help="corner: one patch on the 4 corners (default; the paper does not state its Hermite "
                         "rule, and on an evenly spaced net this patch equals the Bezier surface, which the "
                         "paper's Table 1 does not show); "
                         "piecewise: C1 patches through every point")
-    p.add_argument("--tolerance", type=_tolerance, default=DEFAULT_TOLERANCE_MM, metavar="MM",
+    p.add_argument("--tolerance", type=number(0.0, 1_000.0, "mm"), default=DEFAULT_TOLERANCE_MM, metavar="MM",
                    help=f"|d| at or below this counts as a coincided point (default {DEFAULT_TOLERANCE_MM:g})")
     p.add_argument("--format", choices=TABLE_FORMATS, default="text", help="table format (default text)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the table to FILE instead of standard output")
@@ -87,20 +77,21 @@ def add_arguments(p) -> None:
 
 
 def _reference(text: str):
+    """'lagrange', a points file (named by its extension: .json, .csv, ...), or else a formula.
+
+    Only the extension decides, never whether a file of that name happens to exist: ``--reference x``
+    is the formula x even where a file called x lies in the current folder.
+    """
     if text == "lagrange":
         return text
-    try:
-        is_file = Path(text).suffix.lower() in (".json", ".csv") or Path(text).is_file()
-    except (OSError, ValueError):
-        is_file = False
-    return read_points(text) if is_file else parse_formula(text)
+    if Path(text).suffix.lower() in (".json",) + TABLE_SUFFIXES:
+        return read_points(text)
+    return parse_formula(text)
 
 
 def run(args, out, err) -> int:
     grid = read_points(args.file)
     reference = _reference(args.reference)
-    if args.degree < 1:
-        raise InputError(f"--degree {args.degree}: a B-spline degree should be 1 or more")
     if args.plot:
         from ..plot import image_format
 

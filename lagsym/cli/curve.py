@@ -27,6 +27,6 @@ def add_arguments(p) -> None:
 
 def run(args, out, err) -> int:
     curve = lagrange_curve(load_points(args.file, args, err, "curve"))
-    emit(render(curve, args.format, args.digits), args.output, out)
+    emit(render(curve, args.format, args.digits, args.max_terms), args.output, out)
     report_rounding(curve, args.digits, curve.points.units, err)
     return 0

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ..equation import FORMATS, render, rounding_miss
+from ..equation import FORMATS, MAX_TERMS, render, rounding_miss
 from ..lagrange import lagrange_surface
-from ._common import add_points_arguments, emit, load_points
+from ._common import DIGITS, add_points_arguments, count, emit, load_points
 
 NAME = "equation"
 ORDER = 10
@@ -30,14 +30,16 @@ def add_arguments(p) -> None:
 def add_format_arguments(p) -> None:
     p.add_argument("--format", choices=FORMATS, default="sympy",
                    help="sympy (default, parseable by sympy.sympify), latex, json, horner (nested), python")
-    p.add_argument("--digits", type=int, metavar="N",
+    p.add_argument("--digits", type=DIGITS, metavar="N",
                    help="round coefficients to N significant digits, as the paper prints them")
+    p.add_argument("--max-terms", type=count(1, 10**9), default=MAX_TERMS, metavar="N",
+                   help=f"refuse an equation of more than N terms, except with --digits (default {MAX_TERMS})")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of standard output")
 
 
 def run(args, out, err) -> int:
     surface = lagrange_surface(load_points(args.file, args, err))
-    emit(render(surface, args.format, args.digits), args.output, out)
+    emit(render(surface, args.format, args.digits, args.max_terms), args.output, out)
     report_rounding(surface, args.digits, surface.grid.units, err)
     return 0
 

@@ -8,7 +8,8 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
-from ._common import add_program_arguments, emit, program_settings
+from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+                      DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
@@ -44,9 +45,9 @@ def add_arguments(p) -> None:
     p.add_argument("--form", choices=FORMS,
                    help="horner (shortest) or lagrange (tensor-product basis, most accurate); "
                         "default lagrange at 8 digits, horner at 15")
-    p.add_argument("--tolerance", type=float, default=0.001, metavar="MM",
+    p.add_argument("--tolerance", type=SMALL_MM, default=0.001, metavar="MM",
                    help="largest arithmetic error accepted on the control, mm (default 0.001)")
-    p.add_argument("--variable-base", type=int, metavar="N",
+    p.add_argument("--variable-base", type=count(1, 999), metavar="N",
                    help="first variable number: Fanuc #100 (default) or #500, Heidenhain Q1 (default)")
     p.add_argument("--variables", choices=VARIABLE_PROFILES, default="full",
                    help="the control's variable ranges: full (Fanuc #100-#199, #500-#999; default) or small "
@@ -54,20 +55,20 @@ def add_arguments(p) -> None:
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added, mm")
     p.add_argument("--units", choices=("mm", "inch"), default="mm", help="program units (default mm)")
     p.add_argument("--direction", choices=("x", "y"), default="x", help="rows run along x (default) or y")
-    p.add_argument("--stepover", type=float, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
-    p.add_argument("--step", type=float, default=0.2, metavar="MM", help="forward step along a row, mm (default 0.2)")
+    p.add_argument("--stepover", type=STEP_MM, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
+    p.add_argument("--step", type=STEP_MM, default=0.2, metavar="MM", help="forward step along a row, mm (default 0.2)")
     p.add_argument("--tool-shape", choices=("ball", "flat"), default="ball",
                    help="cutter shape (default ball); a flat end is refused: use lagsym toolpath for it")
-    p.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
+    p.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM",
                    help="cutter diameter, mm; 0 programs the surface itself (default 6)")
-    p.add_argument("--feed", type=float, default=600.0, metavar="MM_MIN", help="cutting feed (default 600)")
-    p.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM_MIN", help="plunge feed (default 200)")
-    p.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
-    p.add_argument("--safe-z", type=float, default=50.0, metavar="MM",
+    p.add_argument("--feed", type=FEED_MM_MIN, default=600.0, metavar="MM_MIN", help="cutting feed (default 600)")
+    p.add_argument("--plunge-feed", type=FEED_MM_MIN, default=200.0, metavar="MM_MIN", help="plunge feed (default 200)")
+    p.add_argument("--spindle", type=SPINDLE_RPM, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    p.add_argument("--safe-z", type=HEIGHT_MM, default=50.0, metavar="MM",
                    help="clearance height for rapid moves, above the whole path (default 50)")
-    p.add_argument("--stock", type=float, default=0.0, metavar="MM", help="stock to leave (default 0)")
-    p.add_argument("--program", type=int, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
-    p.add_argument("--decimals", type=int, metavar="N", help="decimals in positions (default 3 mm, 4 inch)")
+    p.add_argument("--stock", type=STOCK_MM, default=0.0, metavar="MM", help="stock to leave (default 0)")
+    p.add_argument("--program", type=PROGRAM_NUMBER, default=1000, metavar="N", help="program number 1-9999 (default 1000)")
+    p.add_argument("--decimals", type=DECIMALS, metavar="N", help="decimals in positions (default 3 mm, 4 inch)")
     add_program_arguments(p.add_argument_group("machine and program"))
     p.add_argument("--stats", action="store_true",
                    help="compare the program's size with the equivalent point list, and their 9600-baud transfer times")

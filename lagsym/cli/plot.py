@@ -8,6 +8,7 @@ from ..errors import InputError
 from ..grid import CurvePoints
 from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
+from ._common import SCALE, count
 
 NAME = "plot"
 ORDER = 50
@@ -64,8 +65,8 @@ def add_arguments(p) -> None:
                    help="draw z K times its true size (surface, compare, toolpath; the ticks read true heights); "
                         "default: chosen so the height lies between a fifth of the plan and the plan, 1 for true "
                         "proportions")
-    p.add_argument("--samples", type=int, metavar="N", help="samples along each axis")
-    p.add_argument("--scale", type=float, default=None,
+    p.add_argument("--samples", type=count(2, 2_000), metavar="N", help="samples along each axis")
+    p.add_argument("--scale", type=SCALE, default=None,
                    help="with --show toolpath: the --scale the program was made with (default 1)")
     p.add_argument("--origin", default=None, metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")

@@ -6,9 +6,11 @@ import contextlib
 
 from ..conditioning import FLOAT_ERROR_LIMIT, float_error_bound
 from ..export import FORMATS, MESH_MAX_POINTS, format_of, write_csv, write_sample
+from ..errors import InputError
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ..sampling import Box, iter_blocks, sample_grid
+from ..sampling import MAX_AXIS_POINTS, MAX_POINTS, Box, iter_blocks, sample_grid
+from ._common import count, exact
 
 NAME = "sample"
 ORDER = 40
@@ -39,16 +41,20 @@ PROGRESS_POINTS = 250_000  # smaller jobs finish before a bar is worth drawing
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     d = p.add_argument_group("density (counts or spacing)")
-    d.add_argument("--nx", type=int, metavar="N", help="grid lines in x, edges included (default 101; alone, also ny)")
-    d.add_argument("--ny", type=int, metavar="N", help="grid lines in y, edges included (default: as --nx)")
-    d.add_argument("--step", metavar="S", help="largest spacing in both directions, e.g. 0.05")
-    d.add_argument("--dx", metavar="S", help="largest spacing in x (with --dy)")
-    d.add_argument("--dy", metavar="S", help="largest spacing in y (with --dx)")
+    d.add_argument("--nx", type=count(2, MAX_AXIS_POINTS), metavar="N", help="grid lines in x, edges included (default 101; alone, also ny)")
+    d.add_argument("--ny", type=count(2, MAX_AXIS_POINTS), metavar="N", help="grid lines in y, edges included (default: as --nx)")
+    d.add_argument("--step", type=exact(0, 1e300, above=True), metavar="S", help="largest spacing in both directions, e.g. 0.05")
+    d.add_argument("--dx", type=exact(0, 1e300, above=True), metavar="S", help="largest spacing in x (with --dy)")
+    d.add_argument("--dy", type=exact(0, 1e300, above=True), metavar="S", help="largest spacing in y (with --dx)")
     b = p.add_argument_group("domain (default: the control points' box)")
     for name in ("x0", "x1", "y0", "y1"):
-        b.add_argument(f"--{name}", metavar="V", help=f"{name} of the sampled box")
+        b.add_argument(f"--{name}", type=exact(), metavar="V", help=f"{name} of the sampled box")
     b.add_argument("--extrapolate", action="store_true", help="allow a box reaching outside the control points")
     p.add_argument("-o", "--output", metavar="FILE", help=f"output file, format by extension: {', '.join(FORMATS)}")
+    p.add_argument("--max-points", type=count(1, 10**15), default=MAX_POINTS, metavar="N",
+                   help=f"refuse a sample of more than N points (default {MAX_POINTS:.0e})")
+    p.add_argument("--accept-rounding", action="store_true",
+                   help="write the samples even when their rounding error may exceed the data range")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
@@ -79,7 +85,8 @@ def run(args, out, err) -> int:
         nx = nx if nx is not None else (ny if ny is not None else DEFAULT_COUNT)
         ny = ny if ny is not None else nx
     grid = sample_grid(surface, nx, ny, step=args.step, dx=args.dx, dy=args.dy,
-                       box=(args.x0, args.x1, args.y0, args.y1), extrapolate=args.extrapolate)
+                       box=(args.x0, args.x1, args.y0, args.y1), extrapolate=args.extrapolate,
+                       max_points=args.max_points)
     b = surface.grid.bounds
     if not Box(*b).contains(grid.box):
         err.write(f"lagsym: warning: the box x {float(grid.box.x0):g}..{float(grid.box.x1):g}, "
@@ -87,6 +94,10 @@ def run(args, out, err) -> int:
                   f"(x {float(b[0]):g}..{float(b[1]):g}, y {float(b[2]):g}..{float(b[3]):g}): "
                   f"the surface there is extrapolated and follows no data\n")
     rel = float_error_bound(surface, grid.box.floats())
+    if rel > 1 and not args.accept_rounding:
+        raise InputError(f"{args.file}: rounding error of the samples may reach {rel:.1e} times the data range, so the "
+                         f"heights could be anything; use fewer or Chebyshev-spaced nodes, exact values from "
+                         f"'lagsym equation', or --accept-rounding to write them anyway")
     if rel > FLOAT_ERROR_LIMIT:
         err.write(f"lagsym: warning: rounding error of the samples may reach {rel:.1e} of the data range "
                   f"(trusted limit {FLOAT_ERROR_LIMIT:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "

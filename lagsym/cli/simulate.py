@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..io import read_program
 from ..simulate import SIM_DIALECTS, detect_dialect, moves_csv, simulate
-from ._common import emit
+from ._common import count, emit
 
 NAME = "simulate"
 ORDER = 75
@@ -29,7 +29,7 @@ def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=SIM_DIALECTS, help="control language (default: guessed from the text)")
     p.add_argument("--precision", type=int, choices=(8, 15),
                    help="significant digits (default 8 for fanuc and heidenhain, 15 for linuxcnc)")
-    p.add_argument("--max-blocks", type=int, default=20_000_000, metavar="N",
+    p.add_argument("--max-blocks", type=count(1, 1_000_000_000), default=20_000_000, metavar="N",
                    help="stop after N executed blocks as a runaway loop (default 20000000)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the moves CSV to FILE instead of standard output")
 

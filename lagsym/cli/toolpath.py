@@ -6,8 +6,10 @@ from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
 from ..post.program import point_program, write_program
+from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import add_program_arguments, program_settings
+from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+                      DECIMALS, add_program_arguments, count, program_settings)
 
 NAME = "toolpath"
 ORDER = 60
@@ -34,27 +36,29 @@ def add_arguments(p) -> None:
                    help="fanuc (default; also Haas and ISO-reading Bridgeport controls), linuxcnc or grbl")
     g = p.add_argument_group("raster")
     g.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
-    g.add_argument("--stepover", type=float, metavar="MM", help="side step between rows (default 0.5)")
-    g.add_argument("--step", type=float, metavar="MM", help="forward step along a row (default 0.2)")
-    g.add_argument("--scallop", type=float, metavar="MM",
+    g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")
+    g.add_argument("--step", type=STEP_MM, metavar="MM", help="forward step along a row (default 0.2)")
+    g.add_argument("--scallop", type=SMALL_MM, metavar="MM",
                    help="side step from this cusp height of a ball-end cutter, instead of --stepover")
-    g.add_argument("--tolerance", type=float, metavar="MM",
+    g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
                    help="forward steps from this chordal error, instead of a fixed --step")
     t = p.add_argument_group("cutter")
     t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
-    t.add_argument("--tool-diameter", type=float, default=6.0, metavar="MM",
+    t.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM",
                    help="cutter diameter (default 6; 0 gives the uncompensated path on the surface)")
     m = p.add_argument_group("machine and program")
     add_program_arguments(m)
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
     m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
-    m.add_argument("--feed", type=float, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
-    m.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
-    m.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
-    m.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="retract height (default 50)")
-    m.add_argument("--stock-to-leave", type=float, default=0.0, metavar="MM", help="material left on the surface")
-    m.add_argument("--program", type=int, default=1000, metavar="N", help="program number O N (default 1000)")
-    m.add_argument("--decimals", type=int, metavar="N", help="decimals in coordinates (default 3 for mm, 4 for inch)")
+    m.add_argument("--feed", type=FEED_MM_MIN, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
+    m.add_argument("--plunge-feed", type=FEED_MM_MIN, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
+    m.add_argument("--spindle", type=SPINDLE_RPM, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    m.add_argument("--safe-z", type=HEIGHT_MM, default=50.0, metavar="MM", help="retract height (default 50)")
+    m.add_argument("--stock-to-leave", type=STOCK_MM, default=0.0, metavar="MM", help="material left on the surface")
+    m.add_argument("--program", type=PROGRAM_NUMBER, default=1000, metavar="N", help="program number O N (default 1000)")
+    m.add_argument("--decimals", type=DECIMALS, metavar="N", help="decimals in coordinates (default 3 for mm, 4 for inch)")
+    m.add_argument("--max-points", type=count(1, 10**12), default=MAX_PLAN_POINTS, metavar="N",
+                   help=f"refuse a plan of more than N fine drop-cutter samples (default {MAX_PLAN_POINTS:.0e})")
     m.add_argument("--title", help="comment at the top of the program (default: the points file's name)")
 
 
@@ -72,7 +76,7 @@ def run(args, out, err) -> int:
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance)
-    tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings)
+    tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
     if args.output and args.output != "-":

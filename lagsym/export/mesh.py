@@ -106,6 +106,11 @@ def write_stl(path: str | os.PathLike, sample: Sample) -> None:
 
     _check_size(sample, path)
     nx, ny = sample.z.shape
+    # STL holds float32: a coordinate beyond its range would become inf in the file.
+    big = max(float(np.max(np.abs(a))) for a in (sample.x, sample.y, sample.z))
+    if not big <= float(np.finfo(np.float32).max):
+        raise InputError(f"{path}: a coordinate of {big:.3g} does not fit STL's 32-bit floats "
+                         f"(largest {float(np.finfo(np.float32).max):.3g}); write .vtk, .vts, .ply or .npy instead")
     xyz = np.empty((nx * ny, 3), dtype=np.float32)
     xyz[:, 0].reshape(nx, ny)[...] = sample.x
     xyz[:, 1].reshape(nx, ny)[...] = sample.y

@@ -43,6 +43,16 @@ class _JsonValueError(Exception):
     pass
 
 
+def _json_object(pairs: list[tuple[str, Any]]) -> dict:
+    """A JSON object whose keys are all different: with a key twice, which one was meant is unknown."""
+    doc = dict(pairs)
+    if len(doc) != len(pairs):
+        seen: set[str] = set()
+        twice = next(k for k, _ in pairs if k in seen or seen.add(k))
+        raise _JsonValueError(f"the key {twice!r} appears twice in one object; keep one")
+    return doc
+
+
 def _value(v: Any, where: str) -> Fraction:
     if isinstance(v, bool):
         raise InputError(f"{where}: {json.dumps(v)} is a boolean, not a number")
@@ -79,7 +89,8 @@ def _kind(name: str, text: str) -> str:
 
 def _load_json(name: str, text: str) -> Any:
     try:
-        return json.loads(text, parse_float=_json_float, parse_int=_json_int, parse_constant=_json_constant)
+        return json.loads(text, parse_float=_json_float, parse_int=_json_int, parse_constant=_json_constant,
+                          object_pairs_hook=_json_object)
     except _JsonValueError as e:
         raise InputError(f"{name}: {e}") from None
     except json.JSONDecodeError as e:

@@ -20,7 +20,6 @@ Numbers stay exact: ``2,5`` with a decimal comma is 5/2.
 from __future__ import annotations
 
 import csv
-import io
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -108,11 +107,20 @@ def parse_columns(text: str, arity: int | None = None) -> tuple[str, ...] | tupl
     return tuple(cells)
 
 
+MAX_CELL = 10_000  # characters in one cell: a number of 300 digits fits many times over
+
+
 def _split(text: str, sep: str) -> list[tuple[int, list[str]]]:
+    # Lines first, at any line ending (LF, CRLF, or CR alone as old Mac software writes); a cell is
+    # never a line long, so no quoted cell spans lines.
+    lines = text.splitlines()
+    for lineno, line in enumerate(lines, start=1):
+        if len(line) > MAX_CELL and max(len(c) for c in line.split(sep if sep != " " else None)) > MAX_CELL:
+            raise InputError(f"line {lineno} has a cell of more than {MAX_CELL} characters, which is no number")
     if sep == " ":
-        rows = [_join_units(line.split()) for line in text.splitlines()]
+        rows = [_join_units(line.split()) for line in lines]
     else:
-        rows = list(csv.reader(io.StringIO(text), delimiter=sep))
+        rows = [next(csv.reader([line], delimiter=sep), []) for line in lines]
     out = []
     for lineno, row in enumerate(rows, start=1):
         cells = [c.strip() for c in row]
@@ -208,7 +216,10 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
     >>> pts, layout.describe()
     ([(Fraction(0, 1), Fraction(0, 1), Fraction(5, 4))], "semicolon-separated; decimal comma; header 'Nr;X (mm);Y (mm);Z (mm)'; x from column 2, y from column 3, z from column 4; ignoring column(s) Nr; units mm")
     """
-    sep, rows = _separator(text)
+    try:
+        sep, rows = _separator(text)
+    except InputError as e:
+        raise InputError(f"{name}: {e}") from None
     if not rows:
         raise InputError(f"{name}: no points in the file")
     header: list[str] = []

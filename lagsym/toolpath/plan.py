@@ -24,7 +24,9 @@ from .filter import filter_rows
 from .pattern import levels as _levels
 from .pattern import raster_pattern, scallop_stepover
 
-__all__ = ["Toolpath", "plan_toolpath"]
+__all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
+
+MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,7 @@ class Toolpath:
 
 
 def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
-                  evaluator: SurfaceEvaluator | None = None) -> Toolpath:
+                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS) -> Toolpath:
     """Plan a zig-zag raster of gouge-free cutter locations over the surface.
 
     Parameters
@@ -88,6 +90,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         Scale, work offset and stock to leave.
     evaluator : SurfaceEvaluator, optional
         The surface's evaluator (by default :func:`lagsym.evaluate.surface_evaluator`).
+    max_points : int or None
+        Refuse, before any work, a plan of more fine drop-cutter samples than
+        this (``--max-points``); None for no limit.
 
     Returns
     -------
@@ -109,6 +114,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     tol = raster.tolerance_mm
     stepover = _side_step(tool, raster)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
+    _check_size(ev.bounds, raster.direction, stepover, fine, mm_per_unit, max_points)
     levels, along = raster_pattern(ev.bounds, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
     if tol is None:
         along = _fixed_step_samples(along, step / mm_per_unit)
@@ -144,6 +150,21 @@ def _place(settings: MachineSettings, x, y, z_mm):
     place = settings.placement
     x_mm, y_mm = place.to_machine(x, y)
     return x_mm, y_mm, np.asarray(z_mm) + place.origin_mm[2]
+
+
+def _check_size(bounds, direction: str, stepover: float, fine: float, scale: float, max_points: int | None) -> None:
+    """Refuse a plan whose fine samples (rows times samples per row) would exceed ``max_points``."""
+    if max_points is None:
+        return
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    length, cross = (x1 - x0, y1 - y0) if direction == "x" else (y1 - y0, x1 - x0)
+    rows = math.ceil(cross * scale / stepover) + 1
+    per_row = math.ceil(length * scale / fine) + 1
+    if rows * per_row > max_points:
+        raise ToolpathError(
+            f"{rows} rows of {per_row} fine samples is {rows * per_row:.3g} drop-cutter points, more than the limit "
+            f"of {max_points:.3g} (side step {stepover:g} mm, sampling step {fine:g} mm); use larger steps "
+            f"or raise the limit (--max-points)")
 
 
 def _side_step(tool: Tool, raster: RasterSpec) -> float:

@@ -1,0 +1,110 @@
+"""Random bytes, point tables and option values thrown at every command: exit 0, 1, 2 or 3, one line, no traceback.
+
+Bounded so the suite stays fast: few examples, small inputs, a per-example deadline.  Commands that
+need a serial port are run only with ``loop://``.
+"""
+
+from __future__ import annotations
+
+import io
+import tempfile
+from pathlib import Path
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from lagsym.cli import main
+
+SETTINGS = settings(max_examples=25, deadline=20_000, suppress_health_check=[HealthCheck.too_slow],
+                    derandomize=True)
+GOOD = '{"points": [[0, 0, 1], [0, 1, 2], [1, 0, 3], [1, 1, 4]]}'
+PROGRAM = "%\nO1\nG0 X0 Y0 Z10\nG1 Z0 F100\nX1\nY1\nM30\n%\n"
+
+# Each command with the numeric options it takes; values are drawn at random for them.
+COMMANDS = {
+    "equation": ["--digits", "--max-terms"],
+    "curve": ["--digits"],
+    "check": [],
+    "sample": ["--nx", "--ny", "--step", "--x0", "--max-points"],
+    "compare": ["--samples", "--degree", "--tolerance"],
+    "toolpath": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--spindle", "--safe-z",
+                 "--decimals", "--max-points"],
+    "macro": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--safe-z", "--tolerance"],
+    "verify": ["--scale", "--tool-diameter", "--cell", "--gouge-limit"],
+    "simulate": ["--max-blocks"],
+}
+NUMBERS = st.one_of(
+    st.sampled_from(["nan", "inf", "-inf", "0", "-1", "1e308", "1e-308", "1e999999", "999999999999999999", "",
+                     "\u0667", "1/0", "0x10", "1_000"]),
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-10**20, 10**20).map(str),
+)
+
+
+def run(argv: list[str]) -> tuple[int, str]:
+    out, err = io.StringIO(), io.StringIO()
+    status = main(argv, out, err)
+    return status, err.getvalue()
+
+
+def assert_answered(status: int, err: str) -> None:
+    assert status in (0, 1, 2, 3), (status, err)
+    assert "Traceback" not in err and "internal error" not in err, err
+    if status == 2:
+        assert err.count("\n") == 1 and err.startswith("lagsym: error:"), err
+
+
+def _args(cmd: str, files: dict[str, Path]) -> list[str]:
+    if cmd == "verify":
+        return [cmd, str(files["points"]), str(files["program"])]
+    if cmd == "simulate":
+        return [cmd, str(files["program"])]
+    return [cmd, str(files["points"])]
+
+
+@SETTINGS
+@given(cmd=st.sampled_from(sorted(COMMANDS)), data=st.binary(max_size=300))
+def test_random_bytes_as_every_input(cmd, data):
+    with tempfile.TemporaryDirectory() as d:
+        files = {"points": Path(d) / "p.json", "program": Path(d) / "p.nc"}
+        for p in files.values():
+            p.write_bytes(data)
+        assert_answered(*run(_args(cmd, files)))
+
+
+_CELL = st.one_of(st.integers(-5, 5).map(str), st.sampled_from(["1.5", "1,5", "nan", "1e400", "x", "", "1/3", "-0"]))
+
+
+@SETTINGS
+@given(cmd=st.sampled_from(["equation", "check", "sample", "compare", "macro"]),
+       rows=st.lists(st.lists(_CELL, min_size=2, max_size=4), min_size=1, max_size=10),
+       sep=st.sampled_from([",", ";", "\t", " "]), end=st.sampled_from(["\n", "\r\n", "\r"]))
+def test_random_point_tables(cmd, rows, sep, end):
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "p.csv"
+        p.write_text(end.join(sep.join(r) for r in rows) + end, newline="")
+        assert_answered(*run([cmd, str(p)]))
+
+
+@SETTINGS
+@given(cmd=st.sampled_from(sorted(c for c in COMMANDS if COMMANDS[c])), data=st.data())
+def test_random_option_values(cmd, data):
+    option = data.draw(st.sampled_from(COMMANDS[cmd]))
+    value = data.draw(NUMBERS)
+    with tempfile.TemporaryDirectory() as d:
+        files = {"points": Path(d) / "p.json", "program": Path(d) / "p.nc"}
+        files["points"].write_text(GOOD)
+        files["program"].write_text(PROGRAM)
+        argv = _args(cmd, files) + [f"{option}={value}"]
+        if cmd in ("toolpath", "macro") and option != "--safe-z":
+            argv.append("--safe-z=100")
+        assert_answered(*run(argv))
+
+
+@settings(max_examples=10, deadline=20_000, derandomize=True)
+@given(data=st.binary(max_size=200))
+def test_send_to_a_loop_port(data):
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "p.nc"
+        p.write_bytes(data)
+        assert_answered(*run(["send", str(p), "--port", "loop://"]))
