@@ -10,9 +10,6 @@ from ..grid import CurvePoints
 from ..lagrange import lagrange_curve, lagrange_surface
 from ._common import add_points_arguments, load_points
 
-NAME = "check"
-ORDER = 30
-HELP = "measure degree, spacing ratio, Lebesgue constants and overshoot of a surface or curve"
 DESCRIPTION = """Measure what the paper's section 4 warns about for the points in FILE:
 degree in each direction (above 6 is the paper's danger line), the spacing
 ratio between the directions, the Lebesgue constant of each node set and the

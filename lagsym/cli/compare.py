@@ -11,9 +11,6 @@ from ..io import TABLE_SUFFIXES, read_points
 from ..surfaces import HERMITE_KINDS, METHODS
 from ._common import count, emit, number
 
-NAME = "compare"
-ORDER = 45
-HELP = "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)"
 DESCRIPTION = """Build the Lagrange, Hermite, Bezier and B-spline surfaces from the control
 points in FILE, sample them at the same (x, y) positions and print the paper's
 deviation measures (Table 1), one column per method.

@@ -7,9 +7,6 @@ from ..lagrange import lagrange_curve
 from ._common import add_points_arguments, emit, load_points
 from .equation import add_format_arguments, report_rounding
 
-NAME = "curve"
-ORDER = 20
-HELP = "print the exact Lagrange curve y = F(x) through a set of points"
 DESCRIPTION = """Print the exact Lagrange interpolating polynomial y = F(x) through the
 points in FILE (JSON [[x, y], ...] or a table with x,y).  With --digits,
 standard error says how far the rounded equation misses the points.

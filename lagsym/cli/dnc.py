@@ -12,9 +12,6 @@ from ..dnc.server import serve
 from ..errors import Terminated
 from ..io import event_log
 
-NAME = "dnc"
-ORDER = 90
-HELP = "run a DNC server: ports that machines call to punch programs and to ask for them"
 DESCRIPTION = """Serve one or more serial ports as a shop's DNC service, as configured in a
 TOML file (see docs/dnc.md): a program punched from a control is saved under
 its program number (O1234 as 1234.nc; an existing file is kept and the new

@@ -6,9 +6,6 @@ from ..equation import FORMATS, MAX_TERMS, render, rounding_miss
 from ..lagrange import lagrange_surface
 from ._common import DIGITS, add_points_arguments, count, emit, load_points
 
-NAME = "equation"
-ORDER = 10
-HELP = "print the exact Lagrange surface z = F(x, y) through a grid of control points"
 DESCRIPTION = """Print the exact tensor-product Lagrange surface z = F(x, y) through the
 control points in FILE (JSON or a table: CSV, TSV, .xyz), with exact rational
 coefficients.  With --digits, standard error says how far the rounded

@@ -10,9 +10,6 @@ from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
 
-NAME = "export"
-ORDER = 42
-HELP = "write the exact surface as a CAD file: STEP or IGES B-spline surface or solid, exact JSON"
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
 control points' box, stored as a clamped single-span B-spline (parameters u, v

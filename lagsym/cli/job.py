@@ -4,9 +4,6 @@ from __future__ import annotations
 
 from ..io import write_text
 
-NAME = "job"
-ORDER = 63
-HELP = "write one program for a whole job file: roughing, finishing, tool changes, cycle time"
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
 program, in order, with a tool change, spindle speed, feeds and coolant for

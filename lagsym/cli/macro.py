@@ -13,9 +13,6 @@ from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
 
-NAME = "macro"
-ORDER = 70
-HELP = "write a macro program that evaluates the surface on the control (Fanuc, LinuxCNC, Heidenhain)"
 DESCRIPTION = """Write a parametric (macro) program for the surface through the control points in
 FILE.  The program loops over integer-counted rows and points of a zig-zag
 raster over the control points' box (scaled by --scale, moved by --origin) and

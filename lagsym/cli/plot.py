@@ -10,9 +10,6 @@ from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
 from ._common import SCALE, count
 
-NAME = "plot"
-ORDER = 50
-HELP = "draw the surface, its basis functions or a curve (an image with -o, else a window)"
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
 --show basis, every basis function L_i(x) L_k(y) as a grid of small pictures;

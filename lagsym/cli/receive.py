@@ -10,9 +10,6 @@ from ..errors import InputError
 from ..io import event_log
 from .send import add_line_arguments, line_settings
 
-NAME = "receive"
-ORDER = 85
-HELP = "receive a program punched out by a CNC control over RS-232"
 DESCRIPTION = """Wait for a program from a CNC control (PUNCH or OUTPUT on the control) and
 write it to FILE, or to standard output.  The program runs from DC2 (or its
 first character) to DC4, its closing %, ETX, or a silence of --idle-timeout

@@ -8,9 +8,6 @@ from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
 from ._common import origin
 
-NAME = "rough"
-ORDER = 62
-HELP = "rough a block down to the surface in z levels and write it as G-code"
 DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
 points in FILE: at each level (the stock top down by the step-down) a
 raster whose height is never below the cutter's exact drop-cutter height

@@ -12,9 +12,6 @@ from ..lagrange import lagrange_surface
 from ..sampling import MAX_AXIS_POINTS, MAX_POINTS, Box, iter_blocks, sample_grid
 from ._common import count, exact
 
-NAME = "sample"
-ORDER = 40
-HELP = "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)"
 DESCRIPTION = f"""Sample the exact Lagrange surface through the control points in FILE on a
 regular grid and write the interior data, numerically stable at any density.
 

@@ -25,9 +25,6 @@ from ..errors import InputError
 from ..io import event_log, read_program
 from ..machine import LINE_ENDINGS
 
-NAME = "send"
-ORDER = 80
-HELP = "send a program to a CNC control over RS-232 (upload to memory or drip feed)"
 DESCRIPTION = """Send the program in FILE to a CNC control over a serial line, with XON/XOFF
 handled by lagsym itself (paced to the line rate, at most a few characters
 past the control's DC3), a progress bar of what has really left the line,

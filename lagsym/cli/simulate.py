@@ -6,9 +6,6 @@ from ..io import read_program
 from ..simulate import SIM_DIALECTS, detect_dialect, moves_csv, simulate
 from ._common import count, emit
 
-NAME = "simulate"
-ORDER = 75
-HELP = "dry-run a macro program at the control's precision and write the moves it makes"
 DESCRIPTION = """Execute PROGRAM (Fanuc Custom Macro B, LinuxCNC O-words or Heidenhain FN/Q,
 guessed from the text unless --dialect is given) in decimal arithmetic of
 --precision significant digits, rounding after every operation as the control

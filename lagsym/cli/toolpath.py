@@ -11,9 +11,6 @@ from ..toolpath.plan import MAX_PLAN_POINTS
 from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, program_settings)
 
-NAME = "toolpath"
-ORDER = 60
-HELP = "plan a raster toolpath over the exact surface and write it as G-code"
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
 FILE and write it as a point-list G-code program.  Cutter locations come from
 drop-cutter against the exact surface, so the tool never cuts below it, also

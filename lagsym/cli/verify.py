@@ -10,9 +10,6 @@ from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, simulate_cut
 from ._common import SCALE, TOOL_MM, count, number, origin
 
-NAME = "verify"
-ORDER = 65
-HELP = "simulate a G-code program's cut on a height map and report gouge, scallop and area not reached"
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
 result with the exact surface: the worst gouge (the cut below the surface),
