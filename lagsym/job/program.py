@@ -17,7 +17,7 @@ import numpy as np
 from ..machine import MachineSettings
 from ..post.model import iso_comment, units_word
 from ..post.moves import format_moves
-from ..post.numbers import fixed
+from ..gcode.numbers import fixed
 from ..toolpath.rough import PLUNGE, RAPID
 from .operations import PlannedJob, _settings
 from .spec import COOLANTS
