@@ -235,7 +235,28 @@ def sample_grid(
     >>> s.nx, s.ny, s.xs.tolist()
     (5, 5, [0.0, 0.5, 1.0, 1.5, 2.0])
     """
-    grid = getattr(control, "grid", control)
+    region = _region(getattr(control, "grid", control), box, extrapolate)
+    counts = nx is not None or ny is not None
+    spacing = step is not None or dx is not None or dy is not None
+    if counts and spacing:
+        raise InputError("give the density either as counts (nx, ny) or as a spacing (step or dx, dy), not both")
+    if step is not None and (dx is not None or dy is not None):
+        raise InputError("give either step (both directions) or dx and dy, not both")
+    if spacing:
+        if step is None and (dx is None or dy is None):
+            raise InputError("give both dx and dy, or step for both directions")
+        nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
+        sx = as_exact(step if step is not None else dx, nxname)
+        sy = as_exact(step if step is not None else dy, nyname)
+        counts = _count_for(sx, region.x1 - region.x0, nxname), _count_for(sy, region.y1 - region.y0, nyname)
+        return _within(SampleGrid(region, *counts), max_points)
+    if nx is None or ny is None:
+        raise InputError("give both nx and ny (or a spacing)")
+    return _within(SampleGrid(region, _count(nx, "nx"), _count(ny, "ny")), max_points)
+
+
+def _region(grid, box, extrapolate: bool) -> Box:
+    """The box to sample: ``box`` with the control box's edges for its Nones, checked against the control points."""
     cx0, cx1, cy0, cy1 = grid.bounds
     given = [None] * 4 if box is None else list(box)
     if len(given) != 4:
@@ -253,23 +274,7 @@ def sample_grid(
             f"(x {_show(cx0)}..{_show(cx1)}, y {_show(cy0)}..{_show(cy1)}); that is extrapolation: "
             f"allow it explicitly (extrapolate=True, --extrapolate)"
         )
-    counts = nx is not None or ny is not None
-    spacing = step is not None or dx is not None or dy is not None
-    if counts and spacing:
-        raise InputError("give the density either as counts (nx, ny) or as a spacing (step or dx, dy), not both")
-    if step is not None and (dx is not None or dy is not None):
-        raise InputError("give either step (both directions) or dx and dy, not both")
-    if spacing:
-        if step is None and (dx is None or dy is None):
-            raise InputError("give both dx and dy, or step for both directions")
-        nxname, nyname = ("step", "step") if step is not None else ("dx", "dy")
-        sx = as_exact(step if step is not None else dx, nxname)
-        sy = as_exact(step if step is not None else dy, nyname)
-        counts = _count_for(sx, x1 - x0, nxname), _count_for(sy, y1 - y0, nyname)
-        return _within(SampleGrid(region, *counts), max_points)
-    if nx is None or ny is None:
-        raise InputError("give both nx and ny (or a spacing)")
-    return _within(SampleGrid(region, _count(nx, "nx"), _count(ny, "ny")), max_points)
+    return region
 
 
 def _within(g: SampleGrid, max_points: int | None) -> SampleGrid:

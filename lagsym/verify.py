@@ -168,7 +168,6 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     resolution = (r - math.sqrt(max(r * r - (ds / 2) ** 2, 0.0)) if ball else 0.0) + dz_mm / 2
     limit = program_resolution_mm + resolution if gouge_limit_mm is None else float(gouge_limit_mm)
     cut = np.full((nx, ny), np.inf)
-    positions = 0
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
     known = np.asarray(moves.z_known, dtype=bool)
     path = moves.path_mm
@@ -177,15 +176,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     if not len(a_all):
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
     _check_work(a_all, b_all, ds, dz_mm, r, hx, hy, max_contacts)
-    # A few thousand moves at a time, so a long program never needs all its samples in memory at once.
-    for s in range(0, len(a_all), _MOVES_PER_PASS):
-        pts = _samples(a_all[s:s + _MOVES_PER_PASS], b_all[s:s + _MOVES_PER_PASS], ds, dz_mm)
-        near = (pts[:, 0] >= x0 - r - hx) & (pts[:, 0] <= x1 + r + hx) & (pts[:, 1] >= y0 - r - hy) & (
-            pts[:, 1] <= y1 + r + hy)
-        pts = pts[near]
-        positions += len(pts)
-        if len(pts):
-            _press(cut, pts, xs, ys, r, ball)
+    positions = _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm)
     reached = np.isfinite(cut)
     diff = np.where(reached, cut - surf, np.nan)
     if reached.any():
@@ -204,6 +195,25 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=gouge, gouge_at=at(gi),
                      scallop_mm=scallop, scallop_at=at(si), unreached_mm2=float((~reached).sum() * hx * hy),
                      resolution_mm=resolution, gouge_limit_mm=limit, positions=positions)
+
+
+def _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm) -> int:
+    """Press the tool into ``cut`` along every move; the number of tool positions simulated.
+
+    A few thousand moves at a time, so a long program never needs all its samples in memory at once.
+    """
+    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
+    x0, x1, y0, y1 = xs[0], xs[-1], ys[0], ys[-1]
+    positions = 0
+    for s in range(0, len(a_all), _MOVES_PER_PASS):
+        pts = _samples(a_all[s:s + _MOVES_PER_PASS], b_all[s:s + _MOVES_PER_PASS], ds, dz_mm)
+        near = (pts[:, 0] >= x0 - r - hx) & (pts[:, 0] <= x1 + r + hx) & (pts[:, 1] >= y0 - r - hy) & (
+            pts[:, 1] <= y1 + r + hy)
+        pts = pts[near]
+        positions += len(pts)
+        if len(pts):
+            _press(cut, pts, xs, ys, r, ball)
+    return positions
 
 
 def _cells(width: float, depth: float, cell_mm: float, max_cells: int | None) -> tuple[int, int]:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 CACHE = Path(os.environ.get("LAGSYM_TOOL_CACHE", REPO / ".cache" / "debtools"))
-RS274_PACKAGES = ("linuxcnc-uspace", "libboost-python1.74.0")
+RS274_PACKAGES = ("linuxcnc-uspace", "libboost-python1.74.0", "libpython3.11")  # rs274 embeds Python
 
 
 class ToolUnavailable(RuntimeError):

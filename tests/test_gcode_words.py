@@ -74,9 +74,12 @@ def test_comments_are_read_as_rs274_reads_them(rs274):
 
 
 def test_the_macro_writers_keep_the_controls_limits():
-    assert fanuc.MAX_BLOCK == limits.MAX_BLOCK["fanuc"]
-    assert linuxcnc.MAX_BLOCK == limits.MAX_BLOCK["linuxcnc"]
-    assert fanuc.VARIABLE_RANGES == limits.MACRO_VARIABLES["fanuc"]
-    assert heidenhain.VARIABLE_RANGES == limits.MACRO_VARIABLES["heidenhain"]
+    # One table: the writers hold no limits of their own, and the table's rows agree with its columns.
+    for module in (fanuc, linuxcnc, heidenhain):
+        assert not hasattr(module, "MAX_BLOCK") and not hasattr(module, "VARIABLE_RANGES"), module.__name__
+    for dialect in ("fanuc", "linuxcnc", "heidenhain"):
+        assert limits.LIMITS[dialect].max_block == limits.MAX_BLOCK[dialect]
+    for dialect in ("fanuc", "heidenhain"):
+        assert limits.LIMITS[dialect].variables["full"] == limits.MACRO_VARIABLES[dialect]
     for dialect, ranges in limits.MACRO_VARIABLES.items():
         assert all(any(lo <= a and b <= hi for lo, hi in limits.VARIABLE_RANGES[dialect]) for a, b in ranges)

@@ -43,12 +43,14 @@ def write_program(program: PointProgram) -> str:
     >>> from lagsym.machine import MachineSettings
     >>> p = PointProgram(np.array([[0.0, 0.0, 1.0], [2.0, 0.0, 1.0]]), MachineSettings(dialect="linuxcnc"))
     >>> print(write_program(p), end="")
+    (SURFACE IN MM 1 MM PER UNIT PROGRAM IN MM)
     G21 G17 G40 G49 G80 G90 G94
-    G54
     T1 M06
+    G54
     S3000 M03
+    G00 G43 H1 Z50.000
     G00 X0.000 Y0.000
-    G43 H1 Z50.000
+    Z3.000
     G01 Z1.000 F200.0
     X2.000 F600.0
     G00 Z50.000
