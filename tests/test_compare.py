@@ -301,7 +301,7 @@ def test_cli_plot_writes_a_deviation_map(run_cli, tmp_path):
     assert status == 0, err
     assert "Deviation rate" in out
     with Image.open(target) as im:
-        assert im.size == (1024, 768)
+        assert im.size == (1280, 480)  # plot.DEVIATION_WINDOW_SIZE: one row of maps
         px = np.asarray(im.convert("RGB"), dtype=float)
     assert (np.abs(px - px[0, 0]).sum(axis=2) > 30).mean() > 0.05  # something was drawn
 
