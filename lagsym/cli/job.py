@@ -12,7 +12,7 @@ each operation and of the whole job is printed and written in the program's
 header.  See docs/roughing.md for the job file.
 
 examples:
-  lagsym job examples/example-4-job.toml -o part.ngc"""
+  lagsym job examples/example-4-job.toml -o job.ngc"""
 
 
 def add_arguments(p) -> None:

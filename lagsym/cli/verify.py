@@ -21,7 +21,7 @@ input (an unreadable file, a program with arcs or canned cycles).
 
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
-  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.2"""
+  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1"""
 
 
 def add_arguments(p) -> None:
