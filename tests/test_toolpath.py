@@ -14,11 +14,11 @@ from lagsym.errors import ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.machine import DEFAULT_TOLERANCE_MM, MachineSettings, RasterSpec, Tool
 from lagsym.toolpath import Toolpath, plan_toolpath, scallop_stepover
 
 from conftest import EXAMPLES
-from cutters import big_ball_surface, reference, surfaces
+from cutters import big_ball_surface, brute, exact_heights, reference, surfaces, swept_ball
 
 
 @pytest.fixture(scope="module")
@@ -42,12 +42,12 @@ def test_toolpath_is_a_frozen_value_with_read_only_arrays(example4):
 
 
 def test_zig_zag_rows_alternate_and_stay_in_the_box(example4):
-    tp = plan(example4, raster=RasterSpec("y", 2.0, 1.0), origin_mm=(5.0, -3.0, 1.0))
+    tp = plan(example4, raster=RasterSpec("y", 2.0, 1.0, boundary="centre"), origin_mm=(5.0, -3.0, 1.0))
     p = tp.points_mm
     assert p[:, 0].min() == pytest.approx(25.0) and p[:, 0].max() == pytest.approx(105.0)
     assert p[:, 1].min() == pytest.approx(17.0) and p[:, 1].max() == pytest.approx(97.0)
-    row0 = p[tp.rows == 0]
-    row1 = p[tp.rows == 1]
+    # A row's points, without the link to the next row (which the row's number also covers).
+    row0, row1 = (p[(tp.rows == i) & (p[:, 0] == p[tp.rows == i][0, 0])] for i in (0, 1))
     assert np.all(np.diff(row0[:, 1]) > 0) and np.all(np.diff(row1[:, 1]) < 0)
     assert np.all(row0[:, 0] == row0[0, 0]) and row1[0, 0] - row0[0, 0] <= 2.0 + 1e-9
 
@@ -87,3 +87,65 @@ def test_stock_to_leave_raises_the_ball_by_the_stock_on_a_plane():
     a = plan(surf, raster=RasterSpec("x", 5.0, 5.0), scale=1.0)
     b = plan(surf, raster=RasterSpec("x", 5.0, 5.0), scale=1.0, stock_to_leave_mm=0.25)
     np.testing.assert_allclose(b.points_mm[:, 2] - a.points_mm[:, 2], 0.25, atol=1e-9)
+
+
+def test_a_fixed_step_is_the_longest_move_and_points_are_added_where_the_path_bends(example4):
+    # Regression: with stepover 2 and step 1 the moves were lifted by up to 0.418 mm where the ball
+    # starts to rest on the box edge, and elsewhere by the whole surface's curvature bound.
+    tp = plan(example4, raster=RasterSpec("x", 2.0, 1.0, boundary="centre"))
+    p = tp.points_mm
+    assert tp.lift_mm.max() <= DEFAULT_TOLERANCE_MM + 1e-12
+    row = tp.rows[:-1] == tp.rows[1:]
+    assert np.hypot(*np.diff(p[:, :2], axis=0)[row].T).max() <= 1.0 + 1e-9
+    assert len(tp) > 41 * 81  # points were added
+    # Independently: a dense lattice over the tool's disc on the exact polynomial, at points near the edges
+    # and halfway along the moves there.
+    near = np.flatnonzero((p[:-1, 0] < 26.0) | (p[:-1, 0] > 94.0))[::7]
+    for k in near:
+        for u in (0.0, 0.5):
+            q = p[k] + u * (p[k + 1] - p[k])
+            low = brute(example4, q[0] / 20, q[1] / 20, 3.0 / 20) * 20
+            # The lattice falls short of the true maximum by up to about 0.01 mm on the steep flanks near the rim.
+            assert low - 1e-9 <= q[2] <= low + DEFAULT_TOLERANCE_MM + 0.015
+
+
+@pytest.mark.parametrize("boundary, reach", [("inside", -3.0), ("centre", 0.0), ("past", 3.0)])
+def test_boundary_sets_where_the_tool_axis_goes(example4, boundary, reach):
+    tp = plan(example4, tool=Tool("flat", 6.0), raster=RasterSpec("x", 4.0, 2.0, boundary=boundary))
+    x, y = tp.points_mm[:, 0], tp.points_mm[:, 1]
+    assert x.min() == pytest.approx(20.0 - reach) and x.max() == pytest.approx(100.0 + reach)
+    assert y.min() == pytest.approx(20.0 - reach) and y.max() == pytest.approx(100.0 + reach)
+    # Beyond a corner the rows round it: no position further than the reach from the box.
+    dx = np.maximum(np.maximum(20.0 - x, x - 100.0), 0.0)
+    dy = np.maximum(np.maximum(20.0 - y, y - 100.0), 0.0)
+    assert np.hypot(dx, dy).max() <= max(reach, 0.0) + 1e-9
+
+
+def test_past_boundary_finishes_the_edges(example4):
+    """Example 4 at scale 10 with a 6 mm ball: its flanks are steep at the box edges.
+
+    With the tool axis kept in the box (``centre``) a ball centred on the edge
+    cannot reach the bottom of the slope there; ``past`` finishes it.  Checked
+    by a ball swept along the program's moves, written in the tests, against
+    the exact polynomial on cells along the box edges.
+    """
+    scale = 10.0
+    xs = np.linspace(10.0, 50.0, 161)
+    edge = np.array([10.0, 10.25, 49.75, 50.0])
+    heights = {}
+    for boundary in ("centre", "past"):
+        tp = plan(example4, raster=RasterSpec("x", 0.5, 0.5, boundary=boundary), scale=scale)
+        left = []
+        for a, b in ((xs, edge), (edge, xs)):
+            if a.size not in heights:
+                pass
+            key = (a is xs)
+            if key not in heights:
+                heights[key] = exact_heights(example4, a / scale, b / scale) * scale
+            left.append(swept_ball(tp.points_mm, 3.0, a, b) - heights[key])
+        left = np.concatenate([v.ravel() for v in left])
+        if boundary == "centre":
+            assert left.max() > 1.0  # the material left at the steep edges
+        else:
+            assert left.min() >= -2e-3  # no gouge (the swept ball's own sampling errs by about 1 um)
+            assert left.max() <= 0.1

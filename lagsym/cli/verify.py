@@ -7,17 +7,21 @@ from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
-from ..verify import MAX_CELLS, MAX_CONTACTS, simulate_cut
+from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
 from ._common import SCALE, TOOL_MM, count, number, origin
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
 result with the exact surface: the worst gouge (the cut below the surface),
-the largest scallop left above it, and the area the tool never reached.  Any
-point-list program can be checked this way, lagsym's or not.
+the deepest rapid (G00) into the part, the most material left anywhere on the
+part (its edges included) and where, the scallop between passes (normal to
+the surface, a tool radius or more from the edges) and the area the tool never
+reached.  Any point-list program can be checked this way, lagsym's or not.
 
-exit status: 0 no gouge; 1 the program gouges (deeper than the limit); 2 bad
-input (an unreadable file, a program with arcs or canned cycles).
+exit status: 0 the program passes; 1 it gouges or a rapid goes into the part
+(deeper than the gouge limit), or it leaves more material than --max-left
+(or a scallop above --max-scallop); 2 bad input (an unreadable file, a
+program with arcs or canned cycles).
 
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
@@ -33,8 +37,13 @@ def add_arguments(p) -> None:
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset the program was made with, mm")
     p.add_argument("--cell", type=number(1e-3, 1_000.0, "mm"), metavar="MM", help="height-map cell size (default: box side / 400)")
     p.add_argument("--gouge-limit", type=number(0.0, 1_000.0, "mm"), metavar="MM",
-                   help="depth from which a cut counts as a gouge "
-                        "(default: program rounding plus simulation resolution)")
+                   help="depth from which a cut counts as a gouge (default: what the program's rounding can "
+                        "cause: half a unit of its last decimal, and as much sideways times the steepest slope)")
+    p.add_argument("--max-left", type=number(0.0, 1_000.0, "mm"), default=MAX_LEFT_MM, metavar="MM",
+                   help=f"material left anywhere above which the program fails (default {MAX_LEFT_MM})")
+    p.add_argument("--max-scallop", type=number(0.0, 1_000.0, "mm"), metavar="MM",
+                   help="scallop between passes (normal to the surface) above which the program fails "
+                        "(default: reported, not checked)")
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
     p.add_argument("--max-contacts", type=count(1, 10**14), default=MAX_CONTACTS, metavar="N",
@@ -48,6 +57,8 @@ def run(args, out, err) -> int:
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
     report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), place, cell_mm=args.cell,
-                          gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells, max_contacts=args.max_contacts)
+                          program_resolution_mm=program_resolution_mm(text), gouge_limit_mm=args.gouge_limit,
+                          max_cells=args.max_cells, max_contacts=args.max_contacts, max_left_mm=args.max_left,
+                          max_scallop_mm=args.max_scallop)
     out.write("\n".join(report.summary()) + "\n")
-    return ExitStatus.WARNING if report.gouges else ExitStatus.OK
+    return ExitStatus.WARNING if report.fails else ExitStatus.OK

@@ -12,10 +12,10 @@ import math
 import numpy as np
 
 from ..errors import ToolpathError
-from ..machine import DIRECTIONS
+from ..machine import BOUNDARIES, DIRECTIONS
 from ..values import choice, finite, positive
 
-__all__ = ["raster_pattern", "levels", "scallop_stepover"]
+__all__ = ["raster_pattern", "levels", "scallop_stepover", "tool_reach", "within_reach"]
 
 
 def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
@@ -67,3 +67,41 @@ def raster_pattern(bounds, direction: str, stepover: float, step: float):
     if direction == "x":
         return levels(y0, y1, stepover), levels(x0, x1, step)
     return levels(x0, x1, stepover), levels(y0, y1, step)
+
+
+def tool_reach(bounds, radius: float, boundary: str, past: float | None = None):
+    """The box the tool axis ranges over, ``(x0, x1, y0, y1)``, for a boundary mode (see :class:`~lagsym.machine.RasterSpec`).
+
+    ``inside`` shrinks the control points' box by the tool radius (surface
+    units), ``centre`` keeps it, ``past`` widens it by ``past`` (by default
+    the radius); with ``past`` the rows round the box corners
+    (:func:`within_reach`).
+
+    Examples
+    --------
+    >>> tool_reach((0.0, 4.0, 0.0, 2.0), 0.5, "past")
+    (-0.5, 4.5, -0.5, 2.5)
+    """
+    choice(boundary, BOUNDARIES, "boundary")
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    grow = {"inside": -radius, "centre": 0.0, "past": radius if past is None else past}[boundary]
+    if x1 - x0 + 2 * grow < 0 or y1 - y0 + 2 * grow < 0:
+        raise ToolpathError(f"a tool of radius {radius:g} does not fit inside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}; choose another boundary")
+    return (x0 - grow, x1 + grow, y0 - grow, y1 + grow)
+
+
+def within_reach(x, y, bounds, radius: float):
+    """Positions brought within ``radius`` of the box: beyond a corner, onto the arc around it.
+
+    Examples
+    --------
+    >>> [round(float(v), 6) for v in within_reach(3.0, 3.0, (0.0, 2.0, 0.0, 2.0), 1.0)]
+    [2.707107, 2.707107]
+    """
+    x0, x1, y0, y1 = bounds
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    nx, ny = np.clip(x, x0, x1), np.clip(y, y0, y1)
+    d = np.hypot(x - nx, y - ny)
+    f = np.where(d > radius, radius / np.where(d > 0, d, 1.0), 1.0)
+    return nx + (x - nx) * f, ny + (y - ny) * f

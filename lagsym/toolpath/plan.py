@@ -21,8 +21,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from . import chordal
 from .dropcutter import drop_cutter
 from .filter import filter_rows
-from .pattern import levels as _levels
-from .pattern import raster_pattern, scallop_stepover
+from .pattern import raster_pattern, scallop_stepover, tool_reach, within_reach
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
@@ -49,8 +48,13 @@ class Toolpath:
         The side step and forward step actually used (with a chordal
         tolerance, ``step_mm`` is the sampling step the filter started from).
     bounds_mm : tuple of float
-        The control points' box on the machine, ``(x0, x1, y0, y1)``: the
-        envelope of the tool positions.
+        The control points' box on the machine, ``(x0, x1, y0, y1)``.  The
+        tool positions stay inside it (``raster.boundary`` ``centre``), the
+        tool radius inside it (``inside``) or within the tool radius of it
+        (``past``).
+    fine_points : int
+        How many cutter locations the filter chose the points from (the
+        blocks a program would have without filtering).
     """
 
     points_mm: np.ndarray
@@ -61,6 +65,7 @@ class Toolpath:
     stepover_mm: float
     step_mm: float
     bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+    fine_points: int = 0
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -111,22 +116,26 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     """
     ev = evaluator or surface_evaluator(surface)
     mm_per_unit = settings.mm_per_unit
-    tol = raster.tolerance_mm
+    tol = raster.chordal_tolerance_mm
+    cl = _Cutter.of(surface, ev, tool, settings)
+    # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
+    past = min(_past_reach(ev, tool.shape, cl.radius), cl.radius - 2 * cl.grid) if raster.boundary == "past" else None
+    reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     stepover = _side_step(tool, raster)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
-    _check_size(ev.bounds, raster.direction, stepover, fine, mm_per_unit, max_points)
-    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
-    if tol is None:
-        along = _fixed_step_samples(along, step / mm_per_unit)
-    cl = _Cutter.of(surface, ev, tool, settings)
-    path = _fine_path(cl, levels, along, raster.direction, fine)
+    _check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
+    levels, along = raster_pattern(reach, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
+    path = _fine_path(cl, levels, along, raster.direction, fine, past)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
-    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)))
+    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm)
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
     vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
-    dense = chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius)
+    # Where the tool meets a box edge the path may bend between samples; where it does not bend near
+    # a move, the samples show its sag.  A move whose estimated sag exceeds the tolerance is split too.
+    dense = (chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend)) | (sag > tol)
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    vx, vy = cl.on_grid(vx, vy)  # where their cutter locations were computed
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     return Toolpath(
@@ -138,6 +147,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         stepover_mm=float((levels[1] - levels[0]) * mm_per_unit) if len(levels) > 1 else float(stepover),
         step_mm=float(step),
         bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
+        fine_points=len(path.x),
     )
 
 
@@ -167,6 +177,30 @@ def _check_size(bounds, direction: str, stepover: float, fine: float, scale: flo
             f"or raise the limit (--max-points)")
 
 
+_SLOPE_SAMPLES = 257  # points along each box edge where the steepest slope is measured
+
+
+def _past_reach(ev: SurfaceEvaluator, shape: str, radius: float) -> float:
+    """How far beyond the box the tool axis goes with ``--boundary past`` (surface units).
+
+    A flat end touches the box edge up to its radius beyond it.  A ball
+    touches a slope of angle ``a`` at ``radius * sin(a)`` from its axis, so
+    beyond ``radius * sin(a)`` for the steepest slope ``a`` on the box edges
+    it reaches nothing the positions nearer the box have not; further out it
+    would touch the part's edge only near its equator, where a sideways
+    rounding of the position moves the tool a long way down the edge.
+    """
+    if shape != "ball" or radius == 0:
+        return radius
+    x0, x1, y0, y1 = ev.bounds
+    t = np.linspace(0.0, 1.0, _SLOPE_SAMPLES)
+    ex = np.concatenate([x0 + t * (x1 - x0), x0 + t * (x1 - x0), np.full_like(t, x0), np.full_like(t, x1)])
+    ey = np.concatenate([np.full_like(t, y0), np.full_like(t, y1), y0 + t * (y1 - y0), y0 + t * (y1 - y0)])
+    slope = float(np.hypot(ev.fast_points(ex, ey, dx=1), ev.fast_points(ex, ey, dy=1)).max())
+    # A little further than the samples show, for the slope between them.
+    return min(radius, 1.02 * radius * slope / math.hypot(1.0, slope))
+
+
 def _side_step(tool: Tool, raster: RasterSpec) -> float:
     """The side step asked for (mm), or the one a ball leaves the scallop height with."""
     if raster.stepover_mm is not None:
@@ -177,26 +211,15 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
 
 
 def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float) -> tuple[float, float]:
-    """The forward step (mm) and the finer sampling step it is checked at (mm).
+    """The longest move (mm) and the finer sampling step the filter chooses points from (mm).
 
-    A fixed step is sampled four times finer; a chordal tolerance chooses a
-    sampling step whose own chordal error on the surface is a quarter of it.
+    The sampling step is one whose own chordal error on the surface is a
+    quarter of the tolerance, and with a fixed step at most half of it.
     """
-    tol = raster.tolerance_mm
+    fine = chordal.tolerance_step(ev, raster.chordal_tolerance_mm, mm_per_unit)
     if raster.step_mm is None:
-        fine = chordal.tolerance_step(ev, tol, mm_per_unit)
         return fine, fine
-    step = raster.step_mm
-    return step, step / 4.0 if tol is None else min(step, chordal.tolerance_step(ev, tol, mm_per_unit))
-
-
-_EMIT_EVERY = 2  # with a fixed forward step, a fine sample halfway along each move measures its sag
-
-
-def _fixed_step_samples(along: np.ndarray, step: float) -> np.ndarray:
-    """Positions along a row for a fixed forward step: the emitted points and one sample halfway between each two."""
-    n = len(_levels(along[0], along[-1], step)) - 1
-    return np.linspace(along[0], along[-1], n * _EMIT_EVERY + 1)
+    return raster.step_mm, min(raster.step_mm / 2.0, fine)
 
 
 @dataclass(frozen=True)
@@ -205,6 +228,10 @@ class _Cutter:
 
     The radius (surface units) includes the stock to leave for a ball, which
     then rides that much higher; a flat end is lifted by the stock instead.
+    A position beyond the box (``--boundary past``) is first moved to the
+    program's grid (its X and Y as the program writes them): there the tool
+    touches the part's edges with its side, where rounding X or Y by half a
+    unit of the last decimal would lower it against the edge by many units.
     """
 
     surface: object
@@ -213,16 +240,37 @@ class _Cutter:
     shape: str
     lift_tip: float
     mm_per_unit: float
+    settings: MachineSettings | None = None
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
         r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
         r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / mm_per_unit
         lift_tip = r - r_mm / mm_per_unit if tool.shape == "ball" else stock / mm_per_unit
-        return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit)
+        return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit, settings)
+
+    @property
+    def grid(self) -> float:
+        """The program's unit of the last decimal, in surface units."""
+        s = self.settings
+        return 10.0 ** -s.digits / s.unit_factor / self.mm_per_unit if s is not None else 0.0
+
+    def on_grid(self, x, y):
+        """The positions beyond the box moved to the program's grid; those over the box as they are."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        x0, x1, y0, y1 = self.ev.bounds
+        out = (x < x0) | (x > x1) | (y < y0) | (y > y1)
+        if self.settings is None or not out.any():
+            return x, y
+        place, k = self.settings.placement, self.settings.unit_factor * 10 ** self.settings.digits
+        mx, my = place.to_machine(x[out], y[out])
+        sx, sy = place.to_surface(np.rint(np.asarray(mx) * k) / k, np.rint(np.asarray(my) * k) / k)
+        x, y = x.copy(), y.copy()
+        x[out], y[out] = sx, sy
+        return x, y
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, *self.on_grid(x, y), self.radius, self.shape, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
 
@@ -244,57 +292,70 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _FinePath:
-    """Drop the tool over every fine sample of every row and of the links between rows, in cutting order."""
-    a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
-    z_rows = cl(*((a_grid, l_grid) if direction == "x" else (l_grid, a_grid)))
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None) -> _FinePath:
+    """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
+
+    With the tool ``past`` the boundary (that far, surface units), positions
+    further than that from a box corner are brought back onto the arc around
+    it (the rows round the corners).
+    """
     gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
     link_n = max(2, 2 * int(math.ceil(gap * cl.mm_per_unit / fine / 2)))
     u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
-    ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
-    link_a = np.repeat(ends, len(u))
-    link_l = (levels[:-1, None] + u[None, :] * gap).ravel()
-    z_links = (cl(*((link_a, link_l) if direction == "x" else (link_l, link_a)))
-               if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
-    fa, fl, fz, frow, pieces = [], [], [], [], []
+    fa, fl, frow, pieces = [], [], [], []
     count = 0
     for i in range(len(levels)):
-        fwd = i % 2 == 0
-        t = along if fwd else along[::-1]
-        piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
-        if i + 1 < len(levels):
-            piece.append((np.full_like(u, t[-1]), levels[i] + u * gap, z_links[i]))
-        for pa, pl, pz in piece:
-            fa.append(pa)
-            fl.append(pl)
-            fz.append(pz)
-            frow.append(np.full(len(pa), i))
-        # The row runs over fine indices [count, count + len(t)), the link after it up to the next row's start.
+        t = along if i % 2 == 0 else along[::-1]
+        fa += [t]
+        fl += [np.full_like(t, levels[i])]
+        frow += [np.full(len(t), i)]
         row_end = count + len(t) - 1
         pieces.append((count, row_end, True))
+        count = row_end + 1
         if i + 1 < len(levels):
+            # The link runs along the row's end to the next row's start.
+            fa += [np.full_like(u, t[-1])]
+            fl += [levels[i] + u * gap]
+            frow += [np.full(len(u), i)]
             pieces.append((row_end, row_end + len(u) + 1, False))
-        count = row_end + len(u) + 1 if i + 1 < len(levels) else row_end + 1
-    fa, fl, fz, frow = (np.concatenate(v) for v in (fa, fl, fz, frow))
+            count += len(u)
+    fa, fl, frow = (np.concatenate(v) for v in (fa, fl, frow))
     fx, fy = (fa, fl) if direction == "x" else (fl, fa)
+    if past is not None:
+        fx, fy = within_reach(fx, fy, cl.ev.bounds, past)
+    fz = cl(fx, fy)
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
 
-def _emitted(path: _FinePath, tol: float | None, extra: np.ndarray) -> np.ndarray:
-    """Indices of the fine samples to emit: filtered to the tolerance, or every other one of a row for a fixed step.
+def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float | None) -> np.ndarray:
+    """Indices of the fine samples to emit.
 
-    A link between rows is one move with a fixed step.  ``extra`` is the
-    sag between samples the filter adds to what the samples show.
+    With a chordal tolerance alone, the filter keeps the moves within it.
+    With a fixed step (the longest move), every fine sample a step apart is
+    kept (the samples are at most half a step apart) and, where a move's sag
+    exceeds the tolerance, the samples inside it too: points are added where
+    the path bends.  ``extra`` is the sag between samples added to what the
+    samples show.
     """
-    kept = [0]
     s_mm, z = path.s_mm, path.z
-    for lo, hi, is_row in path.pieces:
-        if tol is not None:
+    if longest_mm is None:
+        kept = [0]
+        for lo, hi, _ in path.pieces:
             k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], z[lo:hi + 1], tol, extra[lo:hi + 1]) + lo
-        elif is_row:
-            k = np.arange(lo, hi + 1, _EMIT_EVERY)
-        else:
-            k = np.array([lo, hi])
-        kept.extend(int(v) for v in k[1:])
-    return np.array(kept, dtype=int)
+            kept.extend(int(v) for v in k[1:])
+        return np.array(kept, dtype=int)
+    every = []
+    for lo, hi, _ in path.pieces:
+        widest = float(np.diff(s_mm[lo:hi + 1]).max()) if hi > lo else longest_mm
+        e = max(1, int(longest_mm * (1 + 1e-9) // widest))
+        every.append(np.append(np.arange(lo, hi, e), hi))
+    kept = np.unique(np.concatenate(every))
+    sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
+    split = np.flatnonzero((sag > tol) & (np.diff(kept) > 1))
+    if not split.size:
+        return kept
+    inner = np.concatenate([np.arange(kept[m] + 1, kept[m + 1]) for m in split])
+    return np.union1d(kept, inner)
+
+
