@@ -281,6 +281,16 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     cut = np.full((nx, ny), np.inf)
     positions = _sweep(cut, path[:-1][use & ~rapid], path[1:][use & ~rapid], xs, ys, r, ball, ds, dz_mm)
     crash, crash_positions = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, ball, ds, dz_mm))
+    return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
+                     rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
+                     unreached_mm2=float((~np.isfinite(cut)).sum() * hx * hy), resolution_mm=resolution,
+                     gouge_limit_mm=limit, max_left_mm=float(max_left_mm),
+                     max_scallop_mm=math.inf if max_scallop_mm is None else float(max_scallop_mm),
+                     positions=positions + crash_positions)
+
+
+def _compare(cut, surf, slope, xs, ys, r) -> dict:
+    """Gouge, material left (normal to the surface, and its height) and scallop of a cut map, and where."""
     reached = np.isfinite(cut)
     diff = np.where(reached, cut - surf, np.nan)
     gi = int(np.nanargmin(diff)) if reached.any() else 0
@@ -288,6 +298,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     above = np.where(reached, np.maximum(cut - surf, 0.0), np.inf)
     left = above / np.sqrt(1.0 + slope**2)
     li = int(np.argmax(left))
+    x0, x1, y0, y1 = xs[0], xs[-1], ys[0], ys[-1]
     inner = (xs[:, None] >= x0 + r) & (xs[:, None] <= x1 - r) & (ys[None, :] >= y0 + r) & (ys[None, :] <= y1 - r)
     normal = np.where(inner & reached, left, 0.0)
     si = int(np.argmax(normal))
@@ -296,14 +307,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
         i, j = np.unravel_index(k, cut.shape)
         return float(xs[i]), float(ys[j])
 
-    return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=gouge, gouge_at=at(gi),
-                     rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
-                     left_mm=float(left.flat[li]), left_at=at(li),
-                     left_height_mm=float(above.flat[li]), scallop_mm=float(normal.flat[si]),
-                     scallop_at=at(si), unreached_mm2=float((~reached).sum() * hx * hy), resolution_mm=resolution,
-                     gouge_limit_mm=limit, max_left_mm=float(max_left_mm),
-                     max_scallop_mm=math.inf if max_scallop_mm is None else float(max_scallop_mm),
-                     positions=positions + crash_positions)
+    return dict(gouge_mm=gouge, gouge_at=at(gi), left_mm=float(left.flat[li]), left_at=at(li),
+                left_height_mm=float(above.flat[li]), scallop_mm=float(normal.flat[si]), scallop_at=at(si))
 
 
 def _slopes(surface, sx, sy) -> np.ndarray:

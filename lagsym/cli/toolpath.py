@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
-from ..machine import BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
+from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec,
+                       Tool)
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 

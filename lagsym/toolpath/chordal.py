@@ -14,20 +14,21 @@ by how far the true path may rise above it:
   the samples show plus that bound is a bound of the move's sag
   (:func:`move_sags`).  (A quarter of the path's downward second difference
   at each sample, :func:`bends`, is taken too, when larger.)
-* where the tool crosses a box edge across the move (:func:`crosses_box_edge`),
-  it starts to rest on the edge or a corner between two samples and the path
+* where the tool crosses a box edge across the move (:func:`crosses_box_edge`)
+  and the samples show the path bending there (:func:`bent_moves`), it may
+  start to rest on the edge or a corner between two samples and the path
   can bend down sharply (a square-root onset, or a bend a few hundredths of a
   millimetre wide); no such bound holds.  Each of these moves is checked
   against the true path (:func:`check_moves`): drop-cutter at evenly spaced
   interior points (at least six, at most a sixteenth of the tool radius apart
-  or else 48), then three rounds of denser samples around the worst one.
-  With a tolerance, a move that dips more than the tolerance gets the cutter
-  location at its worst point as a new point, and both halves are checked
-  again, until every move is within the tolerance.  The move is then lifted
-  by the dip found.
+  or else 48), each taken with a quarter of the downward second difference
+  of the samples there.  A move that dips more than the tolerance gets the
+  cutter location at its worst point as a new point, and both halves are
+  checked again, until every move is within the tolerance.  The move is then
+  lifted by the dip found.
 
 Emitted points thus lie on or above the exact drop-cutter value and at most the
-chordal error (the tolerance, when one is given) above it, and no move passes
+chordal tolerance above it, and no move passes
 below the true cutter path by more than what the checks may miss between their
 samples (in the tests, never above ``1e-4`` mm, a tenth of a program's
 resolution).
@@ -183,7 +184,8 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
     """Check the moves marked ``dense`` against the true cutter path; with a tolerance, split those that dip more.
 
     ``cl(x, y, **search)`` gives the cutter locations (mm) over surface
-    positions.  The sag of a checked move becomes the larger of the dip found
+    positions, and ``cl.on_grid(x, y)`` the position a new point is written
+    at.  The sag of a checked move becomes the larger of the dip found
     and the sag its fine samples show (``seen``).  A move whose sag exceeds
     ``tol`` gets the cutter location at its worst point as a new point, and
     both halves are checked again.  Returns the points and each move's sag.
@@ -202,8 +204,7 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
         if not split.size:
             break
         w = u[over]
-        nx = vx[split] + w * (vx[split + 1] - vx[split])
-        ny = vy[split] + w * (vy[split + 1] - vy[split])
+        nx, ny = cl.on_grid(vx[split] + w * (vx[split + 1] - vx[split]), vy[split] + w * (vy[split + 1] - vy[split]))
         vx, vy = np.insert(vx, split + 1, nx), np.insert(vy, split + 1, ny)
         # Few points are added, so their cutter locations get a three times finer, more thorough search.
         vz = np.insert(vz, split + 1, cl(nx, ny, lattice=24, starts=8))

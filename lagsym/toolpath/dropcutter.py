@@ -121,9 +121,9 @@ def _inside_box(cx, cy, box, radius=0.0):
     outside = d > radius + eps_box
     if np.any(outside):
         bad = int(np.flatnonzero(outside)[0])
-        reach = f"further than the tool radius {radius:g} from" if radius > 0 else "outside"
-        raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies {reach} the control points' box "
-                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+        reach = f" by more than the tool radius {radius:g}" if radius > 0 else ""
+        raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}{reach}")
     if radius == 0:
         return nx, ny
     f = np.where(d > radius, radius / np.where(d > 0, d, 1.0), 1.0)

@@ -133,9 +133,13 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
     # Where the tool meets a box edge the path may bend between samples; where it does not bend near
     # a move, the samples show its sag.  A move whose estimated sag exceeds the tolerance is split too.
-    dense = (chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend)) | (sag > tol)
+    # Beyond a corner the rows follow an arc around it, and a move's chord passes nearer the corner than the
+    # samples on the arc: checked too.
+    x0, x1, y0, y1 = ev.bounds
+    corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
+    dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
+             | corner[:-1] | corner[1:] | (sag > tol))
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
-    vx, vy = cl.on_grid(vx, vy)  # where their cutter locations were computed
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     return Toolpath(
@@ -228,10 +232,11 @@ class _Cutter:
 
     The radius (surface units) includes the stock to leave for a ball, which
     then rides that much higher; a flat end is lifted by the stock instead.
-    A position beyond the box (``--boundary past``) is first moved to the
-    program's grid (its X and Y as the program writes them): there the tool
-    touches the part's edges with its side, where rounding X or Y by half a
-    unit of the last decimal would lower it against the edge by many units.
+    :meth:`on_grid` moves the points to emit beyond the box (``--boundary
+    past``) to the program's grid (their X and Y as the program writes them),
+    before their cutter locations are computed: there the tool touches the
+    part's edges with its side, where rounding X or Y by half a unit of the
+    last decimal would lower it against the edge by many units.
     """
 
     surface: object
@@ -270,7 +275,7 @@ class _Cutter:
         return x, y
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, *self.on_grid(x, y), self.radius, self.shape, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
 
@@ -322,7 +327,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     fa, fl, frow = (np.concatenate(v) for v in (fa, fl, frow))
     fx, fy = (fa, fl) if direction == "x" else (fl, fa)
     if past is not None:
-        fx, fy = within_reach(fx, fy, cl.ev.bounds, past)
+        fx, fy = cl.on_grid(*within_reach(fx, fy, cl.ev.bounds, past))
     fz = cl(fx, fy)
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
