@@ -51,7 +51,7 @@ def moves_near_edges(tp, within_mm):
 def example1_corner():
     """Example 1 at scale 10 with a 6 mm ball: the tool rolls onto the steep box edge x = 50 and the corner."""
     surf = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
-    tp = plan(surf, raster=RasterSpec("x", None, None, 0.01, 0.005), scale=10.0)
+    tp = plan(surf, raster=RasterSpec("x", None, None, 0.01, 0.005, boundary="centre"), scale=10.0)
     return surf, tp
 
 

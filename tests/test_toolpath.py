@@ -104,10 +104,11 @@ def test_a_fixed_step_is_the_longest_move_and_points_are_added_where_the_path_be
     # Independently: a dense lattice over the tool's disc on the exact polynomial, at points near the edges
     # and halfway along the moves there.
     near = np.flatnonzero((p[:-1, 0] < 26.0) | (p[:-1, 0] > 94.0))[::7]
+    exact = reference(example4, p[near, 0] / 20, p[near, 1] / 20, 3.0 / 20) * 20
+    assert np.all(p[near, 2] <= exact + DEFAULT_TOLERANCE_MM + 1e-4)  # lifted by at most the tolerance
     for k in near:
-        low = brute(example4, p[k, 0] / 20, p[k, 1] / 20, 3.0 / 20) * 20
-        # The lattice falls short of the true maximum by up to about 0.01 mm on the steep flanks near the rim.
-        assert low - 1e-9 <= p[k, 2] <= low + DEFAULT_TOLERANCE_MM + 0.015
+        # A lower bound of the true maximum: the points are never below it.
+        assert p[k, 2] >= brute(example4, p[k, 0] / 20, p[k, 1] / 20, 3.0 / 20) * 20 - 1e-9
         mid = 0.5 * (p[k] + p[k + 1])
         assert mid[2] >= brute(example4, mid[0] / 20, mid[1] / 20, 3.0 / 20) * 20 - 1e-9  # the move stays above
 
@@ -135,19 +136,13 @@ def test_past_boundary_finishes_the_edges(example4):
     """
     scale = 10.0
     xs = np.linspace(10.0, 50.0, 161)
-    edge = np.array([10.0, 10.25, 49.75, 50.0])
-    heights = {}
+    strips = [(xs, np.array([10.0, 10.25])), (xs, np.array([49.75, 50.0])),
+              (np.array([10.0, 10.25]), xs), (np.array([49.75, 50.0]), xs)]  # the swept ball wants even cells
+    heights = [exact_heights(example4, a / scale, b / scale) * scale for a, b in strips]
     for boundary in ("centre", "past"):
         tp = plan(example4, raster=RasterSpec("x", 0.5, 0.5, boundary=boundary), scale=scale)
-        left = []
-        for a, b in ((xs, edge), (edge, xs)):
-            if a.size not in heights:
-                pass
-            key = (a is xs)
-            if key not in heights:
-                heights[key] = exact_heights(example4, a / scale, b / scale) * scale
-            left.append(swept_ball(tp.points_mm, 3.0, a, b) - heights[key])
-        left = np.concatenate([v.ravel() for v in left])
+        left = np.concatenate([(swept_ball(tp.points_mm, 3.0, a, b) - h).ravel()
+                               for (a, b), h in zip(strips, heights)])
         if boundary == "centre":
             assert left.max() > 1.0  # the material left at the steep edges
         else:
