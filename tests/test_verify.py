@@ -218,7 +218,8 @@ def test_readme_finishing_example(run_cli, tmp_path):
     doc = " ".join((EXAMPLES.parent / "docs" / "toolpaths.md").read_text().split())
     assert f"no gouge ({gouge * 1000:.1f} um, limit {limit * 1000:.1f} um)" in doc, out
     assert f"at most {left:.2f} mm of material normal to the surface ({height:.2f} mm above it)" in doc, out
-    assert f"on the {np.degrees(np.arccos(left / height)):.0f} degree flanks beside the edge y = {y:.0f}" in doc, out
+    assert (f"on the {np.degrees(np.arccos(left / height)):.0f} degree flanks (at Y{y:.1f}, beside the edge "
+            f"y = {20 if y < 60 else 100})") in doc, out
     assert f"in the interior the scallop is {scallop:.3f} mm" in doc, out
     assert status == (0 if left <= 0.1 else 1)
     # Independently: a ball swept along the program's moves, against the exact polynomial, on the cells of
