@@ -143,9 +143,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     return Toolpath(
-        points_mm=np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1),
-        rows=vrow,
-        exact_mm=_place(settings, vx, vy, vz)[2],
+        **_without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                           _place(settings, vx, vy, vz)[2], cl.grid * mm_per_unit),
         tool=tool,
         raster=raster,
         stepover_mm=float((levels[1] - levels[0]) * mm_per_unit) if len(levels) > 1 else float(stepover),
@@ -153,6 +152,28 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
         fine_points=len(path.x),
     )
+
+
+def _without_repeats(points_mm, rows, exact_mm, unit_mm: float) -> dict:
+    """The points without those at the same X and Y as the one before and within a unit of its Z.
+
+    Beyond a box corner several samples can land on one point of the
+    program's grid; the program would write no block for the repeat.  The
+    point kept takes the higher of the two heights.
+    """
+    same = np.zeros(len(points_mm), dtype=bool)
+    same[1:] = ((points_mm[1:, 0] == points_mm[:-1, 0]) & (points_mm[1:, 1] == points_mm[:-1, 1])
+                & (np.abs(np.diff(points_mm[:, 2])) < unit_mm))
+    if not same.any():
+        return dict(points_mm=points_mm, rows=rows, exact_mm=exact_mm)
+    first = np.cumsum(~same) - 1  # the kept point each one merges into
+    keep = np.flatnonzero(~same)
+    z, e = np.full(len(keep), -np.inf), np.full(len(keep), -np.inf)
+    np.maximum.at(z, first, points_mm[:, 2])
+    np.maximum.at(e, first, exact_mm)
+    p = points_mm[keep].copy()
+    p[:, 2] = z
+    return dict(points_mm=p, rows=rows[keep], exact_mm=e)
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
