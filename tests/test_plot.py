@@ -24,9 +24,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import EXAMPLES, ROOT, missing_system_package
+from conftest import EXAMPLES, ROOT, missing_system_package, need_opengl
 from lagsym import plot
-from lagsym.errors import InputError, RenderError
+from lagsym.errors import InputError
 from lagsym.evaluate import evaluate_grid, evaluate_points
 from lagsym.io import read_curve_points, read_points
 from lagsym.lagrange import lagrange_curve, lagrange_surface
@@ -37,10 +37,7 @@ from lagsym.sampling import sample_grid
 @pytest.fixture(autouse=True, scope="module")
 def _offscreen_opengl():
     """Every test here draws: without an OpenGL to draw with, they skip naming the packages to install."""
-    try:
-        plot.rendering_backend()
-    except RenderError:
-        missing_system_package("libegl1 libegl-mesa0 libgl1-mesa-dri", "an offscreen OpenGL (EGL or OSMesa)")
+    need_opengl("the pictures")
 
 
 REFERENCE = Path(__file__).resolve().parent / "reference_images"
