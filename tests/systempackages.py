@@ -1,6 +1,6 @@
 """The Debian packages the tests use but do not fetch themselves, and how a test says one is missing.
 
-Shared by tests/conftest.py and notebooks/conftest.py (the notebooks draw, so they need an OpenGL).
+Used by tests/conftest.py (which also skips the notebooks, as they draw) and the tests that draw.
 """
 
 from __future__ import annotations
@@ -20,10 +20,15 @@ SYSTEM_PACKAGES = {
 }
 
 
+def missing_line(packages: str, what: str) -> str:
+    """The one line that says which Debian ``packages`` to install for ``what``."""
+    assert packages in SYSTEM_PACKAGES, packages
+    return f"{what} not found: install Debian's {packages} (apt-get install {packages})"
+
+
 def missing_system_package(packages: str, what: str) -> None:
     """Skip (or, under LAGSYM_TEST_REQUIRE_ALL, fail) a test whose Debian ``packages`` are not installed."""
-    assert packages in SYSTEM_PACKAGES, packages
-    line = f"{what} not found: install Debian's {packages} (apt-get install {packages})"
+    line = missing_line(packages, what)
     if os.environ.get("LAGSYM_TEST_REQUIRE_ALL"):
         pytest.fail(line, pytrace=False)
     pytest.skip(line, allow_module_level=True)
