@@ -84,9 +84,10 @@ def load_ipython_extension(ipython) -> None:
 
 
 def _rich_html(value):
-    from .plot.inline import rich_html  # the first display pays for pyvista, not the import
-
-    return rich_html(value)
+    # Imported on the first display, which pays for pyvista, not the import.  By name, like the
+    # exports above: the package facade reaches each layer only on demand, at run time; a static
+    # import here would put every module that reads lagsym.__version__ above the plot layer.
+    return importlib.import_module(".plot.inline", __name__).rich_html(value)
 
 
 def _register_in_running_ipython() -> None:
