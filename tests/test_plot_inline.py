@@ -136,6 +136,7 @@ def test_a_surface_shows_its_equation_and_a_figure(opengl, shell, surface4):
     assert drawn_share(img) > 0.2, drawn_share(img)
     assert np.array_equal(img, np.asarray(Image.open(io.BytesIO(png)).convert("RGB")))
     check_reference(img, "surface_thumbnail")
+    assert 10_000 < len(html.encode()) < 100_000  # docs/plotting.md: "a few tens of kilobytes"
 
 
 def test_a_curve_shows_its_equation_and_a_line_plot(opengl, shell, curve3):
@@ -209,6 +210,29 @@ def test_import_lagsym_in_a_running_shell_registers_the_display():
         "      sorted(m for m in ('pyvista', 'vtkmodules', 'lagsym.plot', 'lagsym.lagrange') if m in sys.modules))"
     )
     assert out == "['LagrangeCurve', 'LagrangeSurface'] []"
+
+
+def test_a_terminal_shell_renders_nothing():
+    """A terminal IPython asks only for text/plain: no figure is drawn, pyvista is never loaded."""
+    out = _run(
+        "import sys\n"
+        "from IPython.terminal.interactiveshell import TerminalInteractiveShell\n"
+        "from traitlets.config import Config\n"
+        "c = Config(); c.HistoryManager.hist_file = ':memory:'\n"
+        "sh = TerminalInteractiveShell.instance(config=c)\n"
+        "from lagsym import lagrange_surface, read_points\n"
+        "s = lagrange_surface(read_points('examples/paper-example-2.json'))\n"
+        "print(sorted(sh.display_formatter.format(s)[0]), 'pyvista' in sys.modules)"
+    )
+    assert out == "['text/plain'] False"
+
+
+def test_plotting_page_states_the_thumbnail_size():
+    from lagsym.plot.inline import THUMBNAIL_SIZE
+
+    page = " ".join((ROOT / "docs" / "plotting.md").read_text().split())
+    assert THUMBNAIL_SIZE == (WIDTH, HEIGHT) and f"then a {WIDTH} x {HEIGHT} PNG rendered offscreen" in page
+    assert f"more than {LATEX_TERMS} terms shows the one-line summary" in page
 
 
 def test_ipython_without_a_shell_is_left_alone():
