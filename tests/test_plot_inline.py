@@ -169,18 +169,48 @@ def test_a_big_equation_keeps_the_html_small(opengl, shell):
         assert decode_png(png_of(html)).shape == (HEIGHT, WIDTH, 3)
 
 
-def test_no_figure_falls_back_to_the_latex_without_a_traceback(shell, surface4, monkeypatch, capfd):
-    """Where nothing can render, the HTML is left out (Jupyter shows the LaTeX) and nothing is printed."""
-    import lagsym.plot.backend as backend
+@pytest.fixture
+def fresh_render_check():
+    """``can_render`` asked afresh, and forgotten again afterwards."""
+    from lagsym.plot import inline
+
+    inline.can_render.cache_clear()
+    yield inline
+    inline.can_render.cache_clear()
+
+
+def test_no_backend_falls_back_to_the_latex_without_a_traceback(shell, surface4, fresh_render_check, monkeypatch,
+                                                                  capfd):
+    """Where nothing can render, the HTML is left out (Jupyter shows the LaTeX), nothing is printed, and the
+    backend is sought once, not at every display."""
+    asked = []
 
     def cannot_render():
+        asked.append(1)
         raise RenderError("no display, and VTK cannot render offscreen here")
 
-    monkeypatch.setattr(backend, "rendering_backend", cannot_render)
-    data, _ = shell.display_formatter.format(surface4)
-    assert "text/html" not in data and data["text/latex"] == surface4._repr_latex_()
+    monkeypatch.setattr(fresh_render_check, "rendering_backend", cannot_render)
+    for _ in range(2):
+        data, _ = shell.display_formatter.format(surface4)
+        assert "text/html" not in data and data["text/latex"] == surface4._repr_latex_()
+    assert len(asked) == 1
     out, err = capfd.readouterr()
     assert "Traceback" not in out + err and "RenderError" not in out + err
+
+
+def test_a_render_that_fails_midway_falls_back_too(shell, surface4, fresh_render_check, monkeypatch, capfd):
+    """A backend that is found but fails when the figure is drawn: the LaTeX alone, nothing printed."""
+    import lagsym.plot.backend as backend
+
+    def fails(*args, **kwargs):
+        raise RuntimeError("the OpenGL context was lost")
+
+    monkeypatch.setattr(fresh_render_check, "rendering_backend", lambda: "egl")
+    monkeypatch.setattr(backend, "rendering_backend", fails)
+    data, _ = shell.display_formatter.format(surface4)
+    assert "text/html" not in data and "text/latex" in data
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err and "OpenGL context" not in out + err
 
 
 # ----------------------------------------------------------------------------- registration and imports

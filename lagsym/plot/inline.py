@@ -16,6 +16,7 @@ raises the error that says what to install.
 from __future__ import annotations
 
 import base64
+import functools
 import html
 import io
 import re
@@ -23,14 +24,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..errors import RenderError
 from ..lagrange import LagrangeCurve, LagrangeSurface
-from .backend import new_plotter
+from .backend import new_plotter, rendering_backend
 from .checks import check_window_size
 from .meshes import scalar_mesh
 from .style import SURFACE_CMAP, bar_args, title_for, units_of, view, z_factor, z_note
 from .surface import add_control, curve_figure, sampled_surface
 
-__all__ = ["THUMBNAIL_SIZE", "surface_thumbnail", "curve_thumbnail", "thumbnail_png", "rich_html"]
+__all__ = ["THUMBNAIL_SIZE", "surface_thumbnail", "curve_thumbnail", "thumbnail_png", "can_render", "rich_html"]
 
 THUMBNAIL_SIZE = (320, 240)  # beside the equation, about the size of a figure in a paper's column
 _SAMPLES = 41  # enough for a smooth shading at this size, quick to evaluate for any degree
@@ -94,6 +96,16 @@ def thumbnail_png(value, *, window_size: Sequence[int] = THUMBNAIL_SIZE) -> byte
     return buf.getvalue()
 
 
+@functools.cache
+def can_render() -> bool:
+    """Whether this process can render a figure, asked once (a failed choice of backend costs seconds)."""
+    try:
+        rendering_backend()
+    except RenderError:
+        return False
+    return True
+
+
 def _equation_html(latex: str) -> str:
     """``_repr_latex_``'s text as HTML: its formula as display math, a summary's note as text."""
     # "$z = ...$" or, past lagsym.lagrange.LATEX_TERMS terms, "$z = F$ (degree ..., N terms: ``.expr`` ...)".
@@ -113,9 +125,10 @@ def rich_html(value) -> str | None:
     str or None
         The equation as ``$$...$$`` and a PNG thumbnail in an ``<img>`` tag;
         None (Jupyter shows the LaTeX alone) for any other value and when the
-        thumbnail cannot be rendered.
+        thumbnail cannot be rendered; where no backend can render, that is
+        found once per process, not at every display.
     """
-    if not isinstance(value, (LagrangeSurface, LagrangeCurve)):
+    if not isinstance(value, (LagrangeSurface, LagrangeCurve)) or not can_render():
         return None
     try:
         png = thumbnail_png(value)
