@@ -28,6 +28,8 @@ The modules, one concern each:
 - :mod:`~lagsym.plot.growth`: the deviation against the degree (Figure 11);
 - :mod:`~lagsym.plot.toolpath`: a cutter path over its surface;
 - :mod:`~lagsym.plot.output`: image formats and writing images;
+- :mod:`~lagsym.plot.inline`: the rich display of a surface or a curve in
+  Jupyter (imported on the first display, not here);
 - :mod:`~lagsym.plot.style`, :mod:`~lagsym.plot.meshes` and
   :mod:`~lagsym.plot.checks`: the look, the pyvista data and the argument
   checks the figures share.
