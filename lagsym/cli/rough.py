@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import origin
+from ._common import CORNER_MM, origin
 
 DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
 points in FILE: at each level (the stock top down by the step-down) a
@@ -38,7 +38,9 @@ def add_arguments(p) -> None:
     r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
                    help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
     t = p.add_argument_group("cutter")
-    t.add_argument("--tool-shape", default="flat", help="flat (default) or ball end")
+    t.add_argument("--tool-shape", default="flat", help="flat (default), ball or bull (bull nose: give --corner-radius)")
+    t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
     t.add_argument("--tool-diameter", type=float, default=10.0, metavar="MM", help="cutter diameter (default 10)")
     t.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool and length offset number (default 1)")
     t.add_argument("--flute-length", type=float, metavar="MM", help="refuse a step-down longer than the flutes")
@@ -64,7 +66,7 @@ def job_data(args) -> dict:
     if args.margin is not None:
         stock["margin"] = args.margin
     tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
-    for key in ("flute_length", "reach"):
+    for key in ("corner_radius", "flute_length", "reach"):
         if getattr(args, key) is not None:
             tool[key] = getattr(args, key)
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,

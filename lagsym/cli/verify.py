@@ -8,7 +8,7 @@ from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, simulate_cut
-from ._common import SCALE, TOOL_MM, count, number, origin
+from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
@@ -27,7 +27,9 @@ examples:
 def add_arguments(p) -> None:
     p.add_argument("surface", help="points file: JSON or CSV with x,y,z")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves)")
-    p.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
+    p.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default), flat or bull (bull nose: give --corner-radius)")
+    p.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
     p.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM", help="cutter diameter (default 6)")
     p.add_argument("--scale", type=SCALE, default=1.0, help="model scale, as for toolpath: a points file in inches is 25.4 mm per unit at scale 1 (default 1)")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset the program was made with, mm")
@@ -47,7 +49,7 @@ def run(args, out, err) -> int:
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
-    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), place, cell_mm=args.cell,
+    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter, args.corner_radius), place, cell_mm=args.cell,
                           gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells, max_contacts=args.max_contacts)
     out.write("\n".join(report.summary()) + "\n")
     return ExitStatus.WARNING if report.gouges else ExitStatus.OK
