@@ -35,7 +35,7 @@ from .evaluate import evaluate_grid
 from .gcode import Moves
 from .machine import Placement, Tool, cutter_profile
 
-__all__ = ["CutReport", "simulate_cut", "MAX_CELLS", "MAX_CONTACTS"]
+__all__ = ["CutReport", "simulate_cut", "press_moves", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
@@ -276,3 +276,22 @@ def _press(cut, pts, xs, ys, r, corner):
             if sel.any():
                 a, b = tx[sel], ty[sel]
                 cut[a, b] = np.minimum(cut[a, b], m[sel])
+
+
+def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool,
+                dz_mm: float = 0.01, max_contacts: int | None = MAX_CONTACTS) -> tuple[int, float]:
+    """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
+
+    ``cut[i, j]`` is the height over ``(xs[i], ys[j])``, evenly spaced cell
+    centres.  Returns the number of tool positions simulated and the
+    simulation's vertical resolution (as :func:`simulate_cut` states it).
+    """
+    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
+    r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
+    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
+    ds = 0.5 * min(hx, hy)
+    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
+    if not len(a):
+        return 0, resolution
+    _check_work(a, b, ds, dz_mm, r, hx, hy, max_contacts)
+    return _sweep(cut, a, b, xs, ys, r, corner, ds, dz_mm), resolution
