@@ -139,7 +139,9 @@ def line():
 def test_large_drip_feed_arrives_byte_exact(line):
     baud = 115200
     prog = parse_program(program_text(1200))
-    settings = profile("fanuc", baud=baud, stall_timeout_s=10)
+    # A control with room for 512 characters past its DC3 takes a window of 128: the default 4 is 0.4 ms of
+    # line at this rate, which a loaded machine cannot keep topped up (the buffer would never fill).
+    settings = profile("fanuc", baud=baud, stall_timeout_s=10, overrun_chars=128, buffer_chars=1024)
     pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=1024, high_water=512, low_water=128)
     expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
     assert len(expected) > 30_000
@@ -174,6 +176,26 @@ def test_xoff_stops_the_sender_within_its_limit(line):
     # What the control counted past its DC3 also holds the time the DC3 took to come back, which a
     # starved machine can stretch; the benchmark reports that figure (0 overflow when the machine is
     # not starved), a test cannot promise it.
+
+
+def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line):
+    # What the sender controls: it keeps at most its window on the way and writes nothing once it has read
+    # the DC3, so what the control receives after its DC3 (counted by the control, on a kernel pty pair)
+    # stays within a headroom twice the window: the window on the way, and at most one write that left
+    # before the DC3 was read.  The sender's own count of characters in flight at each XOFF is checked too.
+    baud, window, headroom = 9600, 32, 64
+    prog = parse_program(program_text(200))
+    settings = profile("fanuc", baud=baud, overrun_chars=window)
+    pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
+                     low_water=64, tolerance=headroom)
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
+    result = send_program(pair.near, prog, settings, "drip")
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert sim.xoffs >= 5 and result.xoff_count == sim.xoffs
+    assert result.max_in_flight_at_xoff <= window
+    assert sim.pending_at_xoff <= window  # written but not yet carried by the line when the DC3 went out
+    assert sim.overflow == 0
 
 
 @needs_socat
