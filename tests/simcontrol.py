@@ -198,6 +198,11 @@ class SimControl:
         if self._master is not None:
             os.close(self._master)  # the control's process holds the master now; its close hangs up the line
 
+    @property
+    def arrived(self) -> int:
+        """Bytes arrived so far (readable while the control runs)."""
+        return self._count.value
+
     def wait_for(self, count: int, timeout: float = 30.0) -> bool:
         """Wait until ``count`` bytes have arrived."""
         deadline = time.monotonic() + timeout
@@ -243,7 +248,8 @@ def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
                   "max_after_xoff": control.max_after_xoff, "dropped": control.dropped, "error": control.error,
                   "first_byte_at": control.first_byte_at, "last_byte_at": control.last_byte_at,
                   "executed": len(control.received) - int(control.buffered + 0.999),
-                  "starved_s": control.starved_at_last, "pending_at_xoff": control.pending_at_xoff})
+                  "starved_s": control.starved_at_last, "pending_at_xoff": control.pending_at_xoff,
+                  "episodes": control.episodes})
 
 
 class _Control:
@@ -274,10 +280,13 @@ class _Control:
         self.last_byte_at = None
         self.starved_s = 0.0  # time the machine found the buffer empty since the first character
         self.starved_at_last = 0.0  # the same up to the last character: while the program remained
+        self.episodes = []  # per XOFF: (characters after DC3, excused, left in the pty, rest of the read at DC3)
+        self.pending_now = self.tail = 0
         self.pending_at_xoff = 0  # most characters still waiting in the pty (on the wire) when DC3 went out
 
     def close_episode(self) -> None:
         self.overflow += max(0, int(self.after - self.excused) - self.tolerance)
+        self.episodes.append((self.after, int(self.excused), self.pending_now, self.tail))
 
     def cut(self) -> None:
         self.dropped = True
@@ -351,7 +360,8 @@ class _Control:
                 self.count.value = len(self.received)
                 if crossed:
                     self.port.write(DC3)
-                    self.pending_at_xoff = max(self.pending_at_xoff, self.port.in_waiting)
+                    self.pending_now, self.tail = self.port.in_waiting, self.after
+                    self.pending_at_xoff = max(self.pending_at_xoff, self.pending_now)
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
                     late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S

@@ -184,7 +184,9 @@ class Sender:
             reason = f"{self.hardware.upper()} stayed low (control not ready) for more than {{t}}"
             if not ready and not self.paused:
                 self.paused, self.pause_since, self.pause_reason = True, now, reason
+                self.log(f"{self.hardware.upper()} low after {self.pos} bytes")
             elif ready and self.paused and self.pause_reason == reason:
+                self.log(f"{self.hardware.upper()} high after {now - self.pause_since:.3f} s")
                 self.paused = False
         if self.carrier and now - self.carrier_checked >= _CARRIER_POLL_S:
             self.carrier_checked = now  # a network port may wait on the server to tell its modem lines
@@ -253,7 +255,9 @@ class Sender:
                 self.line.wait(min(longest, (in_flight - low) / self.cps))
                 continue
             written = self.line.write(self.data[self.pos:self.pos + limit - in_flight])
-            self.line_free = max(self.line_free, now) + written / self.cps
+            # The clock starts when the write has returned, not at the top of the turn: a sender descheduled
+            # in between would otherwise count characters as gone that have not yet left.
+            self.line_free = max(self.line_free, time.monotonic()) + written / self.cps
             self.pos += written
         # A healthy look once the last byte has settled, so the last block counts as delivered.
         time.sleep(self.settle_s)
