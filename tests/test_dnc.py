@@ -7,6 +7,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -178,12 +179,27 @@ def test_xoff_stops_the_sender_within_its_limit(line):
     # not starved), a test cannot promise it.
 
 
-def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line):
+@pytest.mark.parametrize("late_s", [0.0, 0.02], ids=["prompt", "late-writes"])
+def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line, monkeypatch, late_s):
     # What the sender controls: it keeps at most its window on the way and writes nothing once it has read
     # the DC3, so what the control receives after its DC3 (counted by the control, on a kernel pty pair)
     # stays within a headroom twice the window: the window on the way, and at most one write that left
     # before the DC3 was read.  The sender's own count of characters in flight at each XOFF is checked too.
+    # "late-writes" holds every other write back 20 ms (17 characters of line), as a busy computer does to
+    # a sender between its look at the clock and its write; the next write then follows at once.
     baud, window, headroom = 9600, 32, 64
+    if late_s:
+        from lagsym.dnc.port import Port
+
+        write, calls = Port.write, []
+
+        def late_write(self, data):
+            calls.append(len(data))
+            if len(calls) % 2:
+                time.sleep(late_s)
+            return write(self, data)
+
+        monkeypatch.setattr(Port, "write", late_write)
     prog = parse_program(program_text(200))
     settings = profile("fanuc", baud=baud, overrun_chars=window)
     pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
