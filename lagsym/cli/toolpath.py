@@ -36,7 +36,8 @@ def add_arguments(p) -> None:
     g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")
     g.add_argument("--step", type=STEP_MM, metavar="MM", help="forward step along a row (default 0.2)")
     g.add_argument("--scallop", type=SMALL_MM, metavar="MM",
-                   help="side step from this cusp height of a ball-end cutter, instead of --stepover")
+                   help="rows spaced so that a ball-end cutter's cusp, measured normal to the surface, is at "
+                        "most this (on slopes too), instead of --stepover")
     g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
                    help="forward steps from this chordal error, instead of a fixed --step")
     t = p.add_argument_group("cutter")

@@ -15,7 +15,7 @@ with ``S = 10**decimals``, and computes Z there:
   the rounded position, ``Z' + Zp dP + Zr dR`` (the tip's path has the
   surface's slopes at the contact point), plus a bound of that plane's error
   over the half unit moved, ``c dmax**2 / 2`` with ``c`` the largest upward
-  bend of the tip's path over the raster.
+  bend of the tip's path over the raster (rounded up to a thousandth of a unit).
 
 Z is then raised by half a unit, so that a control rounding it to the
 nearest unit still goes at or above it.  Heidenhain FN arithmetic has no
@@ -46,10 +46,10 @@ def resolution(settings: MachineSettings) -> Fraction:
     return Fraction(1, 10 ** settings.digits)
 
 
-def round_statement(v: Var, unit: Fraction) -> Assign:
-    """``v = ROUND[v*S]/S``: ``v`` to the nearest multiple of ``unit``."""
+def round_statement(v: Var, unit: Fraction, target: Var | None = None) -> Assign:
+    """``target = ROUND[v*S]/S``: ``v`` to the nearest multiple of ``unit`` (into ``v`` itself by default)."""
     s = const(1 / unit)
-    return Assign(v, div(round_(mul(v, s)), s))
+    return Assign(v if target is None else target, div(round_(mul(v, s)), s))
 
 
 def round_half_away(x: np.ndarray, unit: float) -> np.ndarray:
@@ -63,14 +63,8 @@ def tip_statements(unit: Fraction, lift: Fraction) -> tuple:
     pt, rt, zt, zp, zr, q = var("pt"), var("rt"), var("zt"), var("zp"), var("zr"), var("q")
     out = [Assign(zt, add(zt, const(lift)))]
     for v, slope in ((pt, zp), (rt, zr)):
-        out += [round_statement_into(q, v, unit), Assign(zt, add(zt, mul(slope, sub(q, v)))), Assign(v, q)]
+        out += [round_statement(v, unit, q), Assign(zt, add(zt, mul(slope, sub(q, v)))), Assign(v, q)]
     return tuple(out)
-
-
-def round_statement_into(target: Var, v: Var, unit: Fraction) -> Assign:
-    """``target = ROUND[v*S]/S``."""
-    s = const(1 / unit)
-    return Assign(target, div(round_(mul(v, s)), s))
 
 
 def tips_on_grid(pt, rt, zt, zp, zr, unit: float, lift: float):

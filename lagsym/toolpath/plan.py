@@ -48,7 +48,8 @@ class Toolpath:
     tool : Tool
     raster : RasterSpec
     stepover_mm, step_mm : float
-        The side step and forward step actually used (with a chordal
+        The side step and forward step actually used (with a scallop height,
+        ``stepover_mm`` is the widest gap between rows; with a chordal
         tolerance, ``step_mm`` is the sampling step the filter started from).
     bounds_mm : tuple of float
         The control points' box on the machine, ``(x0, x1, y0, y1)``: the
@@ -134,10 +135,16 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     if tol is None:
         along = _fixed_step_samples(along, step / mm_per_unit)
     cl = _Cutter.of(surface, ev, tool, settings)
+    # Rows and samples on the program's resolution: every move then runs along a line the program can write.
+    levels, along = (cl.snap_axis(levels, 1), cl.snap_axis(along, 0)) if raster.direction == "x" else \
+        (cl.snap_axis(levels, 0), cl.snap_axis(along, 1))
     path = _fine_path(cl, levels, along, raster.direction, fine)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
-    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)))
+    # The sag a semi-convex path may hide between samples, for the longest sample step: on the program's
+    # resolution the steps differ by a unit, and a move's sag is bounded with its longest step.
+    semi = np.full(len(path.s_mm), kappa * float(np.diff(path.s_mm).max(initial=0.0)) ** 2 / 8.0)
+    kept = _emitted(path, tol, np.maximum(bend, semi))
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
     vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
     dense = chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius)
@@ -237,9 +244,10 @@ class _Cutter:
 
     The radius (surface units) includes the stock to leave for a ball, which
     then rides that much higher; a flat end is lifted by the stock instead.
-    Every position is moved onto the program's resolution (``grid``) before
-    the tool is dropped there, so a height is always that of a position the
-    program can write.
+    ``snap`` moves positions onto the program's resolution (``grid``): the
+    rows, the samples along them and any point added are put there before
+    the tool is dropped, so an emitted height is that of a position the
+    program writes.
     """
 
     surface: object
@@ -258,13 +266,20 @@ class _Cutter:
         return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit, ResolutionGrid.of(settings, ev.bounds))
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        x, y = self.snap(x, y)
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
     def snap(self, x, y):
         """The positions the program writes for surface positions ``x, y`` (see :mod:`.resolution`)."""
         return (x, y) if self.grid is None else self.grid.snap(x, y)
+
+    def snap_between(self, x, y, ax, ay, bx, by):
+        """:meth:`snap` of points added on moves ``a -> b``, off their ends (see :mod:`.resolution`)."""
+        return (x, y) if self.grid is None else self.grid.snap_between(x, y, ax, ay, bx, by)
+
+    def snap_axis(self, v, axis: int):
+        """:meth:`snap` of positions on one axis (0: x, 1: y)."""
+        return v if self.grid is None else self.grid.snap_axis(v, axis)
 
 
 @dataclass(frozen=True)
@@ -294,7 +309,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
     u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
     ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
     link_a = np.repeat(ends, len(u))
-    link_l = (levels[:-1, None] + u[None, :] * gaps[:, None]).ravel()
+    link_l = cl.snap_axis((levels[:-1, None] + u[None, :] * gaps[:, None]).ravel(), 1 if direction == "x" else 0)
     z_links = (cl(*((link_a, link_l) if direction == "x" else (link_l, link_a)))
                if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
     fa, fl, fz, frow, pieces = [], [], [], [], []
@@ -304,7 +319,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
         t = along if fwd else along[::-1]
         piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
         if i + 1 < len(levels):
-            piece.append((np.full_like(u, t[-1]), levels[i] + u * gaps[i], z_links[i]))
+            piece.append((np.full_like(u, t[-1]), link_l.reshape(-1, len(u))[i], z_links[i]))
         for pa, pl, pz in piece:
             fa.append(pa)
             fl.append(pl)

@@ -60,8 +60,28 @@ class ResolutionGrid:
         >>> [round(float(v), 6) for v in g.snap([0.12345, 1 / 3], [0.5, 0.0])[0]]
         [0.123, 0.333]
         """
-        x0, x1, y0, y1 = self.bounds
-        return self._axis(x, x0, x1, self.origin_mm[0]), self._axis(y, y0, y1, self.origin_mm[1])
+        return self.snap_axis(x, 0), self.snap_axis(y, 1)
+
+    def snap_between(self, x, y, ax, ay, bx, by) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`snap` of points added on moves ``a -> b``, kept off both ends where the move is long enough.
+
+        A point that would snap onto an end of its move goes one unit further in.
+        """
+        out = []
+        for axis, v, a, b in ((0, x, ax, bx), (1, y, ay, by)):
+            s = self.snap_axis(v, axis)
+            step = np.sign(np.asarray(b, dtype=float) - a) * self.unit_mm / self.mm_per_unit
+            for end, toward in ((a, step), (b, -step)):
+                inner = s + toward
+                room = np.abs(np.asarray(b, dtype=float) - a) > 2.5 * self.unit_mm / self.mm_per_unit
+                s = np.where((np.abs(s - end) < 0.5 * self.unit_mm / self.mm_per_unit) & room, inner, s)
+            out.append(s)
+        return out[0], out[1]
+
+    def snap_axis(self, v, axis: int) -> np.ndarray:
+        """:meth:`snap` of positions on one axis, 0 for x and 1 for y."""
+        lo, hi = self.bounds[2 * axis:2 * axis + 2]
+        return self._axis(v, lo, hi, self.origin_mm[axis])
 
     def _axis(self, v, lo: float, hi: float, origin: float) -> np.ndarray:
         v = np.asarray(v, dtype=float)
