@@ -36,7 +36,8 @@ def add_arguments(p) -> None:
     g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")
     g.add_argument("--step", type=STEP_MM, metavar="MM", help="forward step along a row (default 0.2)")
     g.add_argument("--scallop", type=SMALL_MM, metavar="MM",
-                   help="side step from this cusp height of a ball-end cutter, instead of --stepover")
+                   help="rows spaced so that a ball-end cutter's cusp, measured normal to the surface, is at "
+                        "most this (on slopes too), instead of --stepover")
     g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
                    help="forward steps from this chordal error, instead of a fixed --step")
     t = p.add_argument_group("cutter")
@@ -81,7 +82,16 @@ def run(args, out, err) -> int:
     if args.output and args.output != "-":
         write_text(args.output, text, newline="")
         err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} rows, "
-                  f"side step {tp.stepover_mm:.4f} mm, largest lift for chordal error {tp.lift_mm.max():.4f} mm\n")
+                  f"side step {tp.stepover_mm:.4f} mm, largest lift for chordal error {tp.lift_mm.max():.4f} mm"
+                  + _cusp_note(tp) + "\n")
     else:
         out.write(text)
     return 0
+
+
+def _cusp_note(tp) -> str:
+    """With a scallop height: the worst cusp the rows are predicted to leave, and where."""
+    if tp.cusp_mm is None:
+        return ""
+    x, y = tp.cusp_at_mm
+    return f", worst predicted cusp {tp.cusp_mm:.4f} mm normal to the surface at X{x:.3f} Y{y:.3f}"

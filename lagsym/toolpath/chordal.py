@@ -187,6 +187,8 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
         w = u[over]
         nx = vx[split] + w * (vx[split + 1] - vx[split])
         ny = vy[split] + w * (vy[split + 1] - vy[split])
+        if hasattr(cl, "snap_between"):  # a new point is written: on the program's resolution, along its move
+            nx, ny = cl.snap_between(nx, ny, vx[split], vy[split], vx[split + 1], vy[split + 1])
         vx, vy = np.insert(vx, split + 1, nx), np.insert(vy, split + 1, ny)
         # Few points are added, so their cutter locations get a three times finer, more thorough search.
         vz = np.insert(vz, split + 1, cl(nx, ny, lattice=24, starts=8))

@@ -23,6 +23,8 @@ from .dropcutter import drop_cutter
 from .filter import filter_rows
 from .pattern import levels as _levels
 from .pattern import raster_pattern, scallop_stepover
+from .resolution import ResolutionGrid
+from .scallop import scallop_levels
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
@@ -46,11 +48,17 @@ class Toolpath:
     tool : Tool
     raster : RasterSpec
     stepover_mm, step_mm : float
-        The side step and forward step actually used (with a chordal
+        The side step and forward step actually used (with a scallop height,
+        ``stepover_mm`` is the widest gap between rows; with a chordal
         tolerance, ``step_mm`` is the sampling step the filter started from).
     bounds_mm : tuple of float
         The control points' box on the machine, ``(x0, x1, y0, y1)``: the
         envelope of the tool positions.
+    cusp_mm : float or None
+        With a scallop height, the worst cusp predicted between the rows,
+        measured normal to the surface (mm); None for a fixed side step.
+    cusp_at_mm : tuple of float or None
+        Where that cusp is, ``(x, y)`` on the machine.
     """
 
     points_mm: np.ndarray
@@ -61,6 +69,8 @@ class Toolpath:
     stepover_mm: float
     step_mm: float
     bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+    cusp_mm: float | None = None
+    cusp_at_mm: tuple[float, float] | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -114,19 +124,32 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     tol = raster.tolerance_mm
     stepover = _side_step(tool, raster)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
+    scallop = None if raster.stepover_mm is not None else scallop_levels(
+        ev, raster.direction, tool.radius_mm, raster.scallop_mm, mm_per_unit)
+    if scallop is not None:  # rows walked across the surface: the size check counts them
+        stepover = _span(ev.bounds, raster.direction) * mm_per_unit / max(len(scallop.levels) - 1, 1)
     _check_size(ev.bounds, raster.direction, stepover, fine, mm_per_unit, max_points)
     levels, along = raster_pattern(ev.bounds, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
+    if scallop is not None:
+        levels = scallop.levels
     if tol is None:
         along = _fixed_step_samples(along, step / mm_per_unit)
     cl = _Cutter.of(surface, ev, tool, settings)
+    # Rows and samples on the program's resolution: every move then runs along a line the program can write.
+    levels, along = (cl.snap_axis(levels, 1), cl.snap_axis(along, 0)) if raster.direction == "x" else \
+        (cl.snap_axis(levels, 0), cl.snap_axis(along, 1))
     path = _fine_path(cl, levels, along, raster.direction, fine)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
-    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)))
+    # The sag a semi-convex path may hide between samples, for the longest sample step: on the program's
+    # resolution the steps differ by a unit, and a move's sag is bounded with its longest step.
+    semi = np.full(len(path.s_mm), kappa * float(np.diff(path.s_mm).max(initial=0.0)) ** 2 / 8.0)
+    kept = _emitted(path, tol, np.maximum(bend, semi))
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
     vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
     dense = chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius)
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    vx, vy = cl.snap(vx, vy)  # where the heights were computed, and what the program writes
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     return Toolpath(
@@ -135,10 +158,26 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         exact_mm=_place(settings, vx, vy, vz)[2],
         tool=tool,
         raster=raster,
-        stepover_mm=float((levels[1] - levels[0]) * mm_per_unit) if len(levels) > 1 else float(stepover),
+        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(stepover),
         step_mm=float(step),
         bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
+        **_cusp(scallop, raster.direction, settings),
     )
+
+
+def _span(bounds, direction: str) -> float:
+    """The box's extent across the rows (surface units)."""
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    return y1 - y0 if direction == "x" else x1 - x0
+
+
+def _cusp(scallop, direction: str, settings: MachineSettings) -> dict:
+    """The worst predicted cusp and where it is on the machine, for a plan from a scallop height."""
+    if scallop is None:
+        return {}
+    p, c = scallop.worst_at
+    x, y = settings.placement.to_machine(*((p, c) if direction == "x" else (c, p)))
+    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y))}
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
@@ -206,6 +245,10 @@ class _Cutter:
     The radius (surface units) includes the stock to leave for a ball or a
     bull nose (whose corner grows by it too), which then rides that much
     higher; a flat end is lifted by the stock instead.
+    ``snap`` moves positions onto the program's resolution (``grid``): the
+    rows, the samples along them and any point added are put there before
+    the tool is dropped, so an emitted height is that of a position the
+    program writes.
     """
 
     surface: object
@@ -215,20 +258,34 @@ class _Cutter:
     corner: float | None
     lift_tip: float
     mm_per_unit: float
+    grid: ResolutionGrid | None = None
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
         r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
+        grid = ResolutionGrid.of(settings, ev.bounds)
         if tool.shape == "flat":
-            return cls(surface, ev, r_mm / mm_per_unit, "flat", None, stock / mm_per_unit, mm_per_unit)
+            return cls(surface, ev, r_mm / mm_per_unit, "flat", None, stock / mm_per_unit, mm_per_unit, grid)
         # The tool grown by the stock all round touches the part where the tool touches the part grown by it.
         r = (r_mm + stock) / mm_per_unit
         corner = (tool.corner_mm + stock) / mm_per_unit if tool.shape == "bull" else None
-        return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit)
+        return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
+
+    def snap(self, x, y):
+        """The positions the program writes for surface positions ``x, y`` (see :mod:`.resolution`)."""
+        return (x, y) if self.grid is None else self.grid.snap(x, y)
+
+    def snap_between(self, x, y, ax, ay, bx, by):
+        """:meth:`snap` of points added on moves ``a -> b``, off their ends (see :mod:`.resolution`)."""
+        return (x, y) if self.grid is None else self.grid.snap_between(x, y, ax, ay, bx, by)
+
+    def snap_axis(self, v, axis: int):
+        """:meth:`snap` of positions on one axis (0: x, 1: y)."""
+        return v if self.grid is None else self.grid.snap_axis(v, axis)
 
 
 @dataclass(frozen=True)
@@ -253,12 +310,12 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order."""
     a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
     z_rows = cl(*((a_grid, l_grid) if direction == "x" else (l_grid, a_grid)))
-    gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
-    link_n = max(2, 2 * int(math.ceil(gap * cl.mm_per_unit / fine / 2)))
+    gaps = np.diff(levels)  # rows from a scallop height are not evenly spaced
+    link_n = max(2, 2 * int(math.ceil((gaps.max() if len(gaps) else 0.0) * cl.mm_per_unit / fine / 2)))
     u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
     ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
     link_a = np.repeat(ends, len(u))
-    link_l = (levels[:-1, None] + u[None, :] * gap).ravel()
+    link_l = cl.snap_axis((levels[:-1, None] + u[None, :] * gaps[:, None]).ravel(), 1 if direction == "x" else 0)
     z_links = (cl(*((link_a, link_l) if direction == "x" else (link_l, link_a)))
                if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
     fa, fl, fz, frow, pieces = [], [], [], [], []
@@ -268,7 +325,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _Fine
         t = along if fwd else along[::-1]
         piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
         if i + 1 < len(levels):
-            piece.append((np.full_like(u, t[-1]), levels[i] + u * gap, z_links[i]))
+            piece.append((np.full_like(u, t[-1]), link_l.reshape(-1, len(u))[i], z_links[i]))
         for pa, pl, pz in piece:
             fa.append(pa)
             fl.append(pl)
