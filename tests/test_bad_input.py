@@ -235,3 +235,76 @@ def test_the_documented_limits_are_the_ones_in_force():
     assert f"at most {MAX_EXPONENT} digits and a decimal exponent within +-{MAX_EXPONENT}" in formats
     assert f"at most {MAX_CELL} characters" in formats
     assert f"at most {MAX_LENGTH} characters, {MAX_DEPTH} levels of brackets, {MAX_HEIGHT} chained" in formats
+
+
+# 5 and 6. The serial line's options: one line naming the option and the value, exit 2, before any port opens.
+
+PROG = "%\nO0010\nG21 G90\nG0 X1. Y2.\nG1 Z-1. F100.\nM30\n%\n"
+
+
+@pytest.fixture
+def prog(tmp_path):
+    p = tmp_path / "small.nc"
+    p.write_text(PROG)
+    return p
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["send", "{prog}", "--port", "loop://?x=1"], "--port: 'loop://?x=1': 'x' is not an option of loop://"),
+    (["send", "{prog}", "--port", "loop://?logging=loud"], "logging=loud must be one of"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1:99999"], "'socket://127.0.0.1:99999': the port number must be 1 to 65535"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1:0"], "the port number must be 1 to 65535"),
+    (["send", "{prog}", "--port", "rfc2217://host:4001?timeout=nan"], "timeout=nan must be"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1"], "give the host and port number"),
+    (["send", "{prog}", "--port", "ftp://127.0.0.1:21"], "ftp:// is not a serial URL"),
+    (["send", "{prog}", "--port", "loop://", "--leader", "\u00b2*NUL"], "--leader '\u00b2*NUL'"),
+    (["send", "{prog}", "--port", "loop://", "--trailer", "\u0667"], "--trailer '\u0667'"),
+    (["receive", "--port", "loop://", "--timeout", "inf"], "--timeout: 'inf' is not a finite number"),
+    (["receive", "--port", "loop://", "--timeout", "nan"], "--timeout: 'nan' is not a finite number"),
+    (["receive", "--port", "loop://", "--timeout", "-1"], "--timeout: '-1' is out of range: give a number above 0"),
+    (["receive", "--port", "loop://", "--timeout", "0"], "--timeout: '0' is out of range"),
+    (["receive", "--port", "loop://", "--timeout", "86401"], "up to 86400 s"),
+    (["receive", "--port", "loop://", "--idle-timeout", "inf"], "--idle-timeout: 'inf' is not a finite number"),
+    (["send", "{prog}", "--port", "loop://", "--log", "/dev/full"], "--log /dev/full: cannot write the log file"),
+    (["receive", "--port", "loop://", "--log", "/dev/full"], "--log /dev/full: cannot write the log file"),
+])
+def test_line_options_are_checked_before_the_port_opens(run_cli, prog, argv, needle):
+    import time
+
+    start = time.monotonic()
+    status, out, err = run_cli(*[a.format(prog=prog) for a in argv])
+    one_line_error(status, out, err, needle)
+    assert time.monotonic() - start < 10  # refused, not waited on (receive --timeout inf waited for ever)
+    assert not out
+
+
+def test_a_good_url_still_sends(run_cli, prog, tmp_path):
+    log = tmp_path / "send.log"
+    status, out, err = run_cli("send", prog, "--port", "loop://?logging=error", "--baud", "115200", "--log", log)
+    assert status == 0 and out.startswith("sent 5 blocks"), err
+    assert [line.split(" ", 1)[1] for line in log.read_text().splitlines()][:2] == [
+        "log opened", "sending 47 bytes, 5 blocks, at 10472.7 characters/s"]
+
+
+def test_a_dnc_config_with_a_bad_device_url_names_the_key(run_cli, tmp_path):
+    (tmp_path / "progs").mkdir()
+    cfg = tmp_path / "dnc.toml"
+    cfg.write_text('[[port]]\nname = "mill"\ndevice = "socket://127.0.0.1:70000"\nprograms = "progs"\n'
+                   'received = "in"\n')
+    one_line_error(*run_cli("dnc", "serve", cfg, "--check"), "port[0].device 'socket://127.0.0.1:70000'")
+
+
+def test_a_log_lost_part_way_is_not_a_transfer_done(prog, tmp_path):
+    # A file-size limit of 60 bytes: the log's first line is written, the next ones fail (EFBIG), as on a
+    # disk that fills during the transfer.
+    log = tmp_path / "send.log"
+    code = ("import resource, signal, sys\nsignal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+            "resource.setrlimit(resource.RLIMIT_FSIZE, (60, 60))\nfrom lagsym.cli import main\n"
+            f"sys.exit(main(['send', {str(prog)!r}, '--port', 'loop://', '--baud', '115200', '--log', {str(log)!r}]))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 3, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert f"sent 5 blocks to loop://, but the log {log} was lost (File too large after 1 lines)" in proc.stderr
+    assert "not on record" in proc.stderr and "sent 5 blocks (" not in proc.stdout
+    assert log.read_text().splitlines()[0].endswith(" log opened") and len(log.read_bytes()) == 60

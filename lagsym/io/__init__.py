@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 from ..values import exact_number
-from .files import MAX_BYTES, STDIN_SILENCE_S, event_log, read_bytes, read_program, read_text
+from .files import MAX_BYTES, STDIN_SILENCE_S, EventLog, event_log, read_bytes, read_program, read_text
 from .points import (
     TABLE_SUFFIXES,
     PointsFile,
@@ -34,6 +34,7 @@ __all__ = [
     "read_bytes",
     "read_text",
     "event_log",
+    "EventLog",
     "parse_points",
     "parse_curve_points",
     "exact_number",
