@@ -308,3 +308,48 @@ def test_a_log_lost_part_way_is_not_a_transfer_done(prog, tmp_path):
     assert f"sent 5 blocks to loop://, but the log {log} was lost (File too large after 1 lines)" in proc.stderr
     assert "not on record" in proc.stderr and "sent 5 blocks (" not in proc.stdout
     assert log.read_text().splitlines()[0].endswith(" log opened") and len(log.read_bytes()) == 60
+
+
+# 5. An output under something that is not a folder (it used to be exit 70, NotADirectoryError).
+
+@pytest.mark.parametrize("argv", [
+    ["sample", "{flat}", "--nx", "3", "-o", "{flat}/out.csv"], ["toolpath", "{flat}", "-o", "{flat}/x.nc"],
+    ["export", "{flat}", "-o", "{flat}/x.step"], ["equation", "{flat}", "-o", "{flat}/x.txt"],
+    ["receive", "--port", "loop://", "--timeout", "30", "-o", "{flat}/x.nc"],
+])
+def test_an_output_under_a_file_is_one_line(run_cli, flat, argv):
+    import time
+
+    start = time.monotonic()
+    one_line_error(*run_cli(*[a.format(flat=flat) for a in argv]), "flat.json is not a folder")
+    assert time.monotonic() - start < 20  # receive says so before it waits for the control
+
+
+# 4 and 6 for rough and job: their numbers checked as toolpath's are, their work estimated first.
+
+@pytest.mark.parametrize("option, value, needle", [
+    ("--scale", "1e308", "is out of range"), ("--step", "1e-308", "is out of range"),
+    ("--stepdown", "1e-308", "is out of range"), ("--stepover", "nan", "not a finite number"),
+    ("--feed", "1e-308", "mm/min"), ("--spindle", "1e308", "rpm"), ("--safe-z", "1e23", "mm"),
+    ("--margin", "1e308", "is out of range"), ("--tool-diameter", "1e9", "is out of range"),
+    ("--block", "0,1e308,0,1", "--block X1 = '1e308' is out of range"),
+    ("--block", "0,100000,0,100000", "--max-samples"), ("--max-samples", "10", "62 points, more than the limit of 10"),
+])
+def test_rough_options_are_checked_and_its_work_estimated(run_cli, flat, option, value, needle):
+    one_line_error(*run_cli("rough", flat, "--stock-above", "1", option, value), needle)
+
+
+@pytest.mark.parametrize("old, new, needle", [
+    ("feed = 1200", "feed = 1e-308", "operations[0].feed = 1e-308 is out of range"),
+    ("spindle = 8000", "spindle = 1e308", "operations[0].spindle"),
+    ("safe_z = 90", "safe_z = 1e23", "safe_z = 1e+23 is out of range"),
+    ("stepdown = 2", "stepdown = 1e-308", "operations[0].stepdown"),
+    ("scale = 20", "scale = 1e308", "scale = 1e+308 is out of range"),
+    ("top_above = 2", 'top_above = "x"', "stock.top_above = 'x' must be a number"),
+])
+def test_job_file_numbers_are_checked(run_cli, tmp_path, old, new, needle):
+    text = (ROOT / "examples" / "example-4-job.toml").read_text()
+    assert old in text
+    job = tmp_path / "job.toml"
+    job.write_text(text.replace(old, new).replace('points = "paper-example-4.json"', f'points = "{EX4}"'))
+    one_line_error(*run_cli("job", job), needle)

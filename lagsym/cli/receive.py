@@ -6,7 +6,7 @@ import os
 
 from ..dnc import receive_program
 from ..errors import InputError
-from ..io import event_log
+from ..io import check_output, event_log
 from ._common import emit, number
 from .send import add_line_arguments, check_log, line_settings
 
@@ -42,6 +42,8 @@ def run(args, out, err) -> int:
     to_file = args.output and args.output != "-"
     if to_file and os.path.exists(args.output) and not args.overwrite:
         raise InputError(f"{args.output} exists; give another -o FILE, or --overwrite to replace it")
+    if to_file:
+        check_output(args.output)  # before the control punches: a program that cannot be saved would be lost
     settings = line_settings(args)
 
     def ready() -> None:

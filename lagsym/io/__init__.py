@@ -22,7 +22,7 @@ from .points import (
     read_point_file,
     read_points,
 )
-from .write import atomic_path, atomic_write, write_text
+from .write import atomic_path, atomic_write, check_output, write_text
 
 __all__ = [
     "read_points",
@@ -41,6 +41,7 @@ __all__ = [
     "atomic_path",
     "atomic_write",
     "write_text",
+    "check_output",
     "MAX_BYTES",
     "STDIN_SILENCE_S",
     "TABLE_SUFFIXES",
