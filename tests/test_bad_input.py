@@ -252,7 +252,8 @@ def prog(tmp_path):
 @pytest.mark.parametrize("argv, needle", [
     (["send", "{prog}", "--port", "loop://?x=1"], "--port: 'loop://?x=1': 'x' is not an option of loop://"),
     (["send", "{prog}", "--port", "loop://?logging=loud"], "logging=loud must be one of"),
-    (["send", "{prog}", "--port", "socket://127.0.0.1:99999"], "'socket://127.0.0.1:99999': the port number must be 1 to 65535"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1:99999"],
+     "'socket://127.0.0.1:99999': the port number must be 1 to 65535"),
     (["send", "{prog}", "--port", "socket://127.0.0.1:0"], "the port number must be 1 to 65535"),
     (["send", "{prog}", "--port", "rfc2217://host:4001?timeout=nan"], "timeout=nan must be"),
     (["send", "{prog}", "--port", "socket://127.0.0.1"], "give the host and port number"),
@@ -334,6 +335,7 @@ def test_an_output_under_a_file_is_one_line(run_cli, flat, argv):
     ("--margin", "1e308", "is out of range"), ("--tool-diameter", "1e9", "is out of range"),
     ("--block", "0,1e308,0,1", "--block X1 = '1e308' is out of range"),
     ("--block", "0,100000,0,100000", "--max-samples"), ("--max-samples", "10", "62 points, more than the limit of 10"),
+    ("--tool-diameter", "1e-308", "--max-samples"),
 ])
 def test_rough_options_are_checked_and_its_work_estimated(run_cli, flat, option, value, needle):
     one_line_error(*run_cli("rough", flat, "--stock-above", "1", option, value), needle)

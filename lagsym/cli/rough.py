@@ -93,8 +93,8 @@ def origin_list(text: str):
     parts = text.split(",")
     if len(parts) != 4:
         raise InputError(f"--block {text!r} must be four numbers X0,X1,Y0,Y1 in mm")
-    return [in_range(v, f"--block {name}", -LENGTH_MM, LENGTH_MM, unit="mm") for name, v in zip(("X0", "X1", "Y0", "Y1"),
-                                                                                                parts)]
+    names = ("X0", "X1", "Y0", "Y1")
+    return [in_range(v, f"--block {name}", -LENGTH_MM, LENGTH_MM, unit="mm") for name, v in zip(names, parts)]
 
 
 def run(args, out, err) -> int:

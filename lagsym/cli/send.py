@@ -56,7 +56,8 @@ def add_line_arguments(p) -> None:
     """The serial line options ``send`` and ``receive`` share; the defaults they print are :class:`LineSettings`'s."""
     d = LineSettings()
     p.add_argument("--port", required=True, type=port_name,
-                   help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port, rfc2217://host:port, loop://)")
+                   help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port, rfc2217://host:port, "
+                        "loop://)")
     g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
     g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
     g.add_argument("--baud", type=int, help=f"bits per second (default {d.baud})")

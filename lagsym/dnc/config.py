@@ -122,6 +122,8 @@ def load_config(path: str | Path) -> ServerConfig:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     except OSError as e:
         raise InputError(f"{source}: cannot read the configuration ({e.strerror or e})") from None
+    except UnicodeDecodeError as e:
+        raise InputError(f"{source}: not UTF-8 text (byte {e.start}); a configuration is a TOML text file") from None
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{source}: not TOML: {e}") from None
     for key in data:

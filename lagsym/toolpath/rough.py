@@ -226,14 +226,20 @@ def _check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_po
         return
     along, cross = ((stock.x1 - stock.x0, stock.y1 - stock.y0) if spec.direction == "x"
                     else (stock.y1 - stock.y0, stock.x1 - stock.x0))
-    rows = math.ceil(cross / spec.stepover_mm) + 1
-    per_row = math.ceil((along + 2 * (spec.clearance_mm + tool.radius_mm)) / spec.step_mm) + 1
+    # floats: a side step of 1e-308 mm gives a count no int conversion takes, and it is refused all the same
+    rows = _whole(cross / spec.stepover_mm) + 1
+    per_row = _whole((along + 2 * (spec.clearance_mm + tool.radius_mm)) / spec.step_mm) + 1
     total = rows * per_row * levels
     if total > max_points:
-        what = f"{rows} rows of {per_row} samples" + (f" at {levels} levels" if levels > 1 else "")
+        what = f"{rows:.4g} rows of {per_row:.4g} samples" + (f" at {levels} levels" if levels > 1 else "")
         raise ToolpathError(f"{what} is {total:.3g} points, more than the limit of {max_points:.3g} (side step "
                             f"{spec.stepover_mm:g} mm, step {spec.step_mm:g} mm, step-down {spec.stepdown_mm:g} mm); "
                             f"use larger steps or raise the limit ({option})")
+
+
+def _whole(v: float) -> float:
+    """``ceil(v)``, kept a float: an infinity stays one."""
+    return float(math.ceil(v)) if math.isfinite(v) else v
 
 
 def _check_stock(stock: Stock, box, ev: SurfaceEvaluator, place) -> None:
