@@ -237,6 +237,32 @@ def test_the_documented_limits_are_the_ones_in_force():
     assert f"at most {MAX_LENGTH} characters, {MAX_DEPTH} levels of brackets, {MAX_HEIGHT} chained" in formats
 
 
+def test_the_documented_runaway_and_line_limits_are_the_ones_in_force():
+    from lagsym.cli.receive import MAX_WAIT_S
+    from lagsym.simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS
+    from lagsym.toolpath.rough import MAX_ROUGH_SAMPLES
+
+    cli = " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
+    macros = " ".join((ROOT / "docs" / "macros.md").read_text().split())
+    dnc = " ".join((ROOT / "docs" / "dnc.md").read_text().split())
+    assert (MAX_BLOCKS, MAX_IDLE_BLOCKS, BYTES_PER_MOVE, MAX_ROUGH_SAMPLES, MAX_WAIT_S) == (
+        5_000_000, 200_000, 37, 100_000, 86_400.0)
+    assert 4 + 1 + 4 * 8 == BYTES_PER_MOVE  # array('i') line, array('b') rapid, four doubles
+    for text in (f"`--max-idle-blocks` ({MAX_IDLE_BLOCKS} blocks without a move) or `--max-blocks` "
+                 f"({MAX_BLOCKS:.0e} blocks, {BYTES_PER_MOVE} bytes a move at most)".replace("e+06", "e6"),
+                 f"`--max-samples` ({MAX_ROUGH_SAMPLES:.0e} drop-cutter samples".replace("e+05", "e5"),
+                 f"`--idle-timeout` are at most {MAX_WAIT_S:.0f} s"):
+        assert text in cli, text
+    assert f"`--max-idle-blocks` ({MAX_IDLE_BLOCKS}) blocks without a move or `--max-blocks` ({MAX_BLOCKS})" in formats
+    assert f"`--max-idle-blocks` blocks in a row without a move (default {MAX_IDLE_BLOCKS};" in macros
+    assert (f"`--max-blocks` blocks in all (default {MAX_BLOCKS}, {MAX_BLOCKS / 2_073_695:.1f} times the 2.07 "
+            f"million") in macros  # 2073695: test_simulate.test_the_readme_ball_macro_runs_under_the_default_limit
+    assert (f"{BYTES_PER_MOVE} bytes a move, so a run takes at most {BYTES_PER_MOVE} bytes times `--max-blocks` for "
+            f"them ({BYTES_PER_MOVE * MAX_BLOCKS / 1e6:.0f} MB at the default)") in macros
+    assert f"(default 60, at most {MAX_WAIT_S:.0f})" in dnc and f"(default 5, at most {MAX_WAIT_S:.0f})" in dnc
+
+
 # 5 and 6. The serial line's options: one line naming the option and the value, exit 2, before any port opens.
 
 PROG = "%\nO0010\nG21 G90\nG0 X1. Y2.\nG1 Z-1. F100.\nM30\n%\n"
