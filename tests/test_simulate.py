@@ -277,15 +277,20 @@ RUNAWAYS = {
                                 "can never end"),
     "heidenhain FN 9 to a label": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +0.001\n5 L X+Q1 Y+0 Z+0 F100\n"
                                    "6 FN 9: IF +0 EQU +0 GOTO LBL 1\n7 END PGM 1 MM\n", "can never end"),
-    # conditions that read a variable: the guards at run time
-    "fanuc back where it was": ("%\nO1\n#1=1.\nN10 G1 X1. Y0. Z0. F100.\nG1 X0.\nIF [#1 GT 0.] GOTO 10\nM30\n%\n",
-                                "unchanged"),
-    "linuxcnc no motion": ("#1=0\n#2=0\no100 while [#2 LT 1]\n#1=[#1+1]\no100 endwhile\nM2\n",
+    # a condition on a variable nothing in the loop sets: as good as a constant
+    "fanuc WHILE on an unset variable": ("%\nO1\n#1=0.\nWHILE [#2 LT 1.] DO1\n#1=[#1+0.001]\n"
+                                         "G1 X#1 Y0. Z0. F100.\nEND1\nM30\n%\n", "can never end"),
+    "heidenhain FN 12 on an unset Q": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +1\n5 FN 12: IF +Q2 LT +1 GOTO LBL 1\n"
+                                       "6 END PGM 1 MM\n", "can never end"),
+    # conditions on variables the loop sets, to values that never end it: the guards at run time
+    "fanuc back where it was": ("%\nO1\n#1=0.\nN10 #1=[1.-#1]\nG1 X#1 Y0. Z0. F100.\nIF [#1 GE 0.] GOTO 10\n"
+                                "M30\n%\n", "unchanged"),
+    "linuxcnc no motion": ("#1=0\n#2=0\no100 while [#2 LT 1]\n#1=[#1+1]\n#2=[#2*1]\no100 endwhile\nM2\n",
                            "--max-idle-blocks"),
-    "heidenhain no motion": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +1\n5 FN 12: IF +Q2 LT +1 GOTO LBL 1\n"
-                             "6 END PGM 1 MM\n", "--max-idle-blocks"),
-    "heidenhain back where it was": (_H + "3 LBL 1\n4 L X+1 Y+0 Z+0 F100\n5 L X+0\n"
-                                     "6 FN 12: IF +Q2 LT +1 GOTO LBL 1\n7 END PGM 1 MM\n", "unchanged"),
+    "heidenhain no motion": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +1\n5 FN 3: Q2 = Q2 * +1\n"
+                             "6 FN 12: IF +Q2 LT +1 GOTO LBL 1\n7 END PGM 1 MM\n", "--max-idle-blocks"),
+    "heidenhain back where it was": (_H + "3 LBL 1\n4 L X+1 Y+0 Z+0 F100\n5 L X+0\n6 FN 3: Q2 = Q2 * +1\n"
+                                     "7 FN 12: IF +Q2 LT +1 GOTO LBL 1\n8 END PGM 1 MM\n", "unchanged"),
 }
 
 
@@ -307,7 +312,8 @@ def test_a_runaway_program_stops_within_seconds_in_one_line(run_cli, tmp_path, n
 
 def test_a_moving_loop_on_a_variable_is_stopped_by_the_block_limit(run_cli, tmp_path):
     path = tmp_path / "count.nc"
-    path.write_text("%\nO1\n#1=0.\nWHILE [#2 LT 1.] DO1\n#1=[#1+0.001]\nG1 X#1 Y0. Z0. F100.\nEND1\nM30\n%\n")
+    path.write_text("%\nO1\n#1=0.\nWHILE [#2 LT 1.] DO1\n#2=[#2*1.]\n#1=[#1+0.001]\nG1 X#1 Y0. Z0. F100.\n"
+                    "END1\nM30\n%\n")
     status, out, err = run_cli("simulate", path, "--max-blocks", "30000")
     assert status == 2 and err.count("\n") == 1
     assert "more than 30000 blocks executed" in err and "--max-blocks N lifts it" in err
@@ -329,6 +335,10 @@ def test_the_runaway_limits_are_lifted_by_their_options(run_cli, tmp_path):
     "#1=0.\nWHILE [1 EQ 1] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] GOTO 99\nEND1\nN99 M30\n",
     "#1=0.\nN10 #1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] GOTO 20\nGOTO 10\nN20 M30\n",
     "#1=0.\nN10 #1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] THEN #2=30.\nM#2\nGOTO 10\n",
+    # the condition's variable set through IF THEN, or through an indirect number: each loop still ends
+    "#1=0.\nWHILE [#2 LT 1.] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] THEN #2=1.\nEND1\nM30\n",
+    "#1=0.\n#3=1.\nWHILE [#1 LT 3.] DO1\n#[#3]=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nEND1\nM30\n",
+    "#1=0.\n#3=1.\nWHILE [#[#3] LT 3.] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nEND1\nM30\n",
 ])
 def test_loops_with_a_way_out_are_not_runaways(text):
     assert [m.x for m in simulate(text, "fanuc", 8).moves] == [1.0, 2.0, 3.0]

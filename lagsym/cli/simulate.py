@@ -19,9 +19,10 @@ point, a variable outside the allowed range, a block too long, division by
 zero.  Use it to dry-run any program before it goes to a machine.
 
 A program that would never end stops within seconds with the runaway alarm
-(exit status 2, as every alarm): at once when it comes back to a block with
-every variable and the position unchanged, after --max-idle-blocks blocks
-without a move, or after --max-blocks blocks in all.
+(exit status 2, as every alarm): at once for a loop whose condition nothing in
+it changes (WHILE [1 EQ 1], a GOTO back) or when the run comes back to a block
+with every variable and the position unchanged, after --max-idle-blocks
+blocks without a move, or after --max-blocks blocks in all.
 
 examples:
   lagsym simulate O1000.nc --precision 8 -o moves.csv

@@ -4,11 +4,12 @@ Every run that does not end jumps back (a loop end, a ``GOTO`` or an ``FN 9``
 to an earlier label) again and again, so the guard looks only at backward
 jumps, and four things stop a run there:
 
-* a loop that can be seen in the text never to end: a ``WHILE [1 EQ 1]``
-  or bare ``DOm``, an ``o.. while`` on a constant, a ``GOTO`` or an
-  always-true ``IF``/``FN 9`` jump back, with no block between the target and
-  the jump that can leave (no ``M02``/``M30``/``M99``, ``END PGM``, no jump
-  or loop exit outside it): stopped the second time its jump runs;
+* a loop that can be seen in the text never to end: a ``GOTO`` back, or a
+  loop or ``IF``/``FN 9`` jump back on a condition that nothing in the loop
+  can change (a constant, as ``WHILE [1 EQ 1]``, or variables no block of the
+  loop sets), with no block between the target and the jump that can leave
+  (no ``M02``/``M30``/``M99``, ``END PGM``, no jump or loop exit outside it):
+  stopped the second time its jump runs;
 * the program comes back to the same block with every variable, the
   position and the modes as they were before: it is deterministic, so it
   would loop forever (found with Brent's doubling, so a cycle of any length
@@ -26,7 +27,8 @@ from __future__ import annotations
 from decimal import Decimal
 
 from .alarms import BlockAlarm, ControlAlarm
-from .blocks import End, Goto, IfGoto, IfGotoLabel, OElse, OElseIf, OEndWhile, OIf, OWhile, Stop, While, Words
+from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
+                     OWhile, Stop, While, Words)
 from .control import Control
 
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
@@ -52,7 +54,7 @@ class Runaway:
         if self.endless.get(id(block)) == target:
             first = self.blocks[target]
             self._stop(f"the loop from line {first.line} to line {block.line} can never end: it goes back "
-                       "unconditionally (or on a condition that is always true) and no block in it leaves", block,
+                       "unconditionally or on a condition nothing in it changes, and no block in it leaves", block,
                        question=False)
         if executed > self.max_blocks:
             self._stop(f"more than {self.max_blocks} blocks executed (the limit; --max-blocks N lifts it)", block)
@@ -93,6 +95,52 @@ class _Probe(Control):
         raise _NotConstant
 
 
+class _Reader(Control):
+    """A control whose every variable reads ``value``, noting which are read."""
+
+    def __init__(self, dialect: str, precision: int, value: int):
+        super().__init__(dialect, precision, ((0, 0),))
+        self.value, self.numbers, self.names_read = Decimal(value), set(), set()
+
+    def get(self, n: int) -> Decimal:
+        self.numbers.add(n)
+        return self.value
+
+    def named(self, name: str) -> Decimal:
+        self.names_read.add(name)
+        return self.value
+
+
+def _reads(probe: _Probe, cond):
+    """The variable numbers and names ``cond`` reads, or None where they depend on values (``#[#1]``)."""
+    seen = []
+    for value in (0, 1, 7):
+        r = _Reader(probe.dialect, probe.precision, value)
+        try:
+            cond(r)
+        except (BlockAlarm, ArithmeticError, ValueError):
+            return None
+        seen.append((r.numbers, r.names_read))
+    return seen[0] if all(s == seen[0] for s in seen) else None
+
+
+def _unchanged(probe: _Probe, cond, blocks, lo: int, hi: int) -> bool:
+    """Whether no block from ``lo`` to ``hi`` can change what ``cond`` reads."""
+    reads = _reads(probe, cond)
+    if reads is None:
+        return False
+    numbers, names = reads
+    for c in blocks[lo:hi + 1]:
+        a = c.then if isinstance(c, IfThen) else c
+        if isinstance(a, Assign):
+            n = _constant(probe, a.target)
+            if n is None or n in numbers:
+                return False
+        elif isinstance(a, AssignNamed) and a.name in names:
+            return False
+    return True
+
+
 def _constant(probe: _Probe, expr):
     """The value of ``expr`` if it reads no variable (and raises no alarm), else None."""
     try:
@@ -101,34 +149,33 @@ def _constant(probe: _Probe, expr):
         return None
 
 
-def _always_true(probe: _Probe, cond) -> bool:
-    value = _constant(probe, cond)
-    return value is not None and bool(value)
-
-
 def endless_jumps(blocks, labels: dict[int, int], dialect: str, precision: int) -> dict[int, int]:
     """The backward jumps that, once taken, are taken forever: ``{id(block): target index}``.
 
-    A jump qualifies when it is unconditional (``ENDm`` of a bare ``DOm``,
-    ``GOTO`` a constant) or its condition reads no variable and is true, and
-    nothing from its target to it can end the program or leave the range.
+    A jump qualifies when nothing from its target to it can end the program
+    or leave that range, and it is unconditional (``ENDm`` of a bare ``DOm``,
+    ``GOTO`` a constant) or its condition reads only what no block in the
+    range sets: once it has gone back, its condition was true (the loop's
+    head let the body run, or the ``IF`` jumped) and will be every time.
     """
     probe = _Probe(dialect, precision, ((0, 0),))
     found = {}
     for j, b in enumerate(blocks):
-        target = _always_back(probe, blocks, labels, j, b)
-        if target is not None and not any(_may_leave(probe, blocks, labels, k, target, j) for k in range(target, j)):
+        back = _back(probe, blocks, labels, j, b)
+        if back is None:
+            continue
+        target, cond = back
+        if any(_may_leave(probe, blocks, labels, k, target, j) for k in range(target, j)):
+            continue
+        if cond is None or _unchanged(probe, cond, blocks, target, j):
             found[id(b)] = target
     return found
 
 
-def _always_back(probe, blocks, labels, j: int, b) -> int | None:
-    """The earlier index ``b`` always jumps to, or None."""
+def _back(probe, blocks, labels, j: int, b) -> tuple[int, object] | None:
+    """``(earlier index, its condition or None)`` for a block that jumps back, else None."""
     if isinstance(b, (End, OEndWhile)):
-        head = blocks[b.start]
-        return b.start if head.cond is None or _always_true(probe, head.cond) else None
-    if isinstance(b, (IfGoto, IfGotoLabel)) and not _always_true(probe, b.cond):
-        return None
+        return b.start, blocks[b.start].cond
     if isinstance(b, (Goto, IfGoto)):
         n = _constant(probe, b.number)
         target = None if n is None else labels.get(probe.index(n))
@@ -136,7 +183,9 @@ def _always_back(probe, blocks, labels, j: int, b) -> int | None:
         target = labels.get(b.label)
     else:
         return None
-    return target if target is not None and target <= j else None
+    if target is None or target > j:
+        return None
+    return target, (b.cond if isinstance(b, (IfGoto, IfGotoLabel)) else None)
 
 
 def _may_leave(probe, blocks, labels, k: int, lo: int, hi: int) -> bool:
