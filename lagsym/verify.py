@@ -33,9 +33,9 @@ from ._arrays import freeze_fields
 from .errors import InputError, ToolpathError
 from .evaluate import evaluate_grid
 from .gcode import Moves
-from .machine import Placement, Tool
+from .machine import Placement, Tool, cutter_profile
 
-__all__ = ["CutReport", "simulate_cut", "MAX_CELLS", "MAX_CONTACTS"]
+__all__ = ["CutReport", "simulate_cut", "press_moves", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
@@ -162,10 +162,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
     surf = placement.height_mm(evaluate_grid(surface, sx, sy))
-    ball = tool.shape == "ball" and tool.radius_mm > 0
     r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
+    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
     ds = 0.5 * min(hx, hy)
-    resolution = (r - math.sqrt(max(r * r - (ds / 2) ** 2, 0.0)) if ball else 0.0) + dz_mm / 2
+    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
+    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
     limit = program_resolution_mm + resolution if gouge_limit_mm is None else float(gouge_limit_mm)
     cut = np.full((nx, ny), np.inf)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
@@ -176,7 +177,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     if not len(a_all):
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
     _check_work(a_all, b_all, ds, dz_mm, r, hx, hy, max_contacts)
-    positions = _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm)
+    positions = _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm)
     reached = np.isfinite(cut)
     diff = np.where(reached, cut - surf, np.nan)
     if reached.any():
@@ -197,7 +198,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
                      resolution_mm=resolution, gouge_limit_mm=limit, positions=positions)
 
 
-def _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm) -> int:
+def _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm) -> int:
     """Press the tool into ``cut`` along every move; the number of tool positions simulated.
 
     A few thousand moves at a time, so a long program never needs all its samples in memory at once.
@@ -212,7 +213,7 @@ def _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm) -> int:
         pts = pts[near]
         positions += len(pts)
         if len(pts):
-            _press(cut, pts, xs, ys, r, ball)
+            _press(cut, pts, xs, ys, r, corner)
     return positions
 
 
@@ -240,7 +241,7 @@ def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_
             f"moves and the tool diameter, use a larger cell (--cell), or raise the limit (--max-contacts)")
 
 
-def _press(cut, pts, xs, ys, r, ball):
+def _press(cut, pts, xs, ys, r, corner):
     """Lower ``cut`` to the tool's lower surface at every sampled position (in place)."""
     nx, ny = cut.shape
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
@@ -269,12 +270,28 @@ def _press(cut, pts, xs, ys, r, ball):
             cys = ys[np.clip(iy + dj, 0, ny - 1)]
             d2 = dx2 + (cys - py) ** 2
             inside = d2 <= r2
-            if ball:
-                h = np.where(inside, pz + r - np.sqrt(np.where(inside, r2 - d2, 0.0)), np.inf)
-            else:
-                h = np.where(inside, pz, np.inf)
+            h = np.where(inside, pz + cutter_profile(np.where(inside, d2, 0.0), r, corner), np.inf)
             m = np.minimum.reduceat(h, starts)
             sel = ok & np.isfinite(m)
             if sel.any():
                 a, b = tx[sel], ty[sel]
                 cut[a, b] = np.minimum(cut[a, b], m[sel])
+
+
+def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool,
+                dz_mm: float = 0.01, max_contacts: int | None = MAX_CONTACTS) -> tuple[int, float]:
+    """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
+
+    ``cut[i, j]`` is the height over ``(xs[i], ys[j])``, evenly spaced cell
+    centres.  Returns the number of tool positions simulated and the
+    simulation's vertical resolution (as :func:`simulate_cut` states it).
+    """
+    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
+    r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
+    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
+    ds = 0.5 * min(hx, hy)
+    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
+    if not len(a):
+        return 0, resolution
+    _check_work(a, b, ds, dz_mm, r, hx, hy, max_contacts)
+    return _sweep(cut, a, b, xs, ys, r, corner, ds, dz_mm), resolution

@@ -163,3 +163,12 @@ def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_c
     assert status == 0, err
     assert quoted == (out + err).strip()
     assert f"takes {quoted.split('macro program:')[1].split()[0]} bytes on a Fanuc" in text
+
+
+def test_dnc_page_line_times_of_the_window():
+    from lagsym.dnc import profile
+
+    text = page("dnc.md")
+    ms = {baud: 4 / profile("fanuc", baud=baud).chars_per_s * 1000 for baud in (9600, 115200)}
+    assert f"4 characters are {ms[9600]:.1f} ms of line at 9600 baud and {ms[115200]:.2f} ms at 115200" in text
+    assert f"{profile('fanuc').chars_per_s:.1f} characters/s at 9600 baud" in text

@@ -6,8 +6,8 @@ from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import (FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count, number,
-                      origin)
+from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
+                      number, origin)
 from .job import add_max_points
 
 _STEP_MM = number(1e-3, 1_000.0, "mm")  # a step-down, side step or forward step
@@ -45,7 +45,9 @@ def add_arguments(p) -> None:
     r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
                    help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
     t = p.add_argument_group("cutter")
-    t.add_argument("--tool-shape", default="flat", help="flat (default) or ball end")
+    t.add_argument("--tool-shape", default="flat", help="flat (default), ball or bull (bull nose: give --corner-radius)")
+    t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
     t.add_argument("--tool-diameter", type=TOOL_MM, default=10.0, metavar="MM", help="cutter diameter (default 10)")
     t.add_argument("--tool-number", type=_TOOL_NUMBER, default=1, metavar="N", help="tool and length offset number (default 1)")
     t.add_argument("--flute-length", type=_LEN_MM, metavar="MM", help="refuse a step-down longer than the flutes")
@@ -72,7 +74,7 @@ def job_data(args) -> dict:
     if args.margin is not None:
         stock["margin"] = args.margin
     tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
-    for key in ("flute_length", "reach"):
+    for key in ("corner_radius", "flute_length", "reach"):
         if getattr(args, key) is not None:
             tool[key] = getattr(args, key)
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,

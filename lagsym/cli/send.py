@@ -182,8 +182,8 @@ def add_arguments(p) -> None:
     t.add_argument("--memory-chars", type=int, metavar="N",
                    help="the control's program memory: a larger upload is refused (default: not checked)")
     t.add_argument("--overrun-chars", type=int, metavar="N",
-                   help=f"most characters in flight, so at most N arrive after XOFF (default {d.overrun_chars}; "
-                        "Fanuc tolerates ~10)")
+                   help=f"most characters in flight: about half what the control takes past XOFF (default "
+                        f"{d.overrun_chars}; a Fanuc takes ~10; a larger N keeps a fast line busy)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
 
 

@@ -8,8 +8,8 @@ from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpe
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
-                      DECIMALS, add_program_arguments, count, program_settings)
+from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+                      TOOL_MM, DECIMALS, add_program_arguments, count, program_settings)
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
 FILE and write it as a point-list G-code program.  Cutter locations come from
@@ -40,7 +40,9 @@ def add_arguments(p) -> None:
     g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
                    help="forward steps from this chordal error, instead of a fixed --step")
     t = p.add_argument_group("cutter")
-    t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
+    t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default), flat or bull (bull nose: give --corner-radius)")
+    t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
     t.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM",
                    help="cutter diameter (default 6; 0 gives the uncompensated path on the surface)")
     m = p.add_argument_group("machine and program")
@@ -69,7 +71,7 @@ def run(args, out, err) -> int:
 
     grid = read_points(args.file)
     settings = settings_from(args, args.dialect, grid)
-    tool = Tool(args.tool_shape, args.tool_diameter)
+    tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance)

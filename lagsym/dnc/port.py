@@ -10,7 +10,9 @@ on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
 from __future__ import annotations
 
 import errno
+import select
 import termios
+import time
 
 import serial
 
@@ -67,6 +69,9 @@ class Port:
         except (ValueError, KeyError, *LINE_ERRORS) as e:  # KeyError: pyserial formatting its own URL message
             raise TransferError(_open_failure(name, e)) from None
         self._ser = ser
+        # A local device can be waited on: the sender sleeps until the control says something or the line needs
+        # more, instead of polling.  A URL port (RFC 2217, socket, loop) buffers in pyserial and is polled.
+        self._fd = ser.fd if type(ser) is serial.Serial else None
 
     def read(self, size: int) -> bytes:
         """What has arrived, up to ``size`` bytes, without waiting."""
@@ -76,6 +81,16 @@ class Port:
         """Queue ``data``; the number of bytes taken."""
         written = self._ser.write(data)
         return len(data) if written is None else written
+
+    def wait(self, timeout_s: float) -> None:
+        """Wait up to ``timeout_s`` seconds, returning as soon as the control has sent something (where the port can tell)."""
+        if self._fd is None:
+            time.sleep(timeout_s)
+            return
+        try:
+            select.select([self._fd], [], [], timeout_s)
+        except (OSError, ValueError):  # a line lost meanwhile: the next read says so
+            time.sleep(timeout_s)
 
     def out_waiting(self) -> int:
         """Bytes in the driver's output queue, or 0 where the port cannot tell."""

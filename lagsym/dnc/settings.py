@@ -69,9 +69,11 @@ class LineSettings:
         drip feed it must exceed the longest time the control spends on the
         blocks in its buffer.
     overrun_chars : int
-        Most characters on their way at any moment, so at most this many
-        arrive after the control says XOFF.  Keep it below the control's
-        tolerance (about 10 on a Fanuc).
+        Most characters on their way at any moment: what arrives after the
+        control says XOFF is these and at most one write that left before
+        lagsym read the DC3.  Keep it to about half the control's tolerance
+        (about 10 on a Fanuc); a larger window keeps a fast line busy when
+        the computer wakes the sender late.
     wait_for_xon : bool
         Wait for the control's DC1 before the first character (a Fanuc sends
         it when READ is pressed).

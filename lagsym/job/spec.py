@@ -46,7 +46,8 @@ _TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": l
         "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
         "operations": list}
 _STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
-_TOOL = {"number": int, "shape": str, "diameter": float, "flute_length": float, "reach": float}
+_TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float, "flute_length": float,
+         "reach": float}
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str}
@@ -227,7 +228,8 @@ def _tool(name: str, table: dict, source: str) -> ToolSpec:
         raise InputError(f"{source}: {where}number = {table['number']} must be 1 to 99")
     shape = _choice(table["shape"], TOOL_SHAPES, where + "shape", source)
     try:
-        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source))
+        corner = _positive(table["corner_radius"], where + "corner_radius", source) if "corner_radius" in table else None
+        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source), corner)
     except LagsymError as e:
         raise InputError(f"{source}: {where}: {e}") from None
     opt = {k: _positive(table[k], where + k, source) for k in ("flute_length", "reach") if k in table}

@@ -51,11 +51,12 @@ def refuse_flat_end(tool: Tool | None) -> None:
     surface slopes and the cutter would cut into the part (30.4 mm on paper
     example 1 at scale 10 with a 6 mm cutter).
     """
-    if tool is not None and tool.shape == "flat" and tool.diameter_mm > 0:
+    if tool is not None and tool.shape in ("flat", "bull") and tool.diameter_mm > 0:
+        what = "flat-end" if tool.shape == "flat" else "bull-nose"
         raise ToolpathError(
-            f"a flat-end cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
+            f"a {what} cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
             "which a macro cannot compute on the control: use the point-list toolpath "
-            "(lagsym toolpath --tool-shape flat), which drops the flat end onto the exact surface, "
+            f"(lagsym toolpath --tool-shape {tool.shape}), which drops the cutter onto the exact surface, "
             "or a ball end (--tool-shape ball), or --tool-diameter 0 for the surface itself")
 
 

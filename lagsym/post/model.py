@@ -71,7 +71,7 @@ class PointProgram:
 def point_program(toolpath, settings: MachineSettings, title: str = "") -> PointProgram:
     """The program model of a :class:`~lagsym.toolpath.Toolpath` for one machine."""
     t = toolpath.tool
-    tool = f"T{settings.tool_number} {t.shape.upper()} END D{t.diameter_mm:g} MM"
+    tool = f"T{settings.tool_number} {t.label}"
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
 
 

@@ -203,26 +203,31 @@ def _fixed_step_samples(along: np.ndarray, step: float) -> np.ndarray:
 class _Cutter:
     """Tool-tip heights (mm) over surface positions, as the planner computes them.
 
-    The radius (surface units) includes the stock to leave for a ball, which
-    then rides that much higher; a flat end is lifted by the stock instead.
+    The radius (surface units) includes the stock to leave for a ball or a
+    bull nose (whose corner grows by it too), which then rides that much
+    higher; a flat end is lifted by the stock instead.
     """
 
     surface: object
     ev: SurfaceEvaluator
     radius: float
     shape: str
+    corner: float | None
     lift_tip: float
     mm_per_unit: float
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
         r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
-        r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / mm_per_unit
-        lift_tip = r - r_mm / mm_per_unit if tool.shape == "ball" else stock / mm_per_unit
-        return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit)
+        if tool.shape == "flat":
+            return cls(surface, ev, r_mm / mm_per_unit, "flat", None, stock / mm_per_unit, mm_per_unit)
+        # The tool grown by the stock all round touches the part where the tool touches the part grown by it.
+        r = (r_mm + stock) / mm_per_unit
+        corner = (tool.corner_mm + stock) / mm_per_unit if tool.shape == "bull" else None
+        return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit)
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
 

@@ -312,7 +312,9 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **sea
     out = np.full(x.size, -np.inf)
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
-        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, evaluator=ev, **search)
+        corner = tool.corner_mm / place.mm_per_unit if tool.shape == "bull" else None
+        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner, evaluator=ev,
+                        **search)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 
