@@ -65,9 +65,10 @@ def add_arguments(p) -> None:
     p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
                    help="picture size in pixels (default: 1280x960)")
-    p.add_argument("--z-exaggeration", type=float, metavar="K",
+    p.add_argument("--z-exaggeration", type=number(0.0, 1000.0, above=True), metavar="K",
                    help="draw z K times its true size (surface, compare, toolpath; the ticks read true heights); "
-                        "default: chosen so the height lies between a fifth of the plan and the plan, 1 for true "
+                        "above 0 up to 1000; default: chosen so the height lies between a fifth of the plan and the "
+                        "plan, 1 for true "
                         "proportions")
     p.add_argument("--samples", type=count(2, 2_000), metavar="N", help="samples along each axis")
     p.add_argument("--scale", type=SCALE, default=None,

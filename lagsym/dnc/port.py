@@ -17,7 +17,7 @@ import time
 import serial
 
 from ..errors import TransferError
-from .settings import PARITIES, LineSettings
+from .settings import PARITIES, LineSettings, check_port
 
 __all__ = ["Port", "LINE_ERRORS", "WriteTimeout"]
 
@@ -40,11 +40,14 @@ class Port:
 
     Raises
     ------
+    InputError
+        For a URL that cannot name a port (see :func:`~lagsym.dnc.settings.check_port`).
     TransferError
         If the port cannot be opened.
     """
 
     def __init__(self, name: str, settings: LineSettings, write_timeout: float | None):
+        check_port(name, "port")
         try:
             ser = serial.serial_for_url(name, do_not_open=True)
             ser.baudrate = settings.baud
@@ -63,7 +66,7 @@ class Port:
                 ser.write_timeout = write_timeout
             ser.dtr = settings.dtr
             ser.open()
-        except (ValueError, *LINE_ERRORS) as e:
+        except (ValueError, KeyError, *LINE_ERRORS) as e:  # KeyError: pyserial formatting its own URL message
             raise TransferError(_open_failure(name, e)) from None
         self._ser = ser
         # A local device can be waited on: the sender sleeps until the control says something or the line needs
