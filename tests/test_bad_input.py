@@ -256,8 +256,8 @@ def test_the_documented_runaway_and_line_limits_are_the_ones_in_force():
         assert text in cli, text
     assert f"`--max-idle-blocks` ({MAX_IDLE_BLOCKS}) blocks without a move or `--max-blocks` ({MAX_BLOCKS})" in formats
     assert f"`--max-idle-blocks` blocks in a row without a move (default {MAX_IDLE_BLOCKS};" in macros
-    assert (f"`--max-blocks` blocks in all (default {MAX_BLOCKS}, {MAX_BLOCKS / 2_073_695:.1f} times the 2.07 "
-            f"million") in macros  # 2073695: test_simulate.test_the_readme_ball_macro_runs_under_the_default_limit
+    assert (f"`--max-blocks` blocks in all (default {MAX_BLOCKS}, {MAX_BLOCKS / 2_525_622:.1f} times the 2.53 "
+            f"million") in macros  # 2525622: test_simulate.test_the_readme_ball_macro_runs_under_the_default_limit
     assert (f"{BYTES_PER_MOVE} bytes a move, so a run takes at most {BYTES_PER_MOVE} bytes times `--max-blocks` for "
             f"them ({BYTES_PER_MOVE * MAX_BLOCKS / 1e6:.0f} MB at the default)") in macros
     assert f"(default 60, at most {MAX_WAIT_S:.0f})" in dnc and f"(default 5, at most {MAX_WAIT_S:.0f})" in dnc

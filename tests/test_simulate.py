@@ -357,7 +357,7 @@ def test_moves_are_kept_as_columns():
 
 
 def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
-    """The README's Example 4 ball macro: 2073695 blocks at 8 digits, under the 5e6 default (docs/macros.md)."""
+    """The README's Example 4 ball macro: 2525622 blocks at 8 digits, under the 5e6 default (docs/macros.md)."""
     from conftest import EXAMPLES
     from lagsym.simulate import MAX_BLOCKS
 
@@ -368,5 +368,5 @@ def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
     assert status == 0, err
     status, out, err = run_cli("simulate", prog, "--precision", "8")
     assert status == 0, err
-    assert err.endswith(": fanuc, 8 digits: 2073695 blocks executed, 64566 moves (64562 feed), no alarm\n"), err
-    assert 2073695 < MAX_BLOCKS and len(out.splitlines()) == 64566 + 1
+    assert err.endswith(": fanuc, 8 digits: 2525622 blocks executed, 64566 moves (64562 feed), no alarm\n"), err
+    assert 2525622 < MAX_BLOCKS and len(out.splitlines()) == 64566 + 1

@@ -54,8 +54,10 @@ class Sender:
     """One send over an open port: pacing, flow control, accounting.  Not reused."""
 
     def __init__(self, line, segments, settings: LineSettings, mode: str, port: str,
-                 progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None):
+                 progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None,
+                 resumable_from: int = 2):
         self.line, self.settings, self.mode, self.port = line, settings, mode, port
+        self.resumable_from = resumable_from  # no resume before this block can approach the part
         self.progress, self.log = progress, log or (lambda _m: None)
         self.data = b"".join(b for _, b in segments)
         self.ends: list[tuple[int, int]] = []  # (end offset, block number) of program blocks
@@ -136,6 +138,8 @@ class Sender:
         repeat = None
         if self.mode == "drip":
             resume = self.last_run_block() + 1
+            if resume < self.resumable_from:  # before the program has placed the tool: from the start
+                resume = 1
             if resume <= last:
                 repeat = (max(resume, self.first_block), last)
                 where += (f"; the control's buffer ({self.settings.buffer_chars} characters) may still hold blocks "

@@ -33,7 +33,7 @@ from .control import Control
 
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
 
-MAX_BLOCKS = 5_000_000  # 2.4 times the 2.07 million of the README's Example 4 ball macro at 8 digits
+MAX_BLOCKS = 5_000_000  # 2.0 times the 2.53 million of the README's Example 4 ball macro at 8 digits
 MAX_IDLE_BLOCKS = 200_000  # lagsym's macros move every few hundred blocks at most (a 12x12 Heidenhain one: 613)
 
 
