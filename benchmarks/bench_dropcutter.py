@@ -1,12 +1,13 @@
 """Drop-cutter against the exact surface (lagsym) versus OpenCAMLib on STL triangulations of it.
 
-Both place the same ball-end cutter over the same (x, y) positions of a raster
+Both place the same cutter (ball end, or with ``--corner R`` a bull nose, OpenCAMLib's
+BullCutter) over the same (x, y) positions of a raster
 on the paper's Example 4, scaled to millimetres.  The "exact" value is
 lagsym's drop-cutter with a much finer search (``lattice=24, starts=8``).
 OpenCAMLib sees the surface as triangles, so its cutter locations carry the
 mesh's chordal error, and they can lie below the exact value (a gouge).
 
-    python3 benchmarks/bench_dropcutter.py [--points 4000] [--mesh 50 100 200]
+    python3 benchmarks/bench_dropcutter.py [--points 4000] [--mesh 50 100 200] [--corner 1]
 
 Needs ``opencamlib`` (``pip install opencamlib``; wheels for Python 3.11).
 """
@@ -47,8 +48,8 @@ def stl_surface(ocl, surface, n: int, scale: float):
     return stl
 
 
-def ocl_drop(ocl, stl, diameter: float, x, y, floor: float):
-    cutter = ocl.BallCutter(diameter, 4 * diameter)
+def ocl_drop(ocl, stl, diameter: float, x, y, floor: float, corner: float | None = None):
+    cutter = ocl.BallCutter(diameter, 4 * diameter) if corner is None else ocl.BullCutter(diameter, corner, 4 * diameter)
     bdc = ocl.BatchDropCutter()
     bdc.setSTL(stl)
     bdc.setCutter(cutter)
@@ -64,6 +65,7 @@ def main(argv=None) -> int:
     ap.add_argument("--mesh", type=int, nargs="+", default=[50, 100, 200], help="cells per side of the STL meshes")
     ap.add_argument("--scale", type=float, default=20.0)
     ap.add_argument("--diameter", type=float, default=6.0)
+    ap.add_argument("--corner", type=float, help="corner radius (mm): a bull nose instead of a ball end")
     args = ap.parse_args(argv)
     import opencamlib as ocl
 
@@ -74,13 +76,15 @@ def main(argv=None) -> int:
     gx, gy = np.meshgrid(np.linspace(x0, x1, cols), np.linspace(y0, y1, rows))
     x, y = gx.ravel(), gy.ravel()
     r = args.diameter / 2 / args.scale
+    shape = {"shape": "ball"} if args.corner is None else {"shape": "bull", "corner": args.corner / args.scale}
+    name = "ball" if args.corner is None else f"bull nose R{args.corner:g}"
 
     t = time.perf_counter()
-    z = drop_cutter(surface, x, y, r) * args.scale
+    z = drop_cutter(surface, x, y, r, **shape) * args.scale
     t_lagsym = time.perf_counter() - t
-    exact = drop_cutter(surface, x, y, r, lattice=24, starts=8, margin=False) * args.scale
+    exact = drop_cutter(surface, x, y, r, lattice=24, starts=8, margin=False, **shape) * args.scale
 
-    print(f"Example 4 at scale {args.scale:g}: {len(x)} cutter locations, ball D{args.diameter:g} mm, "
+    print(f"Example 4 at scale {args.scale:g}: {len(x)} cutter locations, {name} D{args.diameter:g} mm, "
           f"{ocl.max_threads()} OpenCAMLib threads")
     print(f"{'method':<28}{'time s':>9}{'vs lagsym':>11}{'max |err| mm':>15}{'below exact mm':>16}")
     print(f"{'lagsym exact drop-cutter':<28}{t_lagsym:>9.3f}{1.0:>10.2f}x{np.abs(z - exact).max():>15.2e}"
@@ -89,7 +93,7 @@ def main(argv=None) -> int:
     for n in args.mesh:
         stl = stl_surface(ocl, surface, n, args.scale)
         t = time.perf_counter()
-        zo = ocl_drop(ocl, stl, args.diameter, x * args.scale, y * args.scale, floor)
+        zo = ocl_drop(ocl, stl, args.diameter, x * args.scale, y * args.scale, floor, args.corner)
         t_ocl = time.perf_counter() - t
         err = zo - exact
         print(f"{f'OpenCAMLib STL {n}x{n}x2':<28}{t_ocl:>9.3f}{t_ocl / t_lagsym:>10.2f}x{np.abs(err).max():>15.2e}"

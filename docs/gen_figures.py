@@ -64,6 +64,12 @@ def main(names: list[str] | None = None) -> int:
         if lagsym(["plot", "examples/paper-example-4.json", "--show", "toolpath", program, "--scale", "20",
                    *size, "-o", str(HERE / "images" / "fig12-toolpath.png")]) != 0:
             return 1
+        job = str(Path(d) / "job.ngc")
+        if lagsym(["job", "examples/example-4-job.toml", "-o", job]) != 0:
+            return 1
+        if lagsym(["plot", "examples/example-4-job.toml", "--show", "machined", job, "--cell", "0.25",
+                   *size, "-o", str(HERE / "images" / "job-machined.png")]) != 0:
+            return 1
     return 0
 
 

@@ -9,11 +9,16 @@ The names below are loaded on first use, so ``import lagsym`` (and the
 ``from lagsym import lagrange_surface`` then imports what that name needs.
 They are listed in the order the data flows: points, grid, exact polynomial,
 evaluator, sampling and comparison, toolpath and programs, serial line.
+
+Imported inside a running IPython shell (a Jupyter kernel), lagsym registers
+the rich display of surfaces and curves, their equation and a small figure;
+``%load_ext lagsym`` does the same after an earlier import.
 """
 
 from __future__ import annotations
 
 import importlib
+import sys
 from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
@@ -61,6 +66,40 @@ def __getattr__(name: str):
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
+
+
+def load_ipython_extension(ipython) -> None:
+    """``%load_ext lagsym``: show surfaces and curves as their equation and a small figure.
+
+    Registers :func:`lagsym.plot.inline.rich_html` as the ``text/html``
+    formatter of :class:`~lagsym.lagrange.LagrangeSurface` and
+    :class:`~lagsym.lagrange.LagrangeCurve` by name, so neither lagsym's
+    numeric modules nor pyvista load before a value is displayed.  ``import
+    lagsym`` calls it itself in a running shell; the magic is for a shell
+    started after lagsym was imported.
+    """
+    formatter = ipython.display_formatter.formatters["text/html"]
+    for name in ("LagrangeSurface", "LagrangeCurve"):
+        formatter.for_type_by_name("lagsym.lagrange", name, _rich_html)
+
+
+def _rich_html(value):
+    # Imported on the first display, which pays for pyvista, not the import.  By name, like the
+    # exports above: the package facade reaches each layer only on demand, at run time; a static
+    # import here would put every module that reads lagsym.__version__ above the plot layer.
+    return importlib.import_module(".plot.inline", __name__).rich_html(value)
+
+
+def _register_in_running_ipython() -> None:
+    """Register the rich display when imported inside an IPython shell; never import IPython here."""
+    ipython = sys.modules.get("IPython")
+    get_ipython = getattr(ipython, "get_ipython", None)
+    shell = get_ipython() if callable(get_ipython) else None
+    if getattr(shell, "display_formatter", None) is not None:
+        load_ipython_extension(shell)
+
+
+_register_in_running_ipython()
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly

@@ -35,6 +35,12 @@ class OutputError(LagsymError, OSError):
     """A result cannot be written where it was asked for (a full disk, a folder without write permission)."""
 
 
+class LogLost(OutputError):
+    """A transfer ran but its event log could not be written to the end (a full disk): exit 3, a fault of the run."""
+
+    exit_status = ExitStatus.LINE_FAULT
+
+
 class GridError(InputError):
     """Control points that do not form the rectangular grid the method needs."""
 

@@ -129,7 +129,8 @@ class LagrangeCurve:
         The variable of :attr:`poly`, :attr:`expr` and :attr:`basis`; plain
         ``x`` by default.
 
-    In Jupyter the curve shows as its equation in LaTeX.
+    In Jupyter the curve shows as its equation in LaTeX and, once ``import lagsym`` has
+    registered the display, a small line plot (:mod:`lagsym.plot.inline`).
     """
 
     points: CurvePoints
@@ -187,7 +188,8 @@ class LagrangeSurface:
         The variables ``(x, y)`` of :attr:`poly`, :attr:`expr` and the bases;
         plain ``x`` and ``y`` by default.
 
-    In Jupyter the surface shows as its equation in LaTeX.
+    In Jupyter the surface shows as its equation in LaTeX and, once ``import lagsym`` has
+    registered the display, a small figure (:mod:`lagsym.plot.inline`).
     """
 
     grid: ControlGrid

@@ -5,8 +5,8 @@ of cells; each cell keeps the lowest height any part of the tool reached over
 its centre.  Every move of the program is sampled densely enough that
 consecutive tool positions are at most half a cell apart sideways and
 ``dz_mm`` apart in height, and at each position the exact lower surface of
-the tool (a sphere for a ball end, a disc for a flat end) is pressed into every
-cell centre under it; feed moves and rapids (``G00``) go into two maps.  The
+the tool (:func:`lagsym.machine.cutter_profile`: ball, flat or bull nose) is
+pressed into every cell centre under it; feed moves and rapids (``G00``) go into two maps.  The
 part is the surface over the box and ends at the box edges (the cells on the
 edges are its top edges).  The result is compared with the exact surface at
 the same cell centres:
@@ -23,7 +23,7 @@ the same cell centres:
 
 The simulation errs towards missing a little cut, never towards inventing one:
 every sampled position is on a move, and between two of them the tool sweeps
-at most ``resolution_mm`` lower than the samples show (the sag of the ball over
+at most ``resolution_mm`` lower than the samples show (the sag of its corner over
 half the sample spacing, plus half a height step).  So a gouge it reports is
 real, and the depth from which a cut counts as a gouge needs no room for the
 simulation: by default it is what the program's rounding can cause,
@@ -44,10 +44,10 @@ from ._arrays import freeze_fields
 from .errors import InputError, ToolpathError
 from .evaluate import evaluate_grid, surface_evaluator
 from .gcode import Moves
-from .machine import MAX_LEFT_MM, Placement, Tool
+from .machine import MAX_LEFT_MM, Placement, Tool, cutter_profile
 
-__all__ = ["CutReport", "simulate_cut", "gouge_limit", "program_resolution_mm", "MAX_CELLS", "MAX_CONTACTS",
-           "MAX_LEFT_MM"]
+__all__ = ["CutReport", "simulate_cut", "press_moves", "gouge_limit", "program_resolution_mm", "MAX_CELLS",
+           "MAX_CONTACTS", "MAX_LEFT_MM"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
@@ -265,10 +265,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     sx, sy = placement.to_surface(xs, ys)
     surf = placement.height_mm(evaluate_grid(surface, sx, sy))
     slope = _slopes(surface, sx, sy)
-    ball = tool.shape == "ball" and tool.radius_mm > 0
     r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
+    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
     ds = 0.5 * min(hx, hy)
-    resolution = (r - math.sqrt(max(r * r - (ds / 2) ** 2, 0.0)) if ball else 0.0) + dz_mm / 2
+    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
+    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
     limit = gouge_limit(program_resolution_mm, float(slope.max())) if gouge_limit_mm is None else float(gouge_limit_mm)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
     known = np.asarray(moves.z_known, dtype=bool)
@@ -279,8 +280,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     _check_work(path[:-1][use], path[1:][use], ds, dz_mm, r, hx, hy, max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
     cut = np.full((nx, ny), np.inf)
-    positions = _sweep(cut, path[:-1][use & ~rapid], path[1:][use & ~rapid], xs, ys, r, ball, ds, dz_mm)
-    crash, crash_positions = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, ball, ds, dz_mm))
+    positions = _sweep(cut, path[:-1][use & ~rapid], path[1:][use & ~rapid], xs, ys, r, corner, ds, dz_mm)
+    crash, crash_positions = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner, ds, dz_mm))
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
                      rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
                      unreached_mm2=float((~np.isfinite(cut)).sum() * hx * hy), resolution_mm=resolution,
@@ -325,13 +326,13 @@ def _rapids(surf, path, use, lines, grid):
     All rapids are pressed into one map; only those that pass over the worst
     cell are simulated again, one by one, to name the line.
     """
-    xs, ys, r, ball, ds, dz = grid
+    xs, ys, r, corner, ds, dz = grid
     none = (0.0, (float(xs[0]), float(ys[0])), 0)
     k = np.flatnonzero(use)
     if not k.size:
         return none, 0
     cut = np.full(surf.shape, np.inf)
-    positions = _sweep(cut, path[k], path[k + 1], xs, ys, r, ball, ds, dz)
+    positions = _sweep(cut, path[k], path[k + 1], xs, ys, r, corner, ds, dz)
     depth = np.where(np.isfinite(cut), surf - cut, -np.inf)
     i = int(np.argmax(depth))
     if not depth.flat[i] > 0.0:
@@ -343,14 +344,14 @@ def _rapids(surf, path, use, lines, grid):
         lo, hi = np.minimum(path[m], path[m + 1]), np.maximum(path[m], path[m + 1])
         if lo[0] - r <= px <= hi[0] + r and lo[1] - r <= py <= hi[1] + r:
             one = np.full(surf.shape, np.inf)
-            _sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r, ball, ds, dz)
+            _sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r, corner, ds, dz)
             if one[a, b] <= cut[a, b]:
                 line = int(lines[m])
                 break
     return (float(depth.flat[i]), (float(px), float(py)), line), positions
 
 
-def _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm) -> int:
+def _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm) -> int:
     """Press the tool into ``cut`` along every move; the number of tool positions simulated.
 
     A few thousand moves at a time, so a long program never needs all its samples in memory at once.
@@ -365,7 +366,7 @@ def _sweep(cut, a_all, b_all, xs, ys, r, ball, ds, dz_mm) -> int:
         pts = pts[near]
         positions += len(pts)
         if len(pts):
-            _press(cut, pts, xs, ys, r, ball)
+            _press(cut, pts, xs, ys, r, corner)
     return positions
 
 
@@ -393,7 +394,7 @@ def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_
             f"moves and the tool diameter, use a larger cell (--cell), or raise the limit (--max-contacts)")
 
 
-def _press(cut, pts, xs, ys, r, ball):
+def _press(cut, pts, xs, ys, r, corner):
     """Lower ``cut`` to the tool's lower surface at every sampled position (in place)."""
     nx, ny = cut.shape
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
@@ -422,12 +423,28 @@ def _press(cut, pts, xs, ys, r, ball):
             cys = ys[np.clip(iy + dj, 0, ny - 1)]
             d2 = dx2 + (cys - py) ** 2
             inside = d2 <= r2
-            if ball:
-                h = np.where(inside, pz + r - np.sqrt(np.where(inside, r2 - d2, 0.0)), np.inf)
-            else:
-                h = np.where(inside, pz, np.inf)
+            h = np.where(inside, pz + cutter_profile(np.where(inside, d2, 0.0), r, corner), np.inf)
             m = np.minimum.reduceat(h, starts)
             sel = ok & np.isfinite(m)
             if sel.any():
                 a, b = tx[sel], ty[sel]
                 cut[a, b] = np.minimum(cut[a, b], m[sel])
+
+
+def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool,
+                dz_mm: float = 0.01, max_contacts: int | None = MAX_CONTACTS) -> tuple[int, float]:
+    """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
+
+    ``cut[i, j]`` is the height over ``(xs[i], ys[j])``, evenly spaced cell
+    centres.  Returns the number of tool positions simulated and the
+    simulation's vertical resolution (as :func:`simulate_cut` states it).
+    """
+    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
+    r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
+    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
+    ds = 0.5 * min(hx, hy)
+    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
+    if not len(a):
+        return 0, resolution
+    _check_work(a, b, ds, dz_mm, r, hx, hy, max_contacts)
+    return _sweep(cut, a, b, xs, ys, r, corner, ds, dz_mm), resolution

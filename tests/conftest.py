@@ -21,24 +21,24 @@ settings.register_profile("dev", max_examples=30, deadline=None, suppress_health
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
 
-# Debian packages the tests use but do not fetch themselves (README, "System packages"). Where one is
-# missing, the tests that need it skip with one line naming it; LAGSYM_TEST_REQUIRE_ALL=1 (set by
-# .ci/run) makes that a failure instead, so a green CI run never hides a skipped check.
-SYSTEM_PACKAGES = {
-    "socat": "the serial-line tests (a pseudo-terminal pair to a simulated control)",
-    "libegl1 libegl-mesa0 libgl1-mesa-dri": "pictures: VTK's offscreen OpenGL (EGL on Mesa)",
-    "xvfb": "the test of the private-Xvfb fallback for pictures",
-    "libgl1 libx11-6": "reading STEP and IGES files back with OpenCascade (cadquery-ocp loads libGL and libX11)",
-}
+from systempackages import SYSTEM_PACKAGES, missing_system_package, need_opengl  # noqa: E402,F401
 
 
-def missing_system_package(packages: str, what: str) -> None:
-    """Skip (or, under LAGSYM_TEST_REQUIRE_ALL, fail) a test whose Debian ``packages`` are not installed."""
-    assert packages in SYSTEM_PACKAGES, packages
-    line = f"{what} not found: install Debian's {packages} (apt-get install {packages})"
-    if os.environ.get("LAGSYM_TEST_REQUIRE_ALL"):
-        pytest.fail(line, pytrace=False)
-    pytest.skip(line, allow_module_level=True)
+def pytest_collection_modifyitems(config, items):
+    """The notebooks draw their figures: without an OpenGL they skip with one line naming the packages.
+
+    (A session-wide hook, so it reaches the notebooks outside tests/.)  Under
+    LAGSYM_TEST_REQUIRE_ALL they run, and fail, instead.
+    """
+    notebooks = [item for item in items if item.path.suffix == ".ipynb"]
+    if not notebooks or os.environ.get("LAGSYM_TEST_REQUIRE_ALL"):
+        return
+    from systempackages import can_render, missing_line
+
+    if not can_render():
+        line = missing_line("libegl1 libegl-mesa0 libgl1-mesa-dri", "an offscreen OpenGL (EGL or OSMesa) for the notebooks' figures")
+        for item in notebooks:
+            item.add_marker(pytest.mark.skip(reason=line))
 
 
 @pytest.fixture(autouse=True)

@@ -19,7 +19,8 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 CACHE = Path(os.environ.get("LAGSYM_TOOL_CACHE", REPO / ".cache" / "debtools"))
-RS274_PACKAGES = ("linuxcnc-uspace", "libboost-python1.74.0", "libpython3.11")  # rs274 embeds Python
+# rs274 embeds Python and reads its input with libedit (which needs libbsd); a minimal Debian has none of them.
+RS274_PACKAGES = ("linuxcnc-uspace", "libboost-python1.74.0", "libpython3.11", "libedit2", "libbsd0")
 
 
 class ToolUnavailable(RuntimeError):

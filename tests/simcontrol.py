@@ -137,8 +137,12 @@ class SimControl:
 
     It runs in a process of its own, so that its pace does not depend on the
     sender's interpreter.  Its record (``received``, ``overflow``, ``xoffs``,
-    ``max_after_xoff``, ``dropped``) is read once it has stopped; reading it
-    stops it.
+    ``max_after_xoff``, ``pending_at_xoff``, ``dropped``, ``starved_s``) is
+    read once it has stopped; reading it stops it.  ``starved_s`` is the time
+    the machine found the buffer empty between the first and the last
+    character (the program not yet all there); ``pending_at_xoff`` the most
+    characters still in the pty, written but not yet carried by the line,
+    when a DC3 went out.
 
     Parameters
     ----------
@@ -194,6 +198,11 @@ class SimControl:
         if self._master is not None:
             os.close(self._master)  # the control's process holds the master now; its close hangs up the line
 
+    @property
+    def arrived(self) -> int:
+        """Bytes arrived so far (readable while the control runs)."""
+        return self._count.value
+
     def wait_for(self, count: int, timeout: float = 30.0) -> bool:
         """Wait until ``count`` bytes have arrived."""
         deadline = time.monotonic() + timeout
@@ -216,7 +225,7 @@ class SimControl:
 
     def __getattr__(self, name):
         if name in ("received", "overflow", "max_after_xoff", "xoffs", "dropped", "first_byte_at", "last_byte_at",
-                    "executed"):
+                    "executed", "starved_s", "pending_at_xoff"):
             return self.stop()[name]
         raise AttributeError(name)
 
@@ -238,7 +247,9 @@ def _control_main(path, params, socat_pid, count, halt, ready, results) -> None:
     results.send({"received": bytes(control.received), "overflow": control.overflow, "xoffs": control.xoffs,
                   "max_after_xoff": control.max_after_xoff, "dropped": control.dropped, "error": control.error,
                   "first_byte_at": control.first_byte_at, "last_byte_at": control.last_byte_at,
-                  "executed": len(control.received) - int(control.buffered + 0.999)})
+                  "executed": len(control.received) - int(control.buffered + 0.999),
+                  "starved_s": control.starved_at_last, "pending_at_xoff": control.pending_at_xoff,
+                  "episodes": control.episodes})
 
 
 class _Control:
@@ -267,9 +278,15 @@ class _Control:
         self.excused = 0.0  # characters that arrived while the simulation itself was descheduled
         self.first_byte_at = None
         self.last_byte_at = None
+        self.starved_s = 0.0  # time the machine found the buffer empty since the first character
+        self.starved_at_last = 0.0  # the same up to the last character: while the program remained
+        self.episodes = []  # per XOFF: (characters after DC3, excused, left in the pty, rest of the read at DC3)
+        self.pending_now = self.tail = 0
+        self.pending_at_xoff = 0  # most characters still waiting in the pty (on the wire) when DC3 went out
 
     def close_episode(self) -> None:
         self.overflow += max(0, int(self.after - self.excused) - self.tolerance)
+        self.episodes.append((self.after, int(self.excused), self.pending_now, self.tail))
 
     def cut(self) -> None:
         self.dropped = True
@@ -301,13 +318,19 @@ class _Control:
                 self.cut()
                 return
             held = self.hold_on_xoff and self.xoffs > 0
+            deficit = 0.0  # characters the machine wanted in this gap beyond what the buffer held
             if not held:
-                self.buffered = 0.0 if self.drain_cps is None else max(0.0, self.buffered - self.drain_cps * gap)
+                if self.drain_cps is not None:
+                    deficit = self.drain_cps * gap - self.buffered
+                self.buffered = 0.0 if self.drain_cps is None else max(0.0, -deficit)
             pending = self.port.in_waiting
             if pending and not was_pending:
                 line_t = max(line_t, now - gap)  # an idle line starts again when the data came, about the last look
             n = min(pending, int((now - line_t) * self.cps)) if pending else 0
             was_pending = pending > n
+            if deficit > 0 and self.first_byte_at is not None:
+                # What the line brings in this look arrived during the gap: only the rest is a starved machine.
+                self.starved_s += max(0.0, deficit - n) / self.drain_cps
             crossed = False
             if n:
                 data = self.port.read(n)
@@ -315,6 +338,7 @@ class _Control:
                 now = time.monotonic()
                 self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
+                self.starved_at_last = self.starved_s
                 for byte in data:
                     self.count_in += 1
                     if self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes:
@@ -336,6 +360,8 @@ class _Control:
                 self.count.value = len(self.received)
                 if crossed:
                     self.port.write(DC3)
+                    self.pending_now, self.tail = self.port.in_waiting, self.after
+                    self.pending_at_xoff = max(self.pending_at_xoff, self.pending_now)
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
                     late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S

@@ -235,3 +235,149 @@ def test_the_documented_limits_are_the_ones_in_force():
     assert f"at most {MAX_EXPONENT} digits and a decimal exponent within +-{MAX_EXPONENT}" in formats
     assert f"at most {MAX_CELL} characters" in formats
     assert f"at most {MAX_LENGTH} characters, {MAX_DEPTH} levels of brackets, {MAX_HEIGHT} chained" in formats
+
+
+def test_the_documented_runaway_and_line_limits_are_the_ones_in_force():
+    from lagsym.cli.receive import MAX_WAIT_S
+    from lagsym.simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS
+    from lagsym.toolpath.rough import MAX_ROUGH_SAMPLES
+
+    cli = " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
+    macros = " ".join((ROOT / "docs" / "macros.md").read_text().split())
+    dnc = " ".join((ROOT / "docs" / "dnc.md").read_text().split())
+    assert (MAX_BLOCKS, MAX_IDLE_BLOCKS, BYTES_PER_MOVE, MAX_ROUGH_SAMPLES, MAX_WAIT_S) == (
+        5_000_000, 200_000, 37, 100_000, 86_400.0)
+    assert 4 + 1 + 4 * 8 == BYTES_PER_MOVE  # array('i') line, array('b') rapid, four doubles
+    for text in (f"`--max-idle-blocks` ({MAX_IDLE_BLOCKS} blocks without a move) or `--max-blocks` "
+                 f"({MAX_BLOCKS:.0e} blocks, {BYTES_PER_MOVE} bytes a move at most)".replace("e+06", "e6"),
+                 f"`--max-samples` ({MAX_ROUGH_SAMPLES:.0e} drop-cutter samples".replace("e+05", "e5"),
+                 f"`--idle-timeout` are at most {MAX_WAIT_S:.0f} s"):
+        assert text in cli, text
+    assert f"`--max-idle-blocks` ({MAX_IDLE_BLOCKS}) blocks without a move or `--max-blocks` ({MAX_BLOCKS})" in formats
+    assert f"`--max-idle-blocks` blocks in a row without a move (default {MAX_IDLE_BLOCKS};" in macros
+    assert (f"`--max-blocks` blocks in all (default {MAX_BLOCKS}, {MAX_BLOCKS / 2_525_622:.1f} times the 2.53 "
+            f"million") in macros  # 2525622: test_simulate.test_the_readme_ball_macro_runs_under_the_default_limit
+    assert (f"{BYTES_PER_MOVE} bytes a move, so a run takes at most {BYTES_PER_MOVE} bytes times `--max-blocks` for "
+            f"them ({BYTES_PER_MOVE * MAX_BLOCKS / 1e6:.0f} MB at the default)") in macros
+    assert f"(default 60, at most {MAX_WAIT_S:.0f})" in dnc and f"(default 5, at most {MAX_WAIT_S:.0f})" in dnc
+
+
+# 5 and 6. The serial line's options: one line naming the option and the value, exit 2, before any port opens.
+
+PROG = "%\nO0010\nG21 G90\nG0 X1. Y2.\nG1 Z-1. F100.\nM30\n%\n"
+
+
+@pytest.fixture
+def prog(tmp_path):
+    p = tmp_path / "small.nc"
+    p.write_text(PROG)
+    return p
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["send", "{prog}", "--port", "loop://?x=1"], "--port: 'loop://?x=1': 'x' is not an option of loop://"),
+    (["send", "{prog}", "--port", "loop://?logging=loud"], "logging=loud must be one of"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1:99999"],
+     "'socket://127.0.0.1:99999': the port number must be 1 to 65535"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1:0"], "the port number must be 1 to 65535"),
+    (["send", "{prog}", "--port", "rfc2217://host:4001?timeout=nan"], "timeout=nan must be"),
+    (["send", "{prog}", "--port", "socket://127.0.0.1"], "give the host and port number"),
+    (["send", "{prog}", "--port", "ftp://127.0.0.1:21"], "ftp:// is not a serial URL"),
+    (["send", "{prog}", "--port", "loop://", "--leader", "\u00b2*NUL"], "--leader '\u00b2*NUL'"),
+    (["send", "{prog}", "--port", "loop://", "--trailer", "\u0667"], "--trailer '\u0667'"),
+    (["receive", "--port", "loop://", "--timeout", "inf"], "--timeout: 'inf' is not a finite number"),
+    (["receive", "--port", "loop://", "--timeout", "nan"], "--timeout: 'nan' is not a finite number"),
+    (["receive", "--port", "loop://", "--timeout", "-1"], "--timeout: '-1' is out of range: give a number above 0"),
+    (["receive", "--port", "loop://", "--timeout", "0"], "--timeout: '0' is out of range"),
+    (["receive", "--port", "loop://", "--timeout", "86401"], "up to 86400 s"),
+    (["receive", "--port", "loop://", "--idle-timeout", "inf"], "--idle-timeout: 'inf' is not a finite number"),
+    (["send", "{prog}", "--port", "loop://", "--log", "/dev/full"], "--log /dev/full: cannot write the log file"),
+    (["receive", "--port", "loop://", "--log", "/dev/full"], "--log /dev/full: cannot write the log file"),
+])
+def test_line_options_are_checked_before_the_port_opens(run_cli, prog, argv, needle):
+    import time
+
+    start = time.monotonic()
+    status, out, err = run_cli(*[a.format(prog=prog) for a in argv])
+    one_line_error(status, out, err, needle)
+    assert time.monotonic() - start < 10  # refused, not waited on (receive --timeout inf waited for ever)
+    assert not out
+
+
+def test_a_good_url_still_sends(run_cli, prog, tmp_path):
+    log = tmp_path / "send.log"
+    status, out, err = run_cli("send", prog, "--port", "loop://?logging=error", "--baud", "115200", "--log", log)
+    assert status == 0 and out.startswith("sent 5 blocks"), err
+    assert [line.split(" ", 1)[1] for line in log.read_text().splitlines()][:2] == [
+        "log opened", "sending 47 bytes, 5 blocks, at 10472.7 characters/s"]
+
+
+def test_a_dnc_config_with_a_bad_device_url_names_the_key(run_cli, tmp_path):
+    (tmp_path / "progs").mkdir()
+    cfg = tmp_path / "dnc.toml"
+    cfg.write_text('[[port]]\nname = "mill"\ndevice = "socket://127.0.0.1:70000"\nprograms = "progs"\n'
+                   'received = "in"\n')
+    one_line_error(*run_cli("dnc", "serve", cfg, "--check"), "port[0].device 'socket://127.0.0.1:70000'")
+
+
+def test_a_log_lost_part_way_is_not_a_transfer_done(prog, tmp_path):
+    # A file-size limit of 60 bytes: the log's first line is written, the next ones fail (EFBIG), as on a
+    # disk that fills during the transfer.
+    log = tmp_path / "send.log"
+    code = ("import resource, signal, sys\nsignal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+            "resource.setrlimit(resource.RLIMIT_FSIZE, (60, 60))\nfrom lagsym.cli import main\n"
+            f"sys.exit(main(['send', {str(prog)!r}, '--port', 'loop://', '--baud', '115200', '--log', {str(log)!r}]))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 3, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert f"sent 5 blocks to loop://, but the log {log} was lost (File too large after 1 lines)" in proc.stderr
+    assert "not on record" in proc.stderr and "sent 5 blocks (" not in proc.stdout
+    assert log.read_text().splitlines()[0].endswith(" log opened") and len(log.read_bytes()) == 60
+
+
+# 5. An output under something that is not a folder (it used to be exit 70, NotADirectoryError).
+
+@pytest.mark.parametrize("argv", [
+    ["sample", "{flat}", "--nx", "3", "-o", "{flat}/out.csv"], ["toolpath", "{flat}", "-o", "{flat}/x.nc"],
+    ["export", "{flat}", "-o", "{flat}/x.step"], ["equation", "{flat}", "-o", "{flat}/x.txt"],
+    ["receive", "--port", "loop://", "--timeout", "30", "-o", "{flat}/x.nc"],
+])
+def test_an_output_under_a_file_is_one_line(run_cli, flat, argv):
+    import time
+
+    start = time.monotonic()
+    one_line_error(*run_cli(*[a.format(flat=flat) for a in argv]), "flat.json is not a folder")
+    assert time.monotonic() - start < 20  # receive says so before it waits for the control
+
+
+# 4 and 6 for rough and job: their numbers checked as toolpath's are, their work estimated first.
+
+@pytest.mark.parametrize("option, value, needle", [
+    ("--scale", "1e308", "is out of range"), ("--step", "1e-308", "is out of range"),
+    ("--stepdown", "1e-308", "is out of range"), ("--stepover", "nan", "not a finite number"),
+    ("--feed", "1e-308", "mm/min"), ("--spindle", "1e308", "rpm"), ("--safe-z", "1e23", "mm"),
+    ("--margin", "1e308", "is out of range"), ("--tool-diameter", "1e9", "is out of range"),
+    ("--block", "0,1e308,0,1", "--block X1 = '1e308' is out of range"),
+    ("--block", "0,100000,0,100000", "--max-samples"), ("--max-samples", "10", "62 points, more than the limit of 10"),
+    ("--tool-diameter", "1e-308", "--max-samples"),
+])
+def test_rough_options_are_checked_and_its_work_estimated(run_cli, flat, option, value, needle):
+    one_line_error(*run_cli("rough", flat, "--stock-above", "1", option, value), needle)
+
+
+@pytest.mark.parametrize("old, new, needle", [
+    ("feed = 1200", "feed = 1e-308", "operations[0].feed = 1e-308 is out of range"),
+    ("spindle = 8000", "spindle = 1e308", "operations[0].spindle"),
+    ("safe_z = 90", "safe_z = 1e23", "safe_z = 1e+23 is out of range"),
+    ("stepdown = 2", "stepdown = 1e-308", "operations[0].stepdown"),
+    ("scale = 20", "scale = 1e308", "scale = 1e+308 is out of range"),
+    ("top_above = 2", 'top_above = "x"', "stock.top_above = 'x' must be a number"),
+])
+def test_job_file_numbers_are_checked(run_cli, tmp_path, old, new, needle):
+    text = (ROOT / "examples" / "example-4-job.toml").read_text()
+    assert old in text
+    job = tmp_path / "job.toml"
+    job.write_text(text.replace(old, new).replace('points = "paper-example-4.json"', f'points = "{EX4}"'))
+    one_line_error(*run_cli("job", job), needle)

@@ -23,7 +23,7 @@ EX4 = str(EXAMPLES / "paper-example-4.json")
      "--base-z 1 is not below the surface, whose lowest height is 0.1507663366"),
     ([EX4, "--solid", "--base-z", "0.1507663366", "-o", "out.json"], "is not below the surface"),
     ([EX4, "--units", "inch", "-o", "out.step"], "the file states \"units\": \"mm\", not --units inch"),
-    ([EX4, "--method", "bspline", "--degree", "0", "-o", "out.step"], "B-spline degree 0 should be an integer >= 1"),
+    ([EX4, "--method", "bspline", "--degree", "0", "-o", "out.step"], "argument --degree: '0' is out of range: give a whole number from 1 to 30"),
     (["missing.json", "-o", "out.step"], "missing.json: no such file"),
     ([EX4, "-o", "no/such/folder/out.step"], "no/such/folder does not exist"),
 ])
@@ -95,3 +95,14 @@ def test_warns_above_the_kernel_degree(run_cli, tmp_path):
     path.write_text(json.dumps([[x, y, 0] for x in range(27) for y in range(2)]))
     status, _, err = run_cli("export", path, "-o", tmp_path / "long.json.step")
     assert status == 0 and "degree (26, 1) is above 25" in err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--degree", "3"], "--degree 3 is the degree of --method bspline"),
+    (["--method", "bspline", "--degree", "999999999"], "--degree"),
+    (["--method", "bspline", "--degree", "0"], "--degree"),
+])
+def test_degree_is_refused_where_it_would_not_be_used(run_cli, tmp_path, args, message):
+    status, _, err = run_cli("export", EXAMPLES / "paper-example-4.json", "-o", tmp_path / "x.step", *args)
+    assert status == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "x.step").exists()

@@ -10,7 +10,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, need_opengl
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -295,6 +295,8 @@ def test_cli_errors_exit_2_with_one_line(run_cli, args, message):
 
 def test_cli_plot_writes_a_deviation_map(run_cli, tmp_path):
     from PIL import Image
+
+    need_opengl("the deviation map")
 
     target = tmp_path / "d.png"
     status, out, err = run_cli("compare", PARABOLA, "--samples", "21x21", "--plot", target)

@@ -7,6 +7,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -139,7 +140,9 @@ def line():
 def test_large_drip_feed_arrives_byte_exact(line):
     baud = 115200
     prog = parse_program(program_text(1200))
-    settings = profile("fanuc", baud=baud, stall_timeout_s=10)
+    # A control with room for 512 characters past its DC3 takes a window of 128: the default 4 is 0.4 ms of
+    # line at this rate, which a loaded machine cannot keep topped up (the buffer would never fill).
+    settings = profile("fanuc", baud=baud, stall_timeout_s=10, overrun_chars=128, buffer_chars=1024)
     pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=1024, high_water=512, low_water=128)
     expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
     assert len(expected) > 30_000
@@ -174,6 +177,41 @@ def test_xoff_stops_the_sender_within_its_limit(line):
     # What the control counted past its DC3 also holds the time the DC3 took to come back, which a
     # starved machine can stretch; the benchmark reports that figure (0 overflow when the machine is
     # not starved), a test cannot promise it.
+
+
+@pytest.mark.parametrize("late_s", [0.0, 0.02], ids=["prompt", "late-writes"])
+def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line, monkeypatch, late_s):
+    # What the sender controls: it keeps at most its window on the way and writes nothing once it has read
+    # the DC3, so what the control receives after its DC3 (counted by the control, on a kernel pty pair)
+    # stays within a headroom twice the window: the window on the way, and at most one write that left
+    # before the DC3 was read.  The sender's own count of characters in flight at each XOFF is checked too.
+    # "late-writes" holds every other write back 20 ms (17 characters of line), as a busy computer does to
+    # a sender between its look at the clock and its write; the next write then follows at once.
+    baud, window, headroom = 9600, 32, 64
+    if late_s:
+        from lagsym.dnc.port import Port
+
+        write, calls = Port.write, []
+
+        def late_write(self, data):
+            calls.append(len(data))
+            if len(calls) % 2:
+                time.sleep(late_s)
+            return write(self, data)
+
+        monkeypatch.setattr(Port, "write", late_write)
+    prog = parse_program(program_text(200))
+    settings = profile("fanuc", baud=baud, overrun_chars=window)
+    pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
+                     low_water=64, tolerance=headroom)
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
+    result = send_program(pair.near, prog, settings, "drip")
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert sim.xoffs >= 5 and result.xoff_count == sim.xoffs
+    assert result.max_in_flight_at_xoff <= window
+    assert sim.pending_at_xoff <= window  # written but not yet carried by the line when the DC3 went out
+    assert sim.overflow == 0
 
 
 @needs_socat
@@ -247,14 +285,18 @@ def _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path):
 @needs_socat
 def test_a_feed_hold_stalls_with_exit_3_and_a_resume_block_that_allows_for_the_buffer(line, run_cli, tmp_path):
     # The control's buffer fills, it says DC3, the machine stops (feed hold) and no DC1 comes: what sits
-    # in its 1200-character buffer has arrived but not run, and a reset would clear it.
+    # in its 3000-character buffer has arrived but not run, and a reset would clear it.  The machine runs at
+    # a fifth of the line rate, so the buffer fills even when a loaded computer slows the sender down.
     baud = 38400
     text = program_text(300)
     path = write(tmp_path, text)
-    pair, sim = line(baud=baud, ignore_xon=True, hold_on_xoff=True, drain_cps=0.5 * chars_per_s(baud),
-                     buffer_chars=1200, high_water=1000, low_water=200)
+    # The buffer is large enough that the machine has run past the program's set-up when it fills, however
+    # fast the sender: a resume then starts after it (a fault within the set-up asks for the whole program,
+    # test_dnc_resume.test_a_fault_within_the_set_up_asks_for_the_program_from_the_start).
+    pair, sim = line(baud=baud, ignore_xon=True, hold_on_xoff=True, drain_cps=0.2 * chars_per_s(baud),
+                     buffer_chars=3000, high_water=2800, low_water=200)
     status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
-                               "--mode", "drip", "--stall-timeout", "1", "--buffer-chars", "1200", "--quiet")
+                               "--mode", "drip", "--stall-timeout", "1", "--buffer-chars", "3000", "--quiet")
     assert status == 3, err
     assert "held XOFF (DC3) for more than 1 s" in err
     assert "the line was lost" not in err and "reconnect" not in err  # a stall, told as a stall

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
+import termios
 import threading
 import time
 from pathlib import Path
@@ -15,7 +17,7 @@ import pytest
 from lagsym.dnc import LineFault, parse_program, profile, send_program, transfer_segments
 from lagsym.dnc.port import Port
 from rfc2217rig import Rfc2217Server
-from simcontrol import PROGRAM, PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import PROGRAM, KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
@@ -128,6 +130,27 @@ def test_send_over_rfc2217_arrives_byte_exact(line):
         server.close()
 
 
+def test_a_drip_feed_over_rfc2217_hears_the_controls_xoff_and_xon(line):
+    # Both directions at once through the RFC 2217 server: the program out, DC3 and DC1 back.
+    baud = 9600
+    pair, sim = line(baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192, low_water=64)
+    server = Rfc2217Server(pair.near)
+    try:
+        prog = parse_program(program_text(120))
+        settings = profile("fanuc", baud=baud, stall_timeout_s=20)
+        events = []
+        result = send_program(server.url, prog, settings, "drip", log=events.append)
+        expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
+        assert sim.wait_for(len(expected))
+        assert bytes(sim.received) == expected
+        assert sim.xoffs >= 3 and result.xoff_count == sim.xoffs
+        pauses = [e.split()[0] for e in events if e.startswith(("XOFF", "XON"))]
+        # The last DC3 may come after the last character has left (the server still held some): no XON then.
+        assert pauses[::2] == ["XOFF"] * sim.xoffs and set(pauses[1::2]) == {"XON"}
+    finally:
+        server.close()
+
+
 def test_receive_over_rfc2217(run_cli, tmp_path):
     with PtyPair() as pair:
         server = Rfc2217Server(pair.near)
@@ -150,10 +173,66 @@ def test_receive_over_rfc2217(run_cli, tmp_path):
 
 def test_a_control_that_stops_taking_the_program_is_not_reported_as_delivered(line, run_cli, tmp_path):
     pair, sim = line(baud=38400, discard_after_bytes=1000)
-    status, out, err = run_cli("send", write(tmp_path, program_text(200)), "--port", pair.near, "--baud", 38400)
+    text = program_text(200)
+    status, out, err = run_cli("send", write(tmp_path, text), "--port", pair.near, "--baud", 38400)
     assert status == 0, err
     assert len(sim.received) == 1000
-    assert "the control confirmed nothing" in out
+    # The message says what was sent (all of it) and that nothing confirmed it arrived.
+    sent = re.match(rf"sent (\d+) blocks \((\d+) bytes\) to {re.escape(pair.near)} in ", out)
+    assert sent and int(sent[1]) == text.count("\n") - 2 and int(sent[2]) == len(text)
+    assert out.splitlines()[1].startswith("the control confirmed nothing: over XON/XOFF alone nothing proves it")
+
+
+@pytest.mark.parametrize("flow", ["xonxoff", "rtscts", "dtrdsr", "none"])
+def test_the_flow_control_setting_reaches_the_port_and_the_kernel(flow):
+    # A pty has no modem lines, but it keeps the hardware flow-control flag: the kernel's own view of the
+    # line (read through the master side) shows what lagsym asked for.  Linux has no DTR/DSR flow control
+    # in the kernel: there it is pyserial's setting and lagsym's pause on DSR.
+    with KernelPty() as pair:
+        port = Port(pair.near, profile("fanuc", flow=flow), write_timeout=1)
+        try:
+            iflag, _, cflag, _, ispeed, _, _ = termios.tcgetattr(pair.fd)
+            assert port._ser.rtscts == (flow == "rtscts") and port._ser.dsrdtr == (flow == "dtrdsr")
+        finally:
+            port.close()
+    assert bool(cflag & termios.CRTSCTS) == (flow == "rtscts")
+    assert not iflag & (termios.IXON | termios.IXOFF)  # XON/XOFF stays lagsym's, never the kernel's
+    assert ispeed == termios.B9600 and cflag & termios.CSTOPB  # the rest of the set-up reached it too
+
+
+@pytest.mark.parametrize("flow, signal_name", [("rtscts", "cts"), ("dtrdsr", "dsr")])
+def test_a_low_cts_or_dsr_pauses_the_send_until_it_rises(line, flow, signal_name):
+    # The RFC 2217 server reports the modem lines the test sets, as a serial server reports its port's.
+    baud = 9600
+    pair, sim = line(baud=baud)
+    server = Rfc2217Server(pair.near)
+    prog = parse_program(program_text(200))
+    settings = profile("fanuc", baud=baud, flow=flow)
+    counts, events = [], []
+
+    def hold():
+        sim.wait_for(1500)
+        setattr(server.lines, signal_name, False)
+        time.sleep(1.0)  # what was on its way arrives
+        counts.append(sim.arrived)
+        time.sleep(1.0)
+        counts.append(sim.arrived)
+        setattr(server.lines, signal_name, True)
+
+    t = threading.Thread(target=hold, daemon=True)
+    t.start()
+    try:
+        result = send_program(server.url, prog, settings, "drip", log=events.append)
+    finally:
+        t.join(10)
+        server.close()
+    up = signal_name.upper()
+    assert [e.split()[:2] for e in events if e.startswith(up)] == [[up, "low"], [up, "high"]]
+    expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
+    assert sim.wait_for(len(expected))
+    assert bytes(sim.received) == expected
+    assert 1500 <= counts[0] == counts[1] < len(expected)  # nothing went while the signal was low
+    assert result.confirmed
 
 
 def test_a_dropped_dsr_is_a_lost_line_within_a_second(line):

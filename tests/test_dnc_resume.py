@@ -57,3 +57,28 @@ def test_find_block_by_what_the_control_shows():
         find_block(p, "N30")
     with pytest.raises(InputError, match="no block is N40"):
         find_block(p, "N40")
+
+
+def test_a_fault_within_the_set_up_asks_for_the_program_from_the_start():
+    """A drip feed that stops before the machine has run past the set-up (no X, Y and Z yet) names no resume
+    block that resume_setup would refuse: the program goes again from the start."""
+    from lagsym.dnc import profile
+    from lagsym.dnc.resume import first_resumable_block
+    from lagsym.dnc.sender import Sender
+    from lagsym.dnc.transfer import transfer_segments
+    from simcontrol import program_text
+
+    program = parse_program(program_text(200))
+    start = first_resumable_block(program)
+    assert start == 8  # O1000, G21 G17 G90 G54, T1 M6, S3000 M3, G0 Z50., G0 X0. Y0., G1 Z-1. F600.: units, X Y Z, feed
+    with pytest.raises(InputError, match="no feed"):
+        resume_setup(program, 7)
+    resume_setup(program, start)
+    settings = profile("fanuc", buffer_chars=100)
+    segments = transfer_segments(program, settings, "drip")
+    for sure, says in ((150, "then send again"), (1000, "then resume with --start-block")):
+        sender = Sender(None, segments, settings, "drip", "loop://", None, None, resumable_from=start)
+        sender.sure = sender.pos = sure
+        fault = sender.fault("the control held XOFF", "release the feed hold")
+        assert says in str(fault), str(fault)
+        assert fault.start_block in (1, None) or fault.start_block >= start

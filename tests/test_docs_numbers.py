@@ -163,3 +163,26 @@ def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_c
     assert status == 0, err
     assert quoted == (out + err).strip()
     assert f"takes {quoted.split('macro program:')[1].split()[0]} bytes on a Fanuc" in text
+
+
+def test_dnc_page_line_times_of_the_window():
+    from lagsym.dnc import profile
+
+    text = page("dnc.md")
+    ms = {baud: 4 / profile("fanuc", baud=baud).chars_per_s * 1000 for baud in (9600, 115200)}
+    assert f"4 characters are {ms[9600]:.1f} ms of line at 9600 baud and {ms[115200]:.2f} ms at 115200" in text
+    assert f"{profile('fanuc').chars_per_s:.1f} characters/s at 9600 baud" in text
+
+
+def test_the_macros_page_quotes_the_program_sizes():
+    from test_macro import rough_grid
+
+    from lagsym.machine import MachineSettings, RasterSpec, Tool
+    from lagsym.macro import macro_program
+
+    text = page("macros.md")
+    for n in (3, 5, 7, 12):
+        sizes = [macro_program(rough_grid(n, seed=n), MachineSettings(dialect=d, safe_z_mm=1e4), RasterSpec("x", 1.0, 1.0),
+                               Tool("flat", 0.0), precision=prec, form=form, tolerance_mm=1e9).size
+                 for prec, form in ((8, "lagrange"), (15, "horner")) for d in ("fanuc", "linuxcnc", "heidenhain")]
+        assert f"| {n}x{n} | " + " | ".join(map(str, sizes)) + " |" in text

@@ -1,7 +1,9 @@
 """Random bytes, point tables and option values thrown at every command: exit 0, 1, 2 or 3, one line, no traceback.
 
 Bounded so the suite stays fast: few examples, small inputs, a per-example deadline.  Commands that
-need a serial port are run only with ``loop://``.
+need a serial port are run only with ``loop://``, and ``receive`` with waits of a fraction of a second;
+``plot`` gets random bytes only (a picture per example would be slow).  Every command is covered:
+``test_every_command_is_fuzzed`` fails when one is added without its entry here.
 """
 
 from __future__ import annotations
@@ -31,8 +33,19 @@ COMMANDS = {
                  "--decimals", "--max-points"],
     "macro": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--safe-z", "--tolerance"],
     "verify": ["--scale", "--tool-diameter", "--cell", "--gouge-limit"],
-    "simulate": ["--max-blocks"],
+    "simulate": ["--max-blocks", "--max-idle-blocks"],
+    "export": ["--degree", "--base-z"],
+    "rough": ["--stock-above", "--margin", "--stepdown", "--stepover", "--step", "--stock-to-leave",
+              "--tool-diameter", "--scale", "--feed", "--spindle", "--safe-z", "--max-points", "--max-samples"],
+    "job": ["--max-points", "--max-samples"],
+    "send": ["--start-block", "--buffer-chars", "--memory-chars", "--overrun-chars", "--stall-timeout", "--leader",
+             "--trailer"],
+    "receive": ["--timeout", "--idle-timeout"],
+    "dnc": [],
+    "plot": [],
 }
+JOB = """points = "{points}"\nsafe_z = 20\n[stock]\ntop_above = 1\n[tools.t]\nnumber = 1\nshape = "flat"
+diameter = 1\n[[operations]]\nkind = "rough"\ntool = "t"\nstepover = 0.5\n"""
 NUMBERS = st.one_of(
     st.sampled_from(["nan", "inf", "-inf", "0", "-1", "1e308", "1e-308", "1e999999", "999999999999999999", "",
                      "\u0667", "1/0", "0x10", "1_000"]),
@@ -57,16 +70,34 @@ def assert_answered(status: int, err: str) -> None:
 def _args(cmd: str, files: dict[str, Path]) -> list[str]:
     if cmd == "verify":
         return [cmd, str(files["points"]), str(files["program"])]
-    if cmd == "simulate":
-        return [cmd, str(files["program"])]
+    if cmd in ("simulate", "send"):
+        return [cmd, str(files["program"])] + (["--port", "loop://", "--baud", "115200", "--quiet"] * (cmd == "send"))
+    if cmd == "receive":  # nothing ever arrives on loop://: a short wait, then exit 3
+        return [cmd, "--port", "loop://", "--timeout", "0.2", "--quiet"]
+    if cmd == "job":
+        return [cmd, str(files["job"])]
+    if cmd == "dnc":
+        return [cmd, "serve", str(files["job"]), "--check"]
+    if cmd == "rough":
+        return [cmd, str(files["points"]), "--stock-above", "1"]
     return [cmd, str(files["points"])]
 
 
-@SETTINGS
+def _files(d: str) -> dict[str, Path]:
+    return {"points": Path(d) / "p.json", "program": Path(d) / "p.nc", "job": Path(d) / "job.toml"}
+
+
+def test_every_command_is_fuzzed():
+    from lagsym.cli import COMMANDS as ALL
+
+    assert set(COMMANDS) == set(ALL)
+
+
+@settings(SETTINGS, max_examples=40)
 @given(cmd=st.sampled_from(sorted(COMMANDS)), data=st.binary(max_size=300))
 def test_random_bytes_as_every_input(cmd, data):
     with tempfile.TemporaryDirectory() as d:
-        files = {"points": Path(d) / "p.json", "program": Path(d) / "p.nc"}
+        files = _files(d)
         for p in files.values():
             p.write_bytes(data)
         assert_answered(*run(_args(cmd, files)))
@@ -86,15 +117,21 @@ def test_random_point_tables(cmd, rows, sep, end):
         assert_answered(*run([cmd, str(p)]))
 
 
-@SETTINGS
+# receive waits as long as its timeouts say: only values that are refused, or a fraction of a second
+_WAITS = st.one_of(st.sampled_from(["nan", "inf", "-inf", "0", "-1", "1e308", "1e999999", "", "\u0667", "1/0"]),
+                   st.floats(1e-3, 0.3).map(repr))
+
+
+@settings(SETTINGS, max_examples=40)
 @given(cmd=st.sampled_from(sorted(c for c in COMMANDS if COMMANDS[c])), data=st.data())
 def test_random_option_values(cmd, data):
     option = data.draw(st.sampled_from(COMMANDS[cmd]))
-    value = data.draw(NUMBERS)
+    value = data.draw(_WAITS if cmd == "receive" else NUMBERS)
     with tempfile.TemporaryDirectory() as d:
-        files = {"points": Path(d) / "p.json", "program": Path(d) / "p.nc"}
+        files = _files(d)
         files["points"].write_text(GOOD)
         files["program"].write_text(PROGRAM)
+        files["job"].write_text(JOB.format(points=files["points"]))
         argv = _args(cmd, files) + [f"{option}={value}"]
         if cmd in ("toolpath", "macro") and option != "--safe-z":
             argv.append("--safe-z=100")

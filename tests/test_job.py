@@ -159,8 +159,10 @@ def test_the_job_cuts_no_gouge(machined):
 
 
 @pytest.mark.xfail(strict=True, reason="open: 0.069 mm is left at (91, 45.25) mm where the cusp bound of rows "
-                   "0.5 mm apart is 0.012 mm; not yet shown whether the ball cannot reach there (a valley "
-                   "tighter than the ball) or the finishing leaves too much")
+                   "0.5 mm apart is 0.012 mm: along the rows the surface is a hollow of radius 2.78 mm there "
+                   "(F_xx = 0.36 / mm), tighter than the 3 mm ball, which rests on both walls (its tip 0.2 mm "
+                   "above the surface at x = 91) and cannot reach the bottom at any side step; the bound "
+                   "does not allow for that")
 def test_the_job_leaves_at_most_the_finishing_cusp(machined):
     """Away from the box edges, what the finish leaves is at most the cusp of its rows on the local slope."""
     fx, fy, f, _, left = machined

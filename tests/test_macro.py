@@ -351,7 +351,8 @@ def test_inch_programs_are_in_inches():
     got = simulate(program.text, "linuxcnc", 15).feed_points()[1:]
     want = planned_points(s, settings, raster, FLAT)
     np.testing.assert_allclose(got, want, atol=1e-4)
-    assert want[0].tolist() == pytest.approx([1.0, 2.0, 7.0])  # surface units are inches at scale 25.4
+    # Surface units are inches at scale 25.4; Z is raised by half the last decimal (0.00005 inch).
+    assert want[0].tolist() == pytest.approx([1.0, 2.0, 7.00005])
 
 
 def test_unknown_dialect_names_the_choices():
@@ -631,3 +632,80 @@ def test_an_inch_surface_is_25_4_mm_a_unit_and_the_header_says_so(run_cli, tmp_p
     f.write_text(json.dumps(data))
     status, out, err = run_cli("macro", f, "--tool-diameter", 0, "--safe-z", 100)
     assert status == 2 and "mm" in err and "inch" in err
+
+
+# ---------------------------------------------------------------- positions rounded on the control
+
+def _lagrange_at(grid, x: Fraction, y: Fraction) -> Fraction:
+    """The interpolating polynomial at (x, y), exact, by the basis products (not lagsym's evaluators)."""
+    def basis(nodes, t):
+        out = []
+        for i, n in enumerate(nodes):
+            b = Fraction(1)
+            for j, m in enumerate(nodes):
+                if j != i:
+                    b *= (t - m) / (n - m)
+            out.append(b)
+        return out
+
+    bx, by = basis(grid.x, x), basis(grid.y, y)
+    return sum(bx[i] * by[k] * grid.z[i][k] for i in range(len(bx)) for k in range(len(by)))
+
+
+def _control_positions(moves, dialect, decimals=3):
+    """Where the control goes: a Fanuc rounds an axis word to its least input increment, LinuxCNC does not."""
+    return np.round(moves, decimals) if dialect == "fanuc" else moves
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
+def test_a_surface_macro_computes_z_at_the_position_the_control_goes_to(rs274, tmp_path, dialect):
+    """A 7x7 grid whose box starts at 1/3 mm: before rounding on the control, Z was 2.86 mm off there.
+
+    Every move's X and Y are on the program's last decimal (so the control has
+    nothing left to round), inside the box, and Z is the exact polynomial there
+    raised by at most one unit of the last decimal, never below it.
+    """
+    rng = random.Random(7)
+    nodes = [Fraction(1, 3) + Fraction(i, 3) for i in range(7)]
+    z = [[Fraction(rng.randint(0, 5000), 100) for _ in range(7)] for _ in range(7)]
+    s = lagrange_surface(grid_from_table(nodes, nodes, z, source="thirds"))
+    settings = machine(dialect=dialect, safe_z_mm=9e4)
+    program = macro_program(s, settings, RasterSpec("x", 0.2, 0.1), FLAT, precision=15, tolerance_mm=1e-3)
+    if dialect == "linuxcnc":
+        path = tmp_path / "thirds.ngc"
+        path.write_text(program.text)
+        got = feeds(rs274.run(path).stdout)
+    else:
+        got = simulate(program.text, "fanuc", 15).feed_points()
+    at = _control_positions(got, dialect)
+    exact = np.array([float(_lagrange_at(s.grid, Fraction(str(x)), Fraction(str(y)))) for x, y in at[:, :2]])
+    dz = got[:, 2] - exact
+    assert dz.min() >= -1e-6 and dz.max() <= 1e-3 + 1e-6, (dz.min(), dz.max())
+    assert np.abs(got[:, :2] * 1000 - np.rint(got[:, :2] * 1000)).max() < 1e-6
+    assert got[:, :2].min() >= 1 / 3 and got[:, :2].max() <= 7 / 3
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
+def test_a_ball_end_macro_never_goes_below_the_cutter_location_where_the_control_goes(rs274, tmp_path, dialect):
+    """The README's 4 mm ball on Example 4 (scale 20): Z at or above a brute-force drop-cutter at the rounded X, Y.
+
+    Before the tip was rounded on the control, the tool went to the rounded
+    position with the height of the unrounded one, up to 2.5 um into the part.
+    """
+    from cutters import brute_ball
+    from test_rough import exact_heights
+
+    s = surface("paper-example-4")
+    settings = machine(dialect=dialect, mm_per_unit=20.0, safe_z_mm=100.0)
+    program = macro_program(s, settings, RasterSpec("x", 4.0, 1.0), BALL)
+    if dialect == "linuxcnc":
+        path = tmp_path / "ball.ngc"
+        path.write_text(program.text)
+        got = feeds(rs274.run(path).stdout)
+    else:
+        got = simulate(program.text, "fanuc", 8).feed_points()
+    at = _control_positions(got, dialect)
+    f = lambda x, y: exact_heights(EXAMPLES / "paper-example-4.json", x, y)  # noqa: E731
+    below = brute_ball(f, (20.0, 100.0, 20.0, 100.0), at[:, 0], at[:, 1], 2.0, n=25, rounds=10) - got[:, 2]
+    assert below.max() <= 2e-5, f"{below.max() * 1000:.2f} um below at {at[np.argmax(below)]}"
+    assert np.abs(got[:, :2] * 1000 - np.rint(got[:, :2] * 1000)).max() < 1e-6  # nothing left to round

@@ -24,9 +24,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import EXAMPLES, ROOT, missing_system_package
+from conftest import EXAMPLES, ROOT, missing_system_package, need_opengl
 from lagsym import plot
-from lagsym.errors import InputError, RenderError
+from lagsym.errors import InputError
 from lagsym.evaluate import evaluate_grid, evaluate_points
 from lagsym.io import read_curve_points, read_points
 from lagsym.lagrange import lagrange_curve, lagrange_surface
@@ -37,10 +37,7 @@ from lagsym.sampling import sample_grid
 @pytest.fixture(autouse=True, scope="module")
 def _offscreen_opengl():
     """Every test here draws: without an OpenGL to draw with, they skip naming the packages to install."""
-    try:
-        plot.rendering_backend()
-    except RenderError:
-        missing_system_package("libegl1 libegl-mesa0 libgl1-mesa-dri", "an offscreen OpenGL (EGL or OSMesa)")
+    need_opengl("the pictures")
 
 
 REFERENCE = Path(__file__).resolve().parent / "reference_images"
@@ -589,3 +586,52 @@ def test_cli_missing_file(run_cli, tmp_path):
     status, _, stderr = run_cli("plot", tmp_path / "none.json", "-o", tmp_path / "x.png")
     assert status == 2 and "no such file" in stderr
     assert not (tmp_path / "x.png").exists()
+
+
+# ----------------------------------------------------------------------------- the machined part
+
+
+def _slot_part():
+    from lagsym.gcode import parse_moves, tool_changes
+    from lagsym.grid import grid_from_table
+    from lagsym.machine import Tool
+    from lagsym.machined import machine_part
+
+    flat = lagrange_surface(grid_from_table([0, 10], [0, 10], [[0, 0], [2, 2]]))
+    text = ("T1 M06\nG00 X-5. Y5. Z10.\nG00 Z2.\nG01 X15. F500.\nG00 Z10.\n"
+            "T2 M06\nG00 X-5. Y3.\nG00 Z1.\nG01 X15. F500.\nG00 Z10.\nM30\n")
+    return machine_part(flat, parse_moves(text), tool_changes(text), {1: Tool("flat", 4.0), 2: Tool("ball", 2.0)},
+                        (-2.0, 12.0, 0.0, 10.0, 5.0), cell_mm=0.1)
+
+
+def test_machined_figure_draws_each_stage_coloured_by_material_left():
+    part = _slot_part()
+    img = render(plot.machined_figure(part, window_size=WIDE, off_screen=True))
+    check_picture(img, WIDE, 0.1)
+    check_reference(img, "machined_slots")
+    # One colour scale: the stage after the ball shows less bright (much material left) than the one before.
+    one = render(plot.machined_figure(part, stages=[0], window_size=SIZE, off_screen=True, left_max_mm=5.0))
+    two = render(plot.machined_figure(part, stages=[1], window_size=SIZE, off_screen=True, left_max_mm=5.0))
+    assert not np.array_equal(one, two)
+    with pytest.raises(InputError, match="stages"):
+        plot.machined_figure(part, stages=[2])
+
+
+def test_cli_draws_a_job_machined(run_cli, tmp_path):
+    pts = tmp_path / "ramp.json"
+    pts.write_text('{"units": "mm", "points": [[0, 0, 0], [0, 10, 0], [10, 0, 2], [10, 10, 2]]}')
+    job = tmp_path / "job.toml"
+    job.write_text('points = "ramp.json"\nsafe_z = 20\n[stock]\ntop = 5\n[tools.a]\nnumber = 1\nshape = "flat"\n'
+                   'diameter = 4\n[tools.b]\nnumber = 2\nshape = "ball"\ndiameter = 2\n'
+                   '[[operations]]\nkind = "finish"\ntool = "b"\nstepover = 1\n')
+    prog = tmp_path / "slot.nc"
+    prog.write_text("T1 M06\nG00 X-5. Y5. Z10.\nG00 Z2.\nG01 X15. F500.\nG00 Z10.\nM30\n")
+    target = tmp_path / "m.png"
+    status, _, err = run_cli("plot", job, "--show", "machined", prog, "--cell", "0.2", "--size", "480x300", "-o", target)
+    assert status == 0, err
+    with Image.open(target) as im:
+        assert im.size == (480, 300)
+    status, _, err = run_cli("plot", job, "--show", "machined", prog, "--scale", "2", "-o", target)
+    assert status == 2 and "--scale is not for --show machined" in err
+    status, _, err = run_cli("plot", EXAMPLES / "paper-example-1.json", "--cell", "0.2", "-o", target)
+    assert status == 2 and "--cell is the height-map cell of --show machined" in err

@@ -215,3 +215,24 @@ def test_cli_inch_surface_is_programmed_at_25_4_mm_a_unit(rs274, run_cli, tmp_pa
     feeds, _ = interpret(rs274, text)
     x0, x1, y0, y1 = (float(v) for v in read_points(EXAMPLES / "paper-example-4.json").bounds)
     assert feeds[:, 0].min() == pytest.approx(x0 * 25.4, abs=1e-3) and feeds[:, 0].max() == pytest.approx(x1 * 25.4, abs=1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("units", ["mm", "inch"])
+def test_every_written_z_is_at_or_above_the_cutter_location_at_the_written_x_y(rs274, units):
+    """On a 67-76 degree flank, the cutter height at the X, Y rs274 goes to is never above the Z it is given.
+
+    Checked against a brute-force drop-cutter on the polynomial itself.  Before
+    X and Y were placed on the program's resolution ahead of the drop-cutter,
+    the tool went up to 1.4 um (mm) below the cutter path at the rounded X, Y.
+    """
+    from cutters import brute_ball, steep_flank
+
+    surf, f = steep_flank()
+    s = MachineSettings(units=units, safe_z_mm=60.0)
+    tp = plan_toolpath(surf, Tool("ball", 2.0), RasterSpec("y", 0.35, None, None, 0.002), s)
+    feeds, _ = interpret(rs274, write_program(point_program(tp, s)))
+    unit = 10.0 ** -s.digits / s.unit_factor
+    assert np.abs(feeds[:, :2] / unit - np.rint(feeds[:, :2] / unit)).max() < 1e-6  # on the grid: nothing to round
+    below = brute_ball(f, (0.0, 6.0, 0.0, 6.0), feeds[:, 0], feeds[:, 1], 1.0) - feeds[:, 2]
+    assert below.max() <= 1e-7, f"{below.max() * 1000:.2f} um below at {feeds[np.argmax(below)]}"

@@ -261,3 +261,112 @@ o{100 + k} endif
     ours = simulate(body + "M2\n", "linuxcnc", 15).feed_points()
     assert ours[:, 0].tolist() == [1.0, 2.0, 3.0, 4.0]
     np.testing.assert_allclose(ours, feeds(rs274.run(path).stdout), atol=1e-9)
+
+
+# ---------------------------------------------------------------- runaway programs
+# Each used to run to the old 20 million block limit: 42 s to 257 s and up to 4.5 GB before its one line.
+
+_H = "0 BEGIN PGM 1 MM\n1 FN 0: Q1 = +0\n2 FN 0: Q2 = +0\n"
+RUNAWAYS = {
+    # loops seen in the text never to end: stopped the second time round
+    "fanuc WHILE [1 EQ 1] with motion": ("%\nO1\n#100=0.\nWHILE [1 EQ 1] DO1\n#100=[#100+0.001]\n"
+                                         "G1 X#100 Y0. Z0. F100.\nEND1\nM30\n%\n", "can never end"),
+    "fanuc bare DO1": ("%\nO1\nDO1\n#100=[#100+1.]\nEND1\nM30\n%\n", "can never end"),
+    "fanuc GOTO": ("%\nO1\nN10 G1 X1. Y0. Z0. F100.\nG1 X0.\nGOTO 10\nM30\n%\n", "can never end"),
+    "linuxcnc while [1 EQ 1]": ("#1=0\no100 while [1 EQ 1]\n#1=[#1+0.001]\nG1 X#1 F100\no100 endwhile\nM2\n",
+                                "can never end"),
+    "heidenhain FN 9 to a label": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +0.001\n5 L X+Q1 Y+0 Z+0 F100\n"
+                                   "6 FN 9: IF +0 EQU +0 GOTO LBL 1\n7 END PGM 1 MM\n", "can never end"),
+    # a condition on a variable nothing in the loop sets: as good as a constant
+    "fanuc WHILE on an unset variable": ("%\nO1\n#1=0.\nWHILE [#2 LT 1.] DO1\n#1=[#1+0.001]\n"
+                                         "G1 X#1 Y0. Z0. F100.\nEND1\nM30\n%\n", "can never end"),
+    "heidenhain FN 12 on an unset Q": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +1\n5 FN 12: IF +Q2 LT +1 GOTO LBL 1\n"
+                                       "6 END PGM 1 MM\n", "can never end"),
+    # conditions on variables the loop sets, to values that never end it: the guards at run time
+    "fanuc back where it was": ("%\nO1\n#1=0.\nN10 #1=[1.-#1]\nG1 X#1 Y0. Z0. F100.\nIF [#1 GE 0.] GOTO 10\n"
+                                "M30\n%\n", "unchanged"),
+    "linuxcnc no motion": ("#1=0\n#2=0\no100 while [#2 LT 1]\n#1=[#1+1]\n#2=[#2*1]\no100 endwhile\nM2\n",
+                           "--max-idle-blocks"),
+    "heidenhain no motion": (_H + "3 LBL 1\n4 FN 1: Q1 = Q1 + +1\n5 FN 3: Q2 = Q2 * +1\n"
+                             "6 FN 12: IF +Q2 LT +1 GOTO LBL 1\n7 END PGM 1 MM\n", "--max-idle-blocks"),
+    "heidenhain back where it was": (_H + "3 LBL 1\n4 L X+1 Y+0 Z+0 F100\n5 L X+0\n6 FN 3: Q2 = Q2 * +1\n"
+                                     "7 FN 12: IF +Q2 LT +1 GOTO LBL 1\n8 END PGM 1 MM\n", "unchanged"),
+}
+
+
+@pytest.mark.parametrize("name", RUNAWAYS)
+def test_a_runaway_program_stops_within_seconds_in_one_line(run_cli, tmp_path, name):
+    import time
+
+    text, needle = RUNAWAYS[name]
+    path = tmp_path / "runaway.nc"
+    path.write_text(text)
+    start = time.monotonic()
+    status, out, err = run_cli("simulate", path, "-o", tmp_path / "moves.csv")
+    took = time.monotonic() - start
+    assert status == 2 and err.count("\n") == 1 and err.startswith("lagsym: error: alarm runaway:"), err
+    assert needle in err and "Traceback" not in err
+    assert took < 30, f"{name}: {took:.1f} s"  # about 1 s here; the old guard took 42 to 257 s
+    assert not (tmp_path / "moves.csv").exists()
+
+
+def test_a_moving_loop_on_a_variable_is_stopped_by_the_block_limit(run_cli, tmp_path):
+    path = tmp_path / "count.nc"
+    path.write_text("%\nO1\n#1=0.\nWHILE [#2 LT 1.] DO1\n#2=[#2*1.]\n#1=[#1+0.001]\nG1 X#1 Y0. Z0. F100.\n"
+                    "END1\nM30\n%\n")
+    status, out, err = run_cli("simulate", path, "--max-blocks", "30000")
+    assert status == 2 and err.count("\n") == 1
+    assert "more than 30000 blocks executed" in err and "--max-blocks N lifts it" in err
+
+
+def test_the_runaway_limits_are_lifted_by_their_options(run_cli, tmp_path):
+    # 150 turns of 3003 blocks without a move: 450450 in a row, beyond the default idle limit
+    path = tmp_path / "slow.nc"
+    path.write_text("%\nO1\n#1=0.\nWHILE [#1 LT 150.] DO1\n#2=0.\nWHILE [#2 LT 999.5] DO2\n#2=[#2+1.]\nEND2\n"
+                    "#1=[#1+1.]\nEND1\nG1 X#1 Y0. Z0. F100.\nM30\n%\n")
+    status, out, err = run_cli("simulate", path)
+    assert status == 2 and "without a move" in err and "--max-idle-blocks" in err
+    status, out, err = run_cli("simulate", path, "--max-idle-blocks", "500000")
+    assert status == 0 and out.splitlines()[1] == "11,G1,150.000000,0.000000,0.000000,100", out
+
+
+@pytest.mark.parametrize("text", [
+    # an always-true loop, a GOTO back, a constant jump: each with a way out, so each ends
+    "#1=0.\nWHILE [1 EQ 1] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] GOTO 99\nEND1\nN99 M30\n",
+    "#1=0.\nN10 #1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] GOTO 20\nGOTO 10\nN20 M30\n",
+    "#1=0.\nN10 #1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] THEN #2=30.\nM#2\nGOTO 10\n",
+    # the condition's variable set through IF THEN, or through an indirect number: each loop still ends
+    "#1=0.\nWHILE [#2 LT 1.] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nIF [#1 GE 3.] THEN #2=1.\nEND1\nM30\n",
+    "#1=0.\n#3=1.\nWHILE [#1 LT 3.] DO1\n#[#3]=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nEND1\nM30\n",
+    "#1=0.\n#3=1.\nWHILE [#[#3] LT 3.] DO1\n#1=[#1+1.]\nG1 X#1 Y0. Z0. F1.\nEND1\nM30\n",
+])
+def test_loops_with_a_way_out_are_not_runaways(text):
+    assert [m.x for m in simulate(text, "fanuc", 8).moves] == [1.0, 2.0, 3.0]
+
+
+def test_moves_are_kept_as_columns():
+    from lagsym.simulate import BYTES_PER_MOVE, SimMove
+
+    sim = simulate("#1=0.\nWHILE [#1 LT 3.] DO1\n#1=[#1+1.]\nG1 X#1 Y[2.*#1] Z0. F50.\nEND1\nG0 Z5.\nM30\n")
+    assert len(sim.moves) == 4 and sim.moves[-1] == SimMove(6, "G0", 3.0, 6.0, 5.0, 50.0)
+    assert sim.moves[0] == SimMove(4, "G1", 1.0, 2.0, 0.0, 50.0) and sim.moves.feeds() == 3
+    assert sim.feed_points().tolist() == [[1.0, 2.0, 0.0], [2.0, 4.0, 0.0], [3.0, 6.0, 0.0]]
+    held = sum(col.itemsize * len(col) for col in (sim.moves._line, sim.moves._rapid, sim.moves._x, sim.moves._y,
+                                                    sim.moves._z, sim.moves._feed))
+    assert held == BYTES_PER_MOVE * 4
+
+
+def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
+    """The README's Example 4 ball macro: 2525622 blocks at 8 digits, under the 5e6 default (docs/macros.md)."""
+    from conftest import EXAMPLES
+    from lagsym.simulate import MAX_BLOCKS
+
+    prog = tmp_path / "O1001.nc"
+    status, _, err = run_cli("macro", EXAMPLES / "paper-example-4.json", "--scale", "20", "--tool-diameter", "4",
+                             "--stepover", "0.5", "--step", "0.2", "--safe-z", "100", "--dialect", "fanuc",
+                             "--program", "1001", "-o", prog)
+    assert status == 0, err
+    status, out, err = run_cli("simulate", prog, "--precision", "8")
+    assert status == 0, err
+    assert err.endswith(": fanuc, 8 digits: 2525622 blocks executed, 64566 moves (64562 feed), no alarm\n"), err
+    assert 2525622 < MAX_BLOCKS and len(out.splitlines()) == 64566 + 1

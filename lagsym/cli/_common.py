@@ -108,6 +108,7 @@ SCALE = number(1e-6, 1e6, "(a scale factor)", above=True)
 STEP_MM = number(1e-4, LENGTH_MM, "mm")
 SMALL_MM = number(1e-6, 1_000.0, "mm", above=True)  # tolerances and cusp heights
 TOOL_MM = number(0.0, 1_000.0, "mm")
+CORNER_MM = number(0.0, 500.0, "mm", above=True)
 FEED_MM_MIN = number(1.0, 100_000.0, "mm/min")
 _RPM = number(1.0, 200_000.0, "rpm, or 0 for the spindle off")
 

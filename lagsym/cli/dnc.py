@@ -50,10 +50,15 @@ def run(args, out, err) -> int:
 
     stop = threading.Event()
     with contextlib.ExitStack() as stack:
-        logs = {p.name: stack.enter_context(event_log(p.log)) for p in config.ports}
+        logs = {p.name: stack.enter_context(event_log(p.log, f"{p.name}: log", _lost(status, p))) for p in config.ports}
         try:
             serve(config, stop, lambda p: logs[p.name], status)
         except KeyboardInterrupt as e:
             why = signal.Signals(e.signum).name if isinstance(e, Terminated) else "Ctrl-C"
             status("server", f"stopped by {why}")
     return 0
+
+
+def _lost(status, port):
+    """What the server says, once, when a port's log can no longer be written."""
+    return lambda why: status(port.name, f"the log {port.log} can no longer be written ({why}); events go unrecorded")

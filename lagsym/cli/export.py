@@ -9,6 +9,7 @@ from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
+from ._common import count
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
@@ -40,7 +41,8 @@ def add_arguments(p) -> None:
                    help=f"output file, format by extension: {', '.join(CAD_FORMATS)}")
     p.add_argument("--method", choices=METHODS, default="lagrange",
                    help="the surface: lagrange (default), or the bezier or bspline comparison surface")
-    p.add_argument("--degree", type=int, default=3, metavar="N", help="B-spline degree for --method bspline (default 3)")
+    p.add_argument("--degree", type=count(1, 30), metavar="N",
+                   help="B-spline degree for --method bspline (default 3, capped at n-1 as compare caps it)")
     p.add_argument("--solid", action="store_true", help="close the surface down to the base plane into a solid")
     p.add_argument("--base-z", metavar="Z", help="height of the base plane (with --solid), below the whole surface")
     p.add_argument("--units", choices=UNITS, help="length unit when FILE states none (default mm)")
@@ -52,11 +54,14 @@ def run(args, out, err) -> int:
         raise InputError("--solid needs --base-z Z, the height of the base plane" if args.solid
                          else f"--base-z {args.base_z} is for a solid: add --solid")
     base = exact_height(args.base_z, "--base-z", args.file) if args.solid else None
+    if args.degree is not None and args.method != "bspline":
+        raise InputError(f"--degree {args.degree} is the degree of --method bspline; the {args.method} surface has "
+                         "the degrees of its control points")
     grid = read_points(args.file)
     units = grid.units or args.units or "mm"
     if args.units and units != args.units:
         raise InputError(f"{args.file}: the file states \"units\": \"{units}\", not --units {args.units}")
-    patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree)
+    patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree or 3)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
     lo, hi = grid.z_range()
     rel = double_error_bound(patch, hi - lo)

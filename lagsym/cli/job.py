@@ -18,12 +18,27 @@ examples:
 def add_arguments(p) -> None:
     p.add_argument("job", help="job file (TOML)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
+    add_max_points(p)
+
+
+def add_max_points(p) -> None:
+    """``--max-points`` (as ``toolpath`` has it) and ``--max-samples``: each operation is estimated first."""
+    from ..toolpath.plan import MAX_PLAN_POINTS
+    from ..toolpath.rough import MAX_ROUGH_SAMPLES
+    from ._common import count
+
+    p.add_argument("--max-points", type=count(1, 10**12), default=MAX_PLAN_POINTS, metavar="N",
+                   help=f"refuse an operation of more than N points, estimated before it is planned "
+                        f"(default {MAX_PLAN_POINTS:.0e})")
+    p.add_argument("--max-samples", type=count(1, 10**12), default=MAX_ROUGH_SAMPLES, metavar="N",
+                   help=f"refuse a roughing level of more than N drop-cutter samples, each checked exactly "
+                        f"(default {MAX_ROUGH_SAMPLES:.0e}, a few minutes)")
 
 
 def run(args, out, err) -> int:
     from ..job import job_program, plan_job, read_job
 
-    planned = plan_job(read_job(args.job))
+    planned = plan_job(read_job(args.job), args.max_points, args.max_samples)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

@@ -6,9 +6,9 @@ import argparse
 
 from ..errors import InputError
 from ..grid import CurvePoints
-from ..io import read_any_points
+from ..io import read_any_points, read_points
 from ..lagrange import lagrange_curve, lagrange_surface
-from ._common import SCALE, count
+from ._common import SCALE, count, number
 
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
@@ -19,7 +19,11 @@ with --show toolpath PROGRAM, the moves of a G-code program over the surface,
 in machine millimetres (give the --scale and --origin it was made with); with
 --show growth FORMULA, the largest deviation of the Lagrange and cubic B-spline
 surfaces from FORMULA on n x n evenly spaced points over the box of FILE, for
-the degrees 2, 4, ..., 12 (the paper's Figure 11: past degree 6 it grows).
+the degrees 2, 4, ..., 12 (the paper's Figure 11: past degree 6 it grows);
+with --show machined PROGRAM, FILE being a job file (TOML), the block after
+each tool of the job's PROGRAM, simulated as lagsym verify --job does and
+coloured by the material left above the surface (the counterpart of the
+paper's photographs, Figures 13 and 15).
 Deviations are d = z_f - z_a everywhere, as lagsym compare prints them.
 A file of [x, y] points draws the curve through them (and, with --show basis,
 its basis polynomials L_i(x)).
@@ -36,10 +40,12 @@ examples:
   lagsym plot examples/paper-example-1.json --z-exaggeration 1 -o true-proportions.png
   lagsym toolpath examples/paper-example-4.json --scale 20 --stepover 2 --step 1 --safe-z 80 -o rough.nc
   lagsym plot examples/paper-example-4.json --show toolpath rough.nc --scale 20 -o toolpath.png
-  lagsym plot examples/parabola.json --show growth "1/(1 + ((x-20)**2 + (y-20)**2)/25)" -o growth.png"""
+  lagsym plot examples/parabola.json --show growth "1/(1 + ((x-20)**2 + (y-20)**2)/25)" -o growth.png
+  lagsym job examples/example-4-job.toml -o job.ngc
+  lagsym plot examples/example-4-job.toml --show machined job.ngc --cell 0.5 -o machined.png"""
 
-SHOW = ("surface", "basis", "compare", "toolpath", "growth")
-TAKES_A_WORD = {"toolpath": "PROGRAM", "growth": "FORMULA"}
+SHOW = ("surface", "basis", "compare", "toolpath", "growth", "machined")
+TAKES_A_WORD = {"toolpath": "PROGRAM", "growth": "FORMULA", "machined": "PROGRAM"}
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -53,20 +59,24 @@ def add_arguments(p) -> None:
     # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
-                   help="surface (default), basis, compare, 'toolpath PROGRAM' or 'growth FORMULA'")
+                   help="surface (default), basis, compare, 'toolpath PROGRAM', 'growth FORMULA' or "
+                        "'machined PROGRAM' (FILE a job file)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
     p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
                    help="picture size in pixels (default: 1280x960)")
-    p.add_argument("--z-exaggeration", type=float, metavar="K",
+    p.add_argument("--z-exaggeration", type=number(0.0, 1000.0, above=True), metavar="K",
                    help="draw z K times its true size (surface, compare, toolpath; the ticks read true heights); "
-                        "default: chosen so the height lies between a fifth of the plan and the plan, 1 for true "
+                        "above 0 up to 1000; default: chosen so the height lies between a fifth of the plan and the "
+                        "plan, 1 for true "
                         "proportions")
     p.add_argument("--samples", type=count(2, 2_000), metavar="N", help="samples along each axis")
     p.add_argument("--scale", type=SCALE, default=None,
                    help="with --show toolpath: the --scale the program was made with (default 1)")
     p.add_argument("--origin", default=None, metavar="X,Y,Z",
                    help="with --show toolpath: the work offset the program was made with (default 0,0,0)")
+    p.add_argument("--cell", type=number(1e-3, 1_000.0, "mm"), metavar="MM",
+                   help="with --show machined: height-map cell size (default: block side / 400)")
 
 
 def _request(show: list[str] | None, file: str | None) -> tuple[str, str | None, str]:
@@ -100,6 +110,15 @@ def run(args, out, err) -> int:
         plot.image_format(args.output)
     elif plot.rendering_backend() != "display":
         raise InputError("no display to open a window on: give -o FILE to write the picture to a file")
+    if what == "machined":
+        figure = _machined_figure(plot, file, program, args)
+        if args.output:
+            plot.save_figure(figure, args.output)
+        else:
+            figure.show(title=f"lagsym plot {file}")
+        return 0
+    if args.cell is not None:
+        raise InputError("--cell is the height-map cell of --show machined PROGRAM")
     points = read_any_points(file)
     _check_options(what, isinstance(points, CurvePoints), args)
     units = args.units or getattr(points, "units", None) or "mm"  # the points file's units unless told
@@ -157,6 +176,31 @@ def _growth_figure(plot, grid, formula, opts):
     n = opts.pop("samples", None) or 81
     growth = plot.degree_growth(parse_formula(formula), grid.bounds, samples=n)
     return plot.growth_figure(growth, **{k: v for k, v in opts.items() if k != "z_exaggeration"})
+
+
+def _machined_figure(plot, job_file, program, args):
+    """The block after each tool of a job, coloured by the material left (the paper's Figures 13 and 15)."""
+    from ..gcode import parse_moves, tool_changes
+    from ..io import read_program
+    from ..job import read_job
+    from ..job.operations import job_stock
+    from ..machine import Placement
+    from ..machined import machine_part
+
+    for option in ("scale", "origin", "units", "samples"):
+        if getattr(args, option) is not None:
+            raise InputError(f"--{option} is not for --show machined: the job file {job_file} places the part")
+    spec = read_job(job_file)
+    surface = lagrange_surface(read_points(spec.points))
+    stock = job_stock(spec, surface)
+    text = read_program(program)
+    part = machine_part(surface, parse_moves(text, source=program), tool_changes(text, source=program),
+                        {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
+                        Placement(spec.mm_per_unit, spec.origin_mm), cell_mm=args.cell)
+    opts = dict(window_size=args.size, off_screen=True if args.output else None)
+    if args.z_exaggeration is not None:
+        opts["z_exaggeration"] = args.z_exaggeration
+    return plot.machined_figure(part, **opts)
 
 
 def _control_points(grid):

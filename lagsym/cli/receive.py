@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 
-from ._common import emit
 from ..dnc import receive_program
 from ..errors import InputError
-from ..io import event_log
-from .send import add_line_arguments, line_settings
+from ..io import check_output, event_log
+from ._common import emit, number
+from .send import add_line_arguments, check_log, line_settings
+
+MAX_WAIT_S = 86_400.0  # a day: the longest --timeout or --idle-timeout
+SECONDS = number(0.0, MAX_WAIT_S, "s", above=True)
 
 DESCRIPTION = """Wait for a program from a CNC control (PUNCH or OUTPUT on the control) and
 write it to FILE, or to standard output.  The program runs from DC2 (or its
@@ -29,19 +32,18 @@ def add_arguments(p) -> None:
     add_line_arguments(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists (default: refuse)")
-    p.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
-                   help="how long to wait for the control to start (default 60)")
-    p.add_argument("--idle-timeout", type=float, default=5.0, metavar="SECONDS",
-                   help="silence that ends a program without DC4 or closing %% (default 5)")
+    p.add_argument("--timeout", type=SECONDS, default=60.0, metavar="SECONDS",
+                   help="how long to wait for the control to start, above 0 up to 86400 (default 60)")
+    p.add_argument("--idle-timeout", type=SECONDS, default=5.0, metavar="SECONDS",
+                   help="silence that ends a program without DC4 or closing %%, above 0 up to 86400 (default 5)")
 
 
 def run(args, out, err) -> int:
-    for name in ("timeout", "idle_timeout"):
-        if not getattr(args, name) > 0:
-            raise InputError(f"--{name.replace('_', '-')} {getattr(args, name)!r} must be a positive number of seconds")
     to_file = args.output and args.output != "-"
     if to_file and os.path.exists(args.output) and not args.overwrite:
         raise InputError(f"{args.output} exists; give another -o FILE, or --overwrite to replace it")
+    if to_file:
+        check_output(args.output)  # before the control punches: a program that cannot be saved would be lost
     settings = line_settings(args)
 
     def ready() -> None:
@@ -53,6 +55,7 @@ def run(args, out, err) -> int:
         text = receive_program(args.port, settings, start_timeout_s=args.timeout, idle_timeout_s=args.idle_timeout,
                                log=log, ready=ready)
     emit(text, args.output, out)
+    check_log(log, f"received {text.count(chr(10))} lines into {args.output if to_file else 'standard output'}")
     if not args.quiet and to_file:
         err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
     return 0

@@ -6,7 +6,14 @@ from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import origin
+from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
+                      number, origin)
+from .job import add_max_points
+
+_STEP_MM = number(1e-3, 1_000.0, "mm")  # a step-down, side step or forward step
+_DEPTH_MM = number(0.0, 1_000.0, "mm")
+_LEN_MM = number(0.0, 10_000.0, "mm", above=True)  # flute length, reach
+_TOOL_NUMBER = count(1, 99)
 
 DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
 points in FILE: at each level (the stock top down by the step-down) a
@@ -25,35 +32,38 @@ def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=("fanuc", "linuxcnc", "grbl"), default="fanuc", help="fanuc (default), linuxcnc or grbl")
     s = p.add_argument_group("stock")
     top = s.add_mutually_exclusive_group(required=True)
-    top.add_argument("--stock-top", type=float, metavar="MM", help="machine Z of the block's top")
-    top.add_argument("--stock-above", type=float, metavar="MM", help="block top this far above the surface's highest point")
-    s.add_argument("--margin", type=float, metavar="MM", help="block beyond the control points' box on every side (default 0)")
+    top.add_argument("--stock-top", type=HEIGHT_MM, metavar="MM", help="machine Z of the block's top")
+    top.add_argument("--stock-above", type=number(0.0, LENGTH_MM, "mm"), metavar="MM", help="block top this far above the surface's highest point")
+    s.add_argument("--margin", type=number(0.0, LENGTH_MM, "mm"), metavar="MM", help="block beyond the control points' box on every side (default 0)")
     s.add_argument("--block", metavar="X0,X1,Y0,Y1", help="the block's extent in machine mm instead of a margin")
     r = p.add_argument_group("roughing")
-    r.add_argument("--stepdown", type=float, default=2.0, metavar="MM", help="depth of each level (default 2)")
-    r.add_argument("--stepover", type=float, metavar="MM", help="side step between rows (default half the tool)")
-    r.add_argument("--step", type=float, default=0.5, metavar="MM", help="forward sampling step (default 0.5)")
-    r.add_argument("--stock-to-leave", type=float, default=0.3, metavar="MM", help="material left above the surface (default 0.3)")
+    r.add_argument("--stepdown", type=_STEP_MM, default=2.0, metavar="MM", help="depth of each level (default 2)")
+    r.add_argument("--stepover", type=_STEP_MM, metavar="MM", help="side step between rows (default half the tool)")
+    r.add_argument("--step", type=_STEP_MM, default=0.5, metavar="MM", help="forward sampling step (default 0.5)")
+    r.add_argument("--stock-to-leave", type=_DEPTH_MM, default=0.3, metavar="MM", help="material left above the surface (default 0.3)")
     r.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
     r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
                    help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
     t = p.add_argument_group("cutter")
-    t.add_argument("--tool-shape", default="flat", help="flat (default) or ball end")
-    t.add_argument("--tool-diameter", type=float, default=10.0, metavar="MM", help="cutter diameter (default 10)")
-    t.add_argument("--tool-number", type=int, default=1, metavar="N", help="tool and length offset number (default 1)")
-    t.add_argument("--flute-length", type=float, metavar="MM", help="refuse a step-down longer than the flutes")
-    t.add_argument("--reach", type=float, metavar="MM", help="tool length below the holder: refuse a deeper cut")
+    t.add_argument("--tool-shape", default="flat", help="flat (default), ball or bull (bull nose: give --corner-radius)")
+    t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
+    t.add_argument("--tool-diameter", type=TOOL_MM, default=10.0, metavar="MM", help="cutter diameter (default 10)")
+    t.add_argument("--tool-number", type=_TOOL_NUMBER, default=1, metavar="N", help="tool and length offset number (default 1)")
+    t.add_argument("--flute-length", type=_LEN_MM, metavar="MM", help="refuse a step-down longer than the flutes")
+    t.add_argument("--reach", type=_LEN_MM, metavar="MM", help="tool length below the holder: refuse a deeper cut")
     m = p.add_argument_group("machine")
-    m.add_argument("--scale", type=float, default=1.0, help="millimetres per surface unit (default 1)")
+    m.add_argument("--scale", type=SCALE, default=1.0, help="millimetres per surface unit (default 1)")
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
     m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
-    m.add_argument("--feed", type=float, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
-    m.add_argument("--plunge-feed", type=float, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
-    m.add_argument("--rapid", type=float, default=5000.0, metavar="MM/MIN", help="rapid rate for the cycle time (default 5000)")
-    m.add_argument("--spindle", type=float, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
+    m.add_argument("--feed", type=FEED_MM_MIN, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
+    m.add_argument("--plunge-feed", type=FEED_MM_MIN, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
+    m.add_argument("--rapid", type=FEED_MM_MIN, default=5000.0, metavar="MM/MIN", help="rapid rate for the cycle time (default 5000)")
+    m.add_argument("--spindle", type=SPINDLE_RPM, default=3000.0, metavar="RPM", help="spindle speed (default 3000)")
     m.add_argument("--coolant", choices=("off", "flood", "mist"), default="off", help="coolant (default off)")
-    m.add_argument("--safe-z", type=float, default=50.0, metavar="MM", help="retract height (default 50)")
-    m.add_argument("--program", type=int, default=1000, metavar="N", help="program number O N (default 1000)")
+    m.add_argument("--safe-z", type=HEIGHT_MM, default=50.0, metavar="MM", help="retract height (default 50)")
+    m.add_argument("--program", type=PROGRAM_NUMBER, default=1000, metavar="N", help="program number O N (default 1000)")
+    add_max_points(p)
 
 
 def job_data(args) -> dict:
@@ -64,7 +74,7 @@ def job_data(args) -> dict:
     if args.margin is not None:
         stock["margin"] = args.margin
     tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
-    for key in ("flute_length", "reach"):
+    for key in ("corner_radius", "flute_length", "reach"):
         if getattr(args, key) is not None:
             tool[key] = getattr(args, key)
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
@@ -80,14 +90,13 @@ def job_data(args) -> dict:
 
 def origin_list(text: str):
     from ..errors import InputError
+    from ..values import in_range
 
-    try:
-        v = [float(t) for t in text.split(",")]
-    except ValueError:
-        v = []
-    if len(v) != 4:
+    parts = text.split(",")
+    if len(parts) != 4:
         raise InputError(f"--block {text!r} must be four numbers X0,X1,Y0,Y1 in mm")
-    return v
+    names = ("X0", "X1", "Y0", "Y1")
+    return [in_range(v, f"--block {name}", -LENGTH_MM, LENGTH_MM, unit="mm") for name, v in zip(names, parts)]
 
 
 def run(args, out, err) -> int:
@@ -95,7 +104,7 @@ def run(args, out, err) -> int:
     from ..job.spec import parse_job
     from .job import report
 
-    planned = plan_job(parse_job(job_data(args), "lagsym rough"))
+    planned = plan_job(parse_job(job_data(args), "lagsym rough"), args.max_points, args.max_samples)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

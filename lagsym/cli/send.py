@@ -15,13 +15,14 @@ from ..dnc import (
     PARITIES,
     PROFILES,
     LineSettings,
+    check_port,
     parse_filler,
     find_block,
     parse_program,
     profile,
     send_program,
 )
-from ..errors import InputError
+from ..errors import InputError, LogLost
 from ..io import event_log, read_program
 from ..machine import LINE_ENDINGS
 
@@ -54,7 +55,9 @@ examples:
 def add_line_arguments(p) -> None:
     """The serial line options ``send`` and ``receive`` share; the defaults they print are :class:`LineSettings`'s."""
     d = LineSettings()
-    p.add_argument("--port", required=True, help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port)")
+    p.add_argument("--port", required=True, type=port_name,
+                   help="device (/dev/ttyUSB0, COM3) or pyserial URL (socket://host:port, rfc2217://host:port, "
+                        "loop://)")
     g = p.add_argument_group("line settings (a --profile fills them in; any option given overrides it)")
     g.add_argument("--profile", choices=tuple(PROFILES), help="usual settings of a control family (see docs/dnc.md)")
     g.add_argument("--baud", type=int, help=f"bits per second (default {d.baud})")
@@ -75,7 +78,23 @@ def add_line_arguments(p) -> None:
     g.add_argument("--iso-check", action=argparse.BooleanOptionalAction, default=None,
                    help="only ISO 840 tape code characters, in what is sent and received (default off)")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
-    p.add_argument("--log", metavar="FILE", help="append a line per event (XOFF, XON, faults) to FILE")
+    p.add_argument("--log", metavar="FILE", help="append a line per event (XOFF, XON, faults) to FILE; a log that "
+                                                 "cannot be written is refused before the port opens")
+
+
+def port_name(text: str) -> str:
+    """An argparse ``type=`` for ``--port``: a device, or a URL with a host, a port number 1-65535 and known options."""
+    try:
+        return check_port(text, "")
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e).strip()) from None
+
+
+def check_log(log, done: str) -> None:
+    """After a transfer: a log that stopped part way means the transfer is not on record (exit 3)."""
+    if log is not None and log.lost is not None:
+        raise LogLost(f"{done}, but the log {log.path} was lost ({log.lost}): the transfer is not on record; "
+                      "free space for the log, and check on the control what arrived")
 
 
 def line_settings(args):
@@ -91,7 +110,10 @@ def line_settings(args):
     for option in ("leader", "trailer"):
         value = getattr(args, option, None)
         if value is not None:
-            overrides[option] = parse_filler(value)
+            try:
+                overrides[option] = parse_filler(value)
+            except InputError as e:
+                raise InputError(f"--{option} {value!r}: {e}") from None
     if getattr(args, "stall_timeout", None) is not None:
         overrides["stall_timeout_s"] = seconds_or_forever(args.stall_timeout)
     if getattr(args, "overrun_chars", None) is not None:
@@ -160,8 +182,8 @@ def add_arguments(p) -> None:
     t.add_argument("--memory-chars", type=int, metavar="N",
                    help="the control's program memory: a larger upload is refused (default: not checked)")
     t.add_argument("--overrun-chars", type=int, metavar="N",
-                   help=f"most characters in flight, so at most N arrive after XOFF (default {d.overrun_chars}; "
-                        "Fanuc tolerates ~10)")
+                   help=f"most characters in flight: about half what the control takes past XOFF (default "
+                        f"{d.overrun_chars}; a Fanuc takes ~10; a larger N keeps a fast line busy)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
 
 
@@ -176,6 +198,7 @@ def run(args, out, err) -> int:
     with event_log(args.log) as log, progress_bar(err, args.quiet, f"{args.mode} {Path(args.file).name}") as bar:
         result = send_program(args.port, program, settings, mode=args.mode, start_block=start,
                               safe_z=args.safe_z, progress=bar, log=log)
+    check_log(log, f"sent {result.blocks} blocks to {args.port}")
     if not args.quiet:
         out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
                   f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from ..io import read_program
-from ..simulate import SIM_DIALECTS, detect_dialect, moves_csv, simulate
+from ..simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, SIM_DIALECTS, detect_dialect, moves_csv, simulate
 from ._common import count, emit
+
+MAX_BLOCKS_LIMIT = 100_000_000  # the moves of a run this long take at most 3.7 GB
 
 DESCRIPTION = """Execute PROGRAM (Fanuc Custom Macro B, LinuxCNC O-words or Heidenhain FN/Q,
 guessed from the text unless --dialect is given) in decimal arithmetic of
@@ -16,6 +18,12 @@ DO/END, brackets nested beyond 5, a constant axis word without a decimal
 point, a variable outside the allowed range, a block too long, division by
 zero.  Use it to dry-run any program before it goes to a machine.
 
+A program that would never end stops within seconds with the runaway alarm
+(exit status 2, as every alarm): at once for a loop whose condition nothing in
+it changes (WHILE [1 EQ 1], a GOTO back) or when the run comes back to a block
+with every variable and the position unchanged, after --max-idle-blocks
+blocks without a move, or after --max-blocks blocks in all.
+
 examples:
   lagsym simulate O1000.nc --precision 8 -o moves.csv
   lagsym simulate surface.ngc --precision 15"""
@@ -26,8 +34,11 @@ def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=SIM_DIALECTS, help="control language (default: guessed from the text)")
     p.add_argument("--precision", type=int, choices=(8, 15),
                    help="significant digits (default 8 for fanuc and heidenhain, 15 for linuxcnc)")
-    p.add_argument("--max-blocks", type=count(1, 1_000_000_000), default=20_000_000, metavar="N",
-                   help="stop after N executed blocks as a runaway loop (default 20000000)")
+    p.add_argument("--max-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_BLOCKS, metavar="N",
+                   help=f"stop after N executed blocks as a runaway loop (default {MAX_BLOCKS}; the moves take "
+                        f"at most {BYTES_PER_MOVE} bytes a block, up to {MAX_BLOCKS_LIMIT})")
+    p.add_argument("--max-idle-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_IDLE_BLOCKS, metavar="N",
+                   help=f"stop after N blocks in a row without a move as a runaway loop (default {MAX_IDLE_BLOCKS})")
     p.add_argument("-o", "--output", metavar="FILE", help="write the moves CSV to FILE instead of standard output")
 
 
@@ -35,9 +46,9 @@ def run(args, out, err) -> int:
     text = read_program(args.program)
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or (15 if dialect == "linuxcnc" else 8)
-    sim = simulate(text, dialect, precision, max_blocks=args.max_blocks)
+    sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks)
     emit(moves_csv(sim), args.output, out)
-    feeds = sum(1 for m in sim.moves if m.motion == "G1")
+    feeds = sim.moves.feeds()
     err.write(f"{args.program}: {dialect}, {precision} digits: {sim.blocks} blocks executed, "
               f"{len(sim.moves)} moves ({feeds} feed), no alarm\n")
     return 0

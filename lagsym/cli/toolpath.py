@@ -9,8 +9,8 @@ from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
-                      DECIMALS, add_program_arguments, count, program_settings)
+from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+                      TOOL_MM, DECIMALS, add_program_arguments, count, program_settings)
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
 FILE and write it as a point-list G-code program.  Cutter locations come from
@@ -39,7 +39,8 @@ def add_arguments(p) -> None:
                    help="longest move along a row (default 0.2, or none with --tolerance alone); points are "
                         "added where the path bends")
     g.add_argument("--scallop", type=SMALL_MM, metavar="MM",
-                   help="side step from this cusp height of a ball-end cutter, instead of --stepover")
+                   help="rows spaced so that a ball-end cutter's cusp, measured normal to the surface, is at "
+                        "most this (on slopes too), instead of --stepover")
     g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
                    help=f"chordal error of the moves: points are added where the path bends and, without "
                         f"--step, left out where it is straight (default {DEFAULT_TOLERANCE_MM})")
@@ -48,7 +49,9 @@ def add_arguments(p) -> None:
                         "the part, so the whole part is finished), centre (the axis stays in the box) or "
                         "inside (the whole tool stays in the box)")
     t = p.add_argument_group("cutter")
-    t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
+    t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default), flat or bull (bull nose: give --corner-radius)")
+    t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
     t.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM",
                    help="cutter diameter (default 6; 0 gives the uncompensated path on the surface)")
     m = p.add_argument_group("machine and program")
@@ -77,7 +80,7 @@ def run(args, out, err) -> int:
 
     grid = read_points(args.file)
     settings = settings_from(args, args.dialect, grid)
-    tool = Tool(args.tool_shape, args.tool_diameter)
+    tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary)
@@ -88,7 +91,16 @@ def run(args, out, err) -> int:
         write_text(args.output, text, newline="")
         err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
                   f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
-                  f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)\n")
+                  f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"
+                  + _cusp_note(tp) + "\n")
     else:
         out.write(text)
     return 0
+
+
+def _cusp_note(tp) -> str:
+    """With a scallop height: the worst cusp the rows are predicted to leave, and where."""
+    if tp.cusp_mm is None:
+        return ""
+    x, y = tp.cusp_at_mm
+    return f", worst predicted cusp {tp.cusp_mm:.4f} mm normal to the surface at X{x:.3f} Y{y:.3f}"

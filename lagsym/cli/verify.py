@@ -1,14 +1,17 @@
-"""``lagsym verify SURFACE PROGRAM``: simulate a program's cut and compare it with the exact surface."""
+"""``lagsym verify SURFACE PROGRAM``: simulate a program's cut and compare it with the exact surface.
+
+``lagsym verify --job JOB.toml PROGRAM`` simulates a whole job's program from its block instead.
+"""
 
 from __future__ import annotations
 
-from ..errors import ExitStatus
-from ..gcode import parse_moves
+from ..errors import ExitStatus, InputError
+from ..gcode import parse_moves, tool_changes
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
-from ._common import SCALE, TOOL_MM, count, number, origin
+from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
@@ -23,42 +26,99 @@ exit status: 0 the program passes; 1 it gouges or a rapid goes into the part
 (or a scallop above --max-scallop); 2 bad input (an unreadable file, a
 program with arcs or canned cycles).
 
+With --job the first file is a job file (TOML, as for lagsym job): the
+program is simulated from the job's block, each part of it (from one M06 to
+the next) with the cutter its T number names in the job, and verify reports
+what each tool removed, any rapid move through material, the worst gouge and
+the material left above the surface (largest, where, and a histogram).  The
+job gives the tools, scale and origin, so those options are refused with it.
+It exits 1 on a gouge, a rapid through material, or, when --max-left is
+given, more material left than that.
+
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
-  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1"""
+  lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1
+  lagsym verify --job examples/example-4-job.toml job.ngc --cell 0.5"""
+
+
+# Options the job file gives instead, refused with --job (with their defaults without it).
+_SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": None, "scale": 1.0, "origin": "0,0,0",
+                "max_contacts": MAX_CONTACTS}
 
 
 def add_arguments(p) -> None:
-    p.add_argument("surface", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("surface", metavar="SURFACE", help="points file: JSON or CSV with x,y,z (with --job: the job file)")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves)")
-    p.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default) or flat end")
-    p.add_argument("--tool-diameter", type=TOOL_MM, default=6.0, metavar="MM", help="cutter diameter (default 6)")
-    p.add_argument("--scale", type=SCALE, default=1.0, help="model scale, as for toolpath: a points file in inches is 25.4 mm per unit at scale 1 (default 1)")
-    p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset the program was made with, mm")
-    p.add_argument("--cell", type=number(1e-3, 1_000.0, "mm"), metavar="MM", help="height-map cell size (default: box side / 400)")
+    p.add_argument("--job", action="store_true",
+                   help="SURFACE is a job file (TOML): simulate the whole job from its block, tool by tool")
+    p.add_argument("--tool-shape", choices=TOOL_SHAPES, help="ball (default), flat or bull (bull nose: give --corner-radius)")
+    p.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
+                   help="corner radius of a bull-nose cutter (--tool-shape bull), less than half its diameter")
+    p.add_argument("--tool-diameter", type=TOOL_MM, metavar="MM", help="cutter diameter (default 6)")
+    p.add_argument("--scale", type=SCALE, help="model scale, as for toolpath: a points file in inches is 25.4 mm per unit at scale 1 (default 1)")
+    p.add_argument("--origin", metavar="X,Y,Z", help="work offset the program was made with, mm (default 0,0,0)")
+    p.add_argument("--cell", type=number(1e-3, 1_000.0, "mm"), metavar="MM",
+                   help="height-map cell size (default: box side / 400; with --job, block side / 400)")
     p.add_argument("--gouge-limit", type=number(0.0, 1_000.0, "mm"), metavar="MM",
                    help="depth from which a cut counts as a gouge (default: what the program's rounding can "
-                        "cause: half a unit of its last decimal, and as much sideways times the steepest slope)")
-    p.add_argument("--max-left", type=number(0.0, 1_000.0, "mm"), default=MAX_LEFT_MM, metavar="MM",
-                   help=f"material left anywhere above which the program fails (default {MAX_LEFT_MM})")
+                        "cause: half a unit of its last decimal, and as much sideways times the steepest slope; "
+                        "with --job, program rounding plus simulation resolution)")
+    p.add_argument("--max-left", type=number(0.0, 1_000.0, "mm"), metavar="MM",
+                   help=f"material left anywhere above which the program fails (default {MAX_LEFT_MM}; with "
+                        f"--job, checked only when given)")
     p.add_argument("--max-scallop", type=number(0.0, 1_000.0, "mm"), metavar="MM",
                    help="scallop between passes (normal to the surface) above which the program fails "
-                        "(default: reported, not checked)")
+                        "(default: reported, not checked; not with --job)")
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
-    p.add_argument("--max-contacts", type=count(1, 10**14), default=MAX_CONTACTS, metavar="N",
+    p.add_argument("--max-contacts", type=count(1, 10**14), metavar="N",
                    help=f"refuse a simulation of more than N tool positions times cells under the tool "
                         f"(default {MAX_CONTACTS:.2g})")
 
 
 def run(args, out, err) -> int:
+    if args.job:
+        return _run_job(args, out)
+    for key, default in _SINGLE_TOOL.items():
+        if getattr(args, key) is None:
+            setattr(args, key, default)
     surface = lagrange_surface(read_points(args.surface))
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
-    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter), place, cell_mm=args.cell,
-                          program_resolution_mm=program_resolution_mm(text), gouge_limit_mm=args.gouge_limit,
-                          max_cells=args.max_cells, max_contacts=args.max_contacts, max_left_mm=args.max_left,
+    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter, args.corner_radius), place,
+                          cell_mm=args.cell, program_resolution_mm=program_resolution_mm(text),
+                          gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells, max_contacts=args.max_contacts,
+                          max_left_mm=MAX_LEFT_MM if args.max_left is None else args.max_left,
                           max_scallop_mm=args.max_scallop)
     out.write("\n".join(report.summary()) + "\n")
     return ExitStatus.WARNING if report.fails else ExitStatus.OK
+
+
+def _run_job(args, out) -> int:
+    from ..job import read_job
+    from ..job.operations import job_stock
+    from ..machined import machine_part
+
+    if args.max_scallop is not None:
+        raise InputError("--max-scallop is for a single program; with --job verify checks the material left "
+                         "(--max-left)")
+    given = [key for key in _SINGLE_TOOL if getattr(args, key) is not None]
+    if given:
+        option = "--" + given[0].replace("_", "-")
+        raise InputError(f"{option} is not for --job: the job file {args.surface} names the tools, scale and origin")
+    spec = read_job(args.surface)
+    surface = lagrange_surface(read_points(spec.points))
+    stock = job_stock(spec, surface)
+    text = read_program(args.program)
+    moves = parse_moves(text, source=args.program)
+    changes = tool_changes(text, source=args.program)
+    tools = {t.number: t.tool for t in spec.tools.values()}
+    part = machine_part(surface, moves, changes, tools, stock.box + (stock.top_mm,),
+                        Placement(spec.mm_per_unit, spec.origin_mm), cell_mm=args.cell,
+                        gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells)
+    out.write("\n".join(part.summary()) + "\n")
+    too_much = args.max_left is not None and part.left_mm > args.max_left
+    if too_much:
+        out.write(f"more material left than --max-left {args.max_left:g} mm\n")
+    return ExitStatus.WARNING if part.gouges or part.crashes or too_much else ExitStatus.OK

@@ -24,7 +24,8 @@ from .blocks import DC1, DC2, DC3, DC4, ISO_840, Program, check_drip, check_iso,
 from .receiver import receive_program
 from .results import LineFault, TransferProgress, TransferResult
 from .resume import find_block, resume_setup
-from .settings import CARRIERS, FLOW_CONTROLS, MODES, PARITIES, PROFILES, LineSettings, parse_filler, profile
+from .settings import (CARRIERS, FLOW_CONTROLS, MODES, PARITIES, PROFILES, URL_SCHEMES, LineSettings, check_port,
+                       parse_filler, profile)
 from .transfer import send_program, transfer_segments
 
 __all__ = [
@@ -37,6 +38,8 @@ __all__ = [
     "MODES",
     "profile",
     "parse_filler",
+    "check_port",
+    "URL_SCHEMES",
     "Program",
     "parse_program",
     "frame",

@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import InputError, LagsymError
-from .settings import LineSettings, profile
+from .settings import LineSettings, check_port, profile
 
 __all__ = ["PortConfig", "ServerConfig", "load_config"]
 
@@ -77,6 +77,7 @@ def _port(source: str, index: int, table, base: Path) -> PortConfig:
     for key in ("name", "device", "programs", "received"):
         if not isinstance(table.get(key), str) or not table[key]:
             raise _bad(source, f"{where}.{key}", "is required, as a string")
+    check_port(table["device"], f"{source}: {where}.device")
     line = table.get("line", {})
     if not isinstance(line, dict):
         raise _bad(source, f"{where}.line", "must be a table of line settings")
@@ -121,6 +122,8 @@ def load_config(path: str | Path) -> ServerConfig:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     except OSError as e:
         raise InputError(f"{source}: cannot read the configuration ({e.strerror or e})") from None
+    except UnicodeDecodeError as e:
+        raise InputError(f"{source}: not UTF-8 text (byte {e.start}); a configuration is a TOML text file") from None
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{source}: not TOML: {e}") from None
     for key in data:

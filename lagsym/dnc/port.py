@@ -10,12 +10,14 @@ on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
 from __future__ import annotations
 
 import errno
+import select
 import termios
+import time
 
 import serial
 
 from ..errors import TransferError
-from .settings import PARITIES, LineSettings
+from .settings import PARITIES, LineSettings, check_port
 
 __all__ = ["Port", "LINE_ERRORS", "WriteTimeout"]
 
@@ -38,11 +40,14 @@ class Port:
 
     Raises
     ------
+    InputError
+        For a URL that cannot name a port (see :func:`~lagsym.dnc.settings.check_port`).
     TransferError
         If the port cannot be opened.
     """
 
     def __init__(self, name: str, settings: LineSettings, write_timeout: float | None):
+        check_port(name, "port")
         try:
             ser = serial.serial_for_url(name, do_not_open=True)
             ser.baudrate = settings.baud
@@ -61,9 +66,12 @@ class Port:
                 ser.write_timeout = write_timeout
             ser.dtr = settings.dtr
             ser.open()
-        except (ValueError, *LINE_ERRORS) as e:
+        except (ValueError, KeyError, *LINE_ERRORS) as e:  # KeyError: pyserial formatting its own URL message
             raise TransferError(_open_failure(name, e)) from None
         self._ser = ser
+        # A local device can be waited on: the sender sleeps until the control says something or the line needs
+        # more, instead of polling.  A URL port (RFC 2217, socket, loop) buffers in pyserial and is polled.
+        self._fd = ser.fd if type(ser) is serial.Serial else None
 
     def read(self, size: int) -> bytes:
         """What has arrived, up to ``size`` bytes, without waiting."""
@@ -73,6 +81,16 @@ class Port:
         """Queue ``data``; the number of bytes taken."""
         written = self._ser.write(data)
         return len(data) if written is None else written
+
+    def wait(self, timeout_s: float) -> None:
+        """Wait up to ``timeout_s`` seconds, returning as soon as the control has sent something (where the port can tell)."""
+        if self._fd is None:
+            time.sleep(timeout_s)
+            return
+        try:
+            select.select([self._fd], [], [], timeout_s)
+        except (OSError, ValueError):  # a line lost meanwhile: the next read says so
+            time.sleep(timeout_s)
 
     def out_waiting(self) -> int:
         """Bytes in the driver's output queue, or 0 where the port cannot tell."""

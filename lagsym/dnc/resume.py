@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..gcode.words import numeric_words, strip_comments
 from .blocks import Program
 
-__all__ = ["resume_setup", "find_block"]
+__all__ = ["resume_setup", "find_block", "first_resumable_block"]
 
 _MACRO = re.compile(r"#|\bGOTO\b|\bWHILE\b|\bIF\b|\bM98\b|\bM99\b|\bG65\b")
 
@@ -157,6 +157,30 @@ def _g(text: str) -> str:
 def _fmt(value: Decimal) -> str:
     text = format(value.normalize() if value != 0 else Decimal(0), "f")
     return text if "." in text else text + "."
+
+
+def first_resumable_block(program: Program, within: int = 500) -> int:
+    """The first block a resume can start at: the first :func:`resume_setup` accepts.
+
+    Before it the program has not yet stated its units, the tool's X, Y and
+    Z, a safe height and a feed, and a resume cannot approach the part; a
+    fault earlier than that asks for the program from the start.  Looked for
+    among the first ``within`` blocks; one more than the program's last block
+    when none there will do.
+
+    Examples
+    --------
+    >>> from lagsym.dnc import parse_program
+    >>> first_resumable_block(parse_program("O1\\nG21 G90\\nG0 X0 Y0\\nG0 Z5.\\nG1 Z-1. F100.\\nX10."))
+    6
+    """
+    for number in range(2, min(len(program), within) + 1):
+        try:
+            resume_setup(program, number)
+        except InputError:
+            continue
+        return number
+    return len(program) + 1
 
 
 def resume_setup(program: Program, start_block: int, safe_z: str | None = None) -> tuple[str, ...]:

@@ -3,7 +3,12 @@
 The sender does its own XON/XOFF: it paces writes to the line rate
 (characters per second = baud / bits per character), keeps at most
 ``LineSettings.overrun_chars`` characters on their way at any moment, and
-reads the line for DC3 (XOFF) and DC1 (XON) before every write.  The kernel's
+reads the line for DC3 (XOFF) and DC1 (XON) before every write.  Between
+writes it waits on the port (``select``), so a DC3 or DC1 wakes it at once,
+and it tops the line up by a quarter of the window at a time: one character
+for the default 4, 16 for a window of 64, so that a control with room for
+many characters past its DC3 can be fed at 115200 baud by a machine that
+wakes the sender late now and then.  The kernel's
 IXON is left off on purpose: it would swallow DC3 before lagsym could see it,
 and many USB adapters keep sending after it anyway.  A Fanuc accepts only
 about 10 characters past DC3 before alarm 087, so the default keeps 4 or
@@ -34,7 +39,8 @@ from .settings import CARRIER_LOSS_S, LineSettings
 
 __all__ = ["Sender"]
 
-_POLL_S = 0.002  # longest sleep between looks at the port while the line is busy
+_POLL_S = 0.002  # longest wait between looks at a port that cannot be waited on, or at CTS/DSR
+_WAIT_S = 0.02  # longest wait on a port that wakes the sender when the control speaks
 _PROGRESS_S = 0.1
 # A byte counts as arrived only this long after the line clock says it left: longer through a network
 # serial server, which holds what it has not yet put on its line.
@@ -48,16 +54,16 @@ class Sender:
     """One send over an open port: pacing, flow control, accounting.  Not reused."""
 
     def __init__(self, line, segments, settings: LineSettings, mode: str, port: str,
-                 progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None):
+                 progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None,
+                 resumable_from: int = 2):
         self.line, self.settings, self.mode, self.port = line, settings, mode, port
+        self.resumable_from = resumable_from  # no resume before this block can approach the part
         self.progress, self.log = progress, log or (lambda _m: None)
         self.data = b"".join(b for _, b in segments)
         self.ends: list[tuple[int, int]] = []  # (end offset, block number) of program blocks
-        self.segment_ends: list[int] = []
         offset = 0
         for number, chunk in segments:
             offset += len(chunk)
-            self.segment_ends.append(offset)
             if number is not None:
                 self.ends.append((offset, number))
         self.blocks_total = len(self.ends)
@@ -75,6 +81,7 @@ class Sender:
         self.max_in_flight = 0
         self.queue_stuck_since: float | None = None
         self.last_queue = 0
+        self.queued = 0  # the driver's output queue, read once a turn of the loop
         self.hardware = _HARDWARE.get(settings.flow)
         self.carrier = None if settings.carrier == "none" else settings.carrier
         for sig in (self.hardware, self.carrier):
@@ -88,7 +95,7 @@ class Sender:
     def in_flight(self, now: float) -> int:
         """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
         clock = max(0.0, (self.line_free - now) * self.cps)
-        return max(math.ceil(clock), self.line.out_waiting())
+        return max(math.ceil(clock), self.queued)
 
     def unsettled(self, now: float) -> int:
         """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
@@ -131,6 +138,8 @@ class Sender:
         repeat = None
         if self.mode == "drip":
             resume = self.last_run_block() + 1
+            if resume < self.resumable_from:  # before the program has placed the tool: from the start
+                resume = 1
             if resume <= last:
                 repeat = (max(resume, self.first_block), last)
                 where += (f"; the control's buffer ({self.settings.buffer_chars} characters) may still hold blocks "
@@ -179,7 +188,9 @@ class Sender:
             reason = f"{self.hardware.upper()} stayed low (control not ready) for more than {{t}}"
             if not ready and not self.paused:
                 self.paused, self.pause_since, self.pause_reason = True, now, reason
+                self.log(f"{self.hardware.upper()} low after {self.pos} bytes")
             elif ready and self.paused and self.pause_reason == reason:
+                self.log(f"{self.hardware.upper()} high after {now - self.pause_since:.3f} s")
                 self.paused = False
         if self.carrier and now - self.carrier_checked >= _CARRIER_POLL_S:
             self.carrier_checked = now  # a network port may wait on the server to tell its modem lines
@@ -197,7 +208,7 @@ class Sender:
 
     def check_queue(self, now: float) -> None:
         """An output queue that does not shrink means nothing reads the line."""
-        queued = self.line.out_waiting()
+        queued = self.queued
         if queued and queued >= self.last_queue:
             if self.queue_stuck_since is None:
                 self.queue_stuck_since = now
@@ -216,12 +227,16 @@ class Sender:
         self.line_free = start
         last_report = -1.0
         limit = self.settings.overrun_chars
-        low = limit - 1  # top up as soon as a character has left: the most margin against late wake-ups
-        seg = 0
+        # Top up once a quarter of the window has left: few wake-ups, and three quarters of it as margin
+        # against a late one (the default window of 4 tops up after each character).
+        low = limit - max(1, limit // 4)
         total = len(self.data)
+        # Waiting on the port returns when the control speaks; where it cannot be waited on, poll.
+        longest = _POLL_S if self.hardware else _WAIT_S
         self.log(f"sending {total} bytes, {self.blocks_total} blocks, at {self.cps:.1f} characters/s")
         while True:
             now = time.monotonic()
+            self.queued = self.line.out_waiting()
             self.poll(now)
             if now - last_report >= _PROGRESS_S:
                 self.report(start, now)
@@ -231,23 +246,22 @@ class Sender:
                 if now - self.pause_since > self.settings.stall_timeout_s:
                     raise self.fault(self.pause_reason.format(t=self.settings.stall_text),
                                      "clear the control (reset any alarm) and put it back in DNC or READ mode")
-                time.sleep(_POLL_S)
+                self.line.wait(longest)
                 continue
             in_flight = self.in_flight(now)
             if self.pos >= total:
                 if in_flight == 0:
                     finished = now  # the last byte has left the line
                     break
-                time.sleep(min(_POLL_S, in_flight / self.cps))
+                self.line.wait(min(longest, in_flight / self.cps))
                 continue
             if in_flight > low:
-                time.sleep(min(_POLL_S, (in_flight - low) / self.cps))
+                self.line.wait(min(longest, (in_flight - low) / self.cps))
                 continue
-            while self.segment_ends[seg] <= self.pos:
-                seg += 1
-            n = min(limit - in_flight, self.segment_ends[seg] - self.pos)
-            written = self.line.write(self.data[self.pos:self.pos + n])
-            self.line_free = max(self.line_free, now) + written / self.cps
+            written = self.line.write(self.data[self.pos:self.pos + limit - in_flight])
+            # The clock starts when the write has returned, not at the top of the turn: a sender descheduled
+            # in between would otherwise count characters as gone that have not yet left.
+            self.line_free = max(self.line_free, time.monotonic()) + written / self.cps
             self.pos += written
         # A healthy look once the last byte has settled, so the last block counts as delivered.
         time.sleep(self.settle_s)

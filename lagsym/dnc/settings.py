@@ -15,12 +15,19 @@ from ..machine import LINE_ENDINGS, bits_per_char
 from ..values import choice, positive
 from .blocks import DC1, DC2, DC3, DC4
 
-__all__ = ["LineSettings", "PROFILES", "FLOW_CONTROLS", "CARRIERS", "PARITIES", "MODES", "profile", "parse_filler"]
+__all__ = ["LineSettings", "PROFILES", "FLOW_CONTROLS", "CARRIERS", "PARITIES", "MODES", "URL_SCHEMES", "profile",
+           "parse_filler", "check_port"]
 
 FLOW_CONTROLS = ("xonxoff", "rtscts", "dtrdsr", "none")
 CARRIERS = ("none", "dsr", "cd", "cts")
 PARITIES = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}
 MODES = ("upload", "drip")
+# pyserial's URL handlers; the options of the three lagsym documents are checked here, because pyserial
+# answers a bad one with an error of its own formatting (a KeyError) rather than a message.
+URL_SCHEMES = ("socket", "rfc2217", "loop", "spy", "hwgrep", "alt", "cp2110")
+_URL_OPTIONS = {"loop": ("logging",), "socket": ("logging",),
+                "rfc2217": ("logging", "ign_set_control", "poll_modem", "timeout")}
+_LOGGING = ("debug", "info", "warning", "error")
 _FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
 
 
@@ -62,9 +69,11 @@ class LineSettings:
         drip feed it must exceed the longest time the control spends on the
         blocks in its buffer.
     overrun_chars : int
-        Most characters on their way at any moment, so at most this many
-        arrive after the control says XOFF.  Keep it below the control's
-        tolerance (about 10 on a Fanuc).
+        Most characters on their way at any moment: what arrives after the
+        control says XOFF is these and at most one write that left before
+        lagsym read the DC3.  Keep it to about half the control's tolerance
+        (about 10 on a Fanuc); a larger window keeps a fast line busy when
+        the computer wakes the sender late.
     wait_for_xon : bool
         Wait for the control's DC1 before the first character (a Fanuc sends
         it when READ is pressed).
@@ -200,12 +209,71 @@ def parse_filler(spec: str) -> str:
     out = []
     for item in (s.strip() for s in spec.split(",") if s.strip()):
         count, _, name = item.rpartition("*")
-        if not count and item.isdigit():
+        if not count and _digits(item):
             count, name = item, "NUL"
         name = name.upper()
         if name not in _FILLERS:
             raise InputError(f"leader/trailer item {item!r}: {name!r} is not one of {', '.join(_FILLERS)}")
-        if count and (not count.isdigit() or int(count) > 10_000):
+        if count and (not _digits(count) or int(count) > 10_000):
             raise InputError(f"leader/trailer item {item!r}: {count!r} is not a count from 0 to 10000")
         out.append(_FILLERS[name] * (int(count) if count else 1))
     return "".join(out)
+
+
+def _digits(text: str) -> bool:
+    """ASCII digits only: ``str.isdigit`` also takes superscripts and other scripts' digits, which int() refuses."""
+    return text.isascii() and text.isdigit()
+
+
+def check_port(name: str, where: str = "--port") -> str:
+    """A port name: a device, or a pyserial URL whose host, port number and options are checked.
+
+    Examples
+    --------
+    >>> check_port("socket://dnc.shop.lan:4001"), check_port("loop://?logging=debug")
+    ('socket://dnc.shop.lan:4001', 'loop://?logging=debug')
+    >>> check_port("socket://127.0.0.1:99999")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: --port 'socket://127.0.0.1:99999': the port number must be 1 to 65535 (socket://HOST:PORT)
+    """
+    if not isinstance(name, str) or not name.strip() or "\x00" in name:
+        raise InputError(f"{where} {name!r}: give a device (/dev/ttyUSB0, COM3) or a URL (socket://host:4001)")
+    if "://" not in name:
+        return name  # a device: opening it says whether it is there
+    scheme, _, rest = name.partition("://")
+    scheme = scheme.lower()
+    if scheme not in URL_SCHEMES:
+        raise InputError(f"{where} {name!r}: {scheme}:// is not a serial URL; the schemes are "
+                         f"{', '.join(s + '://' for s in URL_SCHEMES)}")
+    if scheme not in _URL_OPTIONS:
+        return name
+    place, _, query = rest.partition("?")
+    if scheme == "loop":
+        if place.strip("/"):
+            raise InputError(f"{where} {name!r}: loop:// takes no host or path")
+    else:
+        host, colon, number = place.rstrip("/").rpartition(":")
+        if not colon or not host:
+            raise InputError(f"{where} {name!r}: give the host and port number ({scheme}://HOST:PORT)")
+        if not _digits(number) or not 1 <= int(number) <= 65535:
+            raise InputError(f"{where} {name!r}: the port number must be 1 to 65535 ({scheme}://HOST:PORT)")
+    for item in filter(None, query.split("&")):
+        _url_option(name, where, scheme, *item.partition("=")[::2])
+    return name
+
+
+def _url_option(name: str, where: str, scheme: str, key: str, value: str) -> None:
+    known = _URL_OPTIONS[scheme]
+    if key not in known:
+        raise InputError(f"{where} {name!r}: {key!r} is not an option of {scheme}:// (its options: "
+                         f"{', '.join(known)})")
+    if key == "logging" and value not in _LOGGING:
+        raise InputError(f"{where} {name!r}: logging={value} must be one of {', '.join(_LOGGING)}")
+    if key == "timeout":
+        try:
+            ok = 0 < float(value) <= 3600
+        except ValueError:
+            ok = False
+        if not ok:
+            raise InputError(f"{where} {name!r}: timeout={value} must be a number of seconds above 0, up to 3600")

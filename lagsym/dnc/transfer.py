@@ -15,7 +15,7 @@ from ..errors import InputError, TransferError
 from ..values import choice
 from .blocks import Program, check_drip, check_iso, frame, tv_padded
 from .results import LineFault, TransferProgress, TransferResult
-from .resume import resume_setup
+from .resume import first_resumable_block, resume_setup
 from .settings import MODES, LineSettings
 
 __all__ = ["TransferProgress", "TransferResult", "LineFault", "transfer_segments", "send_program"]
@@ -114,7 +114,8 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     if owned:
         line = Port(port, settings, write_timeout=timeout)
     try:
-        sender = Sender(line, segments, settings, mode, port, progress, log)
+        sender = Sender(line, segments, settings, mode, port, progress, log,
+                        resumable_from=first_resumable_block(program) if start_block <= 1 else 2)
     except BaseException:
         if owned:
             line.close()

@@ -8,8 +8,8 @@ reads (block length, variable numbers).
 
 from __future__ import annotations
 
-from .moves import Moves, move_points, parse_moves
+from .moves import Moves, move_points, parse_moves, tool_changes
 from .words import FUNCTIONS, WordError, numeric_words, strip_comments, words
 
-__all__ = ["Moves", "parse_moves", "move_points", "WordError", "FUNCTIONS", "strip_comments",
+__all__ = ["Moves", "parse_moves", "move_points", "tool_changes", "WordError", "FUNCTIONS", "strip_comments",
            "numeric_words", "words"]

@@ -24,7 +24,7 @@ from .._arrays import freeze_fields
 from ..errors import ProgramError
 from .words import WordError, numeric_words
 
-__all__ = ["Moves", "parse_moves", "move_points"]
+__all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
 
 _IGNORED_G = {17, 40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 94, 97}
 _IGNORED_LETTERS = set("NSTMHDP")
@@ -206,3 +206,27 @@ def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.nd
         return np.zeros((0, 3)), np.zeros(0, dtype=bool)
     first = int(known[0])
     return np.array(m.points_mm[first:]), np.array(m.rapid[first + 1:])
+
+
+def tool_changes(text: str, source: str = "<program>") -> list[tuple[int, int]]:
+    """``(line, tool number)`` of every tool change (``M06``, with the ``T`` of its block or the last one before).
+
+    Examples
+    --------
+    >>> tool_changes("T1 M06\\nG00 X0 Y0\\nT2\\nM6\\n")
+    [(1, 1), (4, 2)]
+    """
+    out, tool = [], None
+    for no, raw, block in _blocks(text):
+        try:
+            words = numeric_words(block)
+        except WordError as e:
+            raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
+        for letter, value in words:
+            if letter == "T":
+                tool = int(float(value))
+        if any(letter == "M" and float(value) == 6 for letter, value in words):
+            if tool is None:
+                raise ProgramError(f"{source}, line {no}: a tool change (M06) before any T word")
+            out.append((no, tool))
+    return out

@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 from ..values import exact_number
-from .files import MAX_BYTES, STDIN_SILENCE_S, event_log, read_bytes, read_program, read_text
+from .files import MAX_BYTES, STDIN_SILENCE_S, EventLog, event_log, read_bytes, read_program, read_text
 from .points import (
     TABLE_SUFFIXES,
     PointsFile,
@@ -22,7 +22,7 @@ from .points import (
     read_point_file,
     read_points,
 )
-from .write import atomic_path, atomic_write, write_text
+from .write import atomic_path, atomic_write, check_output, write_text
 
 __all__ = [
     "read_points",
@@ -34,12 +34,14 @@ __all__ = [
     "read_bytes",
     "read_text",
     "event_log",
+    "EventLog",
     "parse_points",
     "parse_curve_points",
     "exact_number",
     "atomic_path",
     "atomic_write",
     "write_text",
+    "check_output",
     "MAX_BYTES",
     "STDIN_SILENCE_S",
     "TABLE_SUFFIXES",

@@ -16,7 +16,8 @@ from collections.abc import Iterator
 
 from ..errors import InputError
 
-__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "read_bytes", "read_text", "read_program", "event_log"]
+__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "read_bytes", "read_text", "read_program", "event_log",
+           "EventLog"]
 
 MAX_BYTES = 64 * 1024 * 1024
 
@@ -117,19 +118,60 @@ def read_program(path: str | os.PathLike) -> str:
                          f"a control reads ASCII programs") from None
 
 
+class EventLog:
+    """Appends a time-stamped line per event to an open log file.
+
+    A write that fails (a full disk) is not raised in the middle of a
+    transfer: the log stops, :attr:`lost` says why and after how many lines,
+    and ``on_lost`` hears it once.  The command then reports the log as lost
+    rather than the transfer as done.
+    """
+
+    def __init__(self, fh, path, on_lost=None):
+        self.fh, self.path, self.on_lost = fh, path, on_lost
+        self.lines = 0
+        self.error: str | None = None  # why the first failed write failed
+        self.lost: str | None = None  # that, and after how many lines
+
+    def __call__(self, message: str) -> None:
+        if self.lost is not None:
+            return
+        try:
+            self.fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
+            self.fh.flush()
+        except OSError as e:
+            self.error = str(e.strerror or e)
+            self.lost = f"{self.error} after {self.lines} lines"
+            if self.on_lost:
+                self.on_lost(self.lost)
+            return
+        self.lines += 1
+
+
 @contextlib.contextmanager
-def event_log(path: str | os.PathLike | None) -> Iterator:
-    """A function that appends a time-stamped line to the log file ``path``, or None without a path."""
+def event_log(path: str | os.PathLike | None, option: str = "--log", on_lost=None) -> Iterator:
+    """An :class:`EventLog` on the file ``path``, opened for appending, or None without a path.
+
+    The file is tried with a first line before anything starts, so a log
+    that cannot be written (no permission, a full disk) is refused at once,
+    with ``option`` and the path.
+    """
     if not path:
         yield None
         return
     try:
         fh = open(path, "a", encoding="utf-8")
     except OSError as e:
-        raise InputError(f"{path}: cannot open the log file ({e.strerror or e})") from None
-    with fh:
-        def log(message: str) -> None:
-            fh.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {message}\n")
-            fh.flush()
-
+        raise InputError(f"{option} {path}: cannot open the log file ({e.strerror or e})") from None
+    try:
+        log = EventLog(fh, path, on_lost)
+        log("log opened")
+        if log.lost is not None:
+            raise InputError(f"{option} {path}: cannot write the log file ({log.error}); "
+                             "nothing was started")
         yield log
+    finally:
+        try:
+            fh.close()
+        except OSError:
+            pass  # every line was flushed as it was written; a failure is already in log.lost

@@ -19,7 +19,7 @@ from typing import IO
 
 from ..errors import InputError, OutputError
 
-__all__ = ["atomic_path", "atomic_write", "write_text"]
+__all__ = ["atomic_path", "atomic_write", "write_text", "check_output"]
 
 
 def _write_error(path, e: OSError) -> OutputError:
@@ -35,8 +35,26 @@ def _is_stream(given: Path, real: Path) -> bool:
         return True
     try:
         return not stat.S_ISREG(real.stat().st_mode)
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # a new name; its folder is checked next
         return False
+
+
+def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
+    """Whether ``path`` can be written, before any work: ``(real path, written through, folder of the temporary)``.
+
+    Raises :class:`InputError` for a folder, a name under something that is
+    not a folder, or a missing folder.
+    """
+    given = Path(path)
+    real = Path(os.path.realpath(given))
+    if real.is_dir():
+        raise InputError(f"{path}: is a directory")
+    stream = _is_stream(given, real)
+    directory = Path(tempfile.gettempdir()) if stream else real.parent
+    if not directory.is_dir():
+        what = f"{directory} is not a folder" if directory.exists() else f"the folder {directory} does not exist"
+        raise InputError(f"{path}: {what}")
+    return real, stream, directory
 
 
 @contextlib.contextmanager
@@ -58,13 +76,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[str]:
     untouched and no partial file behind, and is one :class:`OutputError`.
     """
     given = Path(path)
-    real = Path(os.path.realpath(given))
-    if real.is_dir():
-        raise InputError(f"{path}: is a directory")
-    stream = _is_stream(given, real)
-    directory = Path(tempfile.gettempdir()) if stream else real.parent
-    if not directory.is_dir():
-        raise InputError(f"{path}: the folder {directory} does not exist")
+    real, stream, directory = check_output(path)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".part" + real.suffix, dir=directory)
     except OSError as e:

@@ -20,7 +20,8 @@ from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec
 from ..toolpath import plan_toolpath
-from ..toolpath.rough import FEED, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
+from ..toolpath.plan import MAX_PLAN_POINTS
+from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
 from .spec import JobSpec, OperationSpec, ToolSpec
 
 __all__ = ["Operation", "plan_job", "job_stock", "PlannedJob"]
@@ -86,8 +87,13 @@ def _settings(spec: JobSpec, op: OperationSpec | None = None, stock_mm: float = 
                            program_number=spec.program_number, work_offset=spec.work_offset, **kw)
 
 
-def plan_job(spec: JobSpec) -> PlannedJob:
-    """Read the points, build the block and plan every operation in order."""
+def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
+             max_samples: int | None = MAX_ROUGH_SAMPLES) -> PlannedJob:
+    """Read the points, build the block and plan every operation in order.
+
+    Each operation is estimated before it is planned: at most ``max_points``
+    points, and a roughing level at most ``max_samples`` drop-cutter samples.
+    """
     surface = lagrange_surface(read_points(spec.points))
     ev = surface_evaluator(surface)
     stock = job_stock(spec, surface, ev)
@@ -96,20 +102,21 @@ def plan_job(spec: JobSpec) -> PlannedJob:
     ops = []
     for i, op in enumerate(spec.operations):
         try:
-            ops.append(_plan(spec, op, spec.tools[op.tool], surface, ev, stock, i))
+            ops.append(_plan(spec, op, spec.tools[op.tool], surface, ev, stock, i, (max_points, max_samples)))
         except ToolpathError as e:
             raise InputError(f"{spec.source}: operations[{i}] ({op.kind}): {e}") from None
     return PlannedJob(spec, surface, stock, tuple(ops))
 
 
-def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, i: int) -> Operation:
+def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, i: int,
+          limits: tuple) -> Operation:
     o = op.options
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
                        step_mm=o.get("step", 0.5), stock_to_leave_mm=o.get("stock_to_leave", 0.3),
                        direction=o.get("direction", "x"), milling=o.get("milling", "zigzag"),
                        flute_length_mm=tool.flute_length_mm, reach_mm=tool.reach_mm)
-        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev)
+        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev, *limits)
         return Operation(op, tool, rp.points_mm, rp.kinds, rp)
     default_dir = "y" if op.kind == "cross-finish" else "x"
     stepover = o.get("stepover", None if "scallop" in o else 0.5)
@@ -118,7 +125,8 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
         raster = RasterSpec(o.get("direction", default_dir), stepover, step, o.get("scallop"), o.get("tolerance"))
     except LagsymError as e:
         raise ToolpathError(str(e)) from None
-    tp = plan_toolpath(surface, tool.tool, raster, _settings(spec, op, o.get("stock_to_leave", 0.0)), ev)
+    tp = plan_toolpath(surface, tool.tool, raster, _settings(spec, op, o.get("stock_to_leave", 0.0)), ev,
+                       max_points=limits[0])
     _check_reach(tool, stock, tp.points_mm[:, 2].min())
     p = tp.points_mm
     above = stock.top_mm + 2.0

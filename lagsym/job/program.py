@@ -87,8 +87,7 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
     out.append(_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM", spec.dialect))
     for i, (op, m) in enumerate(zip(job.operations, minutes), 1):
         t = op.tool
-        out.append(_comment(f"{i} {op.spec.kind} T{t.number} {t.tool.shape} D{t.tool.diameter_mm:g} "
-                            f"{m:.1f} MIN", spec.dialect))
+        out.append(_comment(f"{i} {op.spec.kind} T{t.number} {t.tool.label} {m:.1f} MIN", spec.dialect))
     out.append(_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN",
                         spec.dialect))
     out.append(f"{units_word(s)} G17 G90 G94" if spec.dialect == "grbl" else f"{units_word(s)} G17 G40 G49 G80 G90 G94")
@@ -100,8 +99,7 @@ def _operation(op, s: MachineSettings, spec, changed: bool) -> list[str]:
     """The blocks of one operation: tool change (when the tool changes), spindle, coolant, moves, retract."""
     t, p = op.tool, op.points_mm
     num = lambda v: fixed(float(v) * s.unit_factor, s.digits)  # noqa: E731 - one length format for this operation
-    out = [_comment(f"{op.spec.kind} {t.name} T{t.number} {t.tool.shape} END D{t.tool.diameter_mm:g} MM",
-                    spec.dialect)]
+    out = [_comment(f"{op.spec.kind} {t.name} T{t.number} {t.tool.label}", spec.dialect)]
     if changed:
         if spec.dialect == "grbl":
             out += ["M05", f"G00 Z{num(spec.safe_z_mm)}", _comment(f"LOAD T{t.number} AND SET ITS LENGTH", "grbl"),

@@ -33,6 +33,7 @@ from ..errors import InputError, LagsymError
 from ..io.files import read_bytes
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING
+from ..values import in_range
 
 __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KINDS", "COOLANTS"]
 
@@ -45,7 +46,8 @@ _TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": l
         "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
         "operations": list}
 _STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
-_TOOL = {"number": int, "shape": str, "diameter": float, "flute_length": float, "reach": float}
+_TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float, "flute_length": float,
+         "reach": float}
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str}
@@ -130,11 +132,30 @@ def _choice(value, options, key: str, source: str):
     return value
 
 
+# The ranges of the command line's options (lagsym.cli._common), by the last part of the key: every number
+# of a job file is finite and one a program word and the planners can hold.
+_RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plunge_feed": (1.0, 1e5),
+           "spindle": (1.0, 2e5), "diameter": (0.0, 1000.0), "flute_length": (0.0, 1e4), "reach": (0.0, 1e4),
+           "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
+           "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
+           "tolerance": (1e-6, 1000.0)}
+_LENGTH_MM = 1e5  # safe_z, origin and block coordinates: within 100 m
+
+
 def _positive(value, key: str, source: str, allow_zero: bool = False) -> float:
+    low, high = _RANGES[key.rsplit(".", 1)[-1]]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{source}: {key} = {value!r} must be a number")
     v = float(value)
     if not (v == v and abs(v) != float("inf")) or v < 0 or (v == 0 and not allow_zero):
         raise InputError(f"{source}: {key} = {value!r} must be a number {'0 or more' if allow_zero else 'above 0'}")
-    return v
+    return in_range(v, f"{source}: {key}", low, high, above=low == 0 and not allow_zero)
+
+
+def _length(value, key: str, source: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{source}: {key} = {value!r} must be a number of mm")
+    return in_range(value, f"{source}: {key}", -_LENGTH_MM, _LENGTH_MM, unit="mm")
 
 
 def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobSpec:
@@ -166,11 +187,11 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         dialect=_choice(data.get("dialect", "fanuc"), JOB_DIALECTS, "dialect", source),
         units=_choice(data.get("units", "mm"), UNITS, "units", source),
         mm_per_unit=_positive(data.get("scale", 1.0), "scale", source),
-        origin_mm=tuple(float(v) for v in origin),
+        origin_mm=tuple(_length(v, f"origin[{k}]", source) for k, v in enumerate(origin)),
         work_offset=_choice(data.get("work_offset", "G54"), ("G54", "G55", "G56", "G57", "G58", "G59"),
                             "work_offset", source),
         program_number=program_number,
-        safe_z_mm=float(data.get("safe_z", 50.0)),
+        safe_z_mm=_length(data.get("safe_z", 50.0), "safe_z", source),
         rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
         title=data.get("title", Path(data["points"]).stem),
         stock=_stock(data["stock"], source), tools=tools, operations=ops)
@@ -186,6 +207,10 @@ def _stock(table: dict, source: str) -> dict:
         b = table["block"]
         if len(b) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in b):
             raise InputError(f"{source}: stock.block = {b!r} must be four numbers [x0, x1, y0, y1] in mm")
+        for k, v in enumerate(b):
+            _length(v, f"stock.block[{k}]", source)
+    if "top" in table:
+        _length(table["top"], "stock.top", source)
     if "margin" in table:
         _positive(table["margin"], "stock.margin", source, allow_zero=True)
     if "top_above" in table:
@@ -203,7 +228,8 @@ def _tool(name: str, table: dict, source: str) -> ToolSpec:
         raise InputError(f"{source}: {where}number = {table['number']} must be 1 to 99")
     shape = _choice(table["shape"], TOOL_SHAPES, where + "shape", source)
     try:
-        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source))
+        corner = _positive(table["corner_radius"], where + "corner_radius", source) if "corner_radius" in table else None
+        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source), corner)
     except LagsymError as e:
         raise InputError(f"{source}: {where}: {e}") from None
     opt = {k: _positive(table[k], where + k, source) for k in ("flute_length", "reach") if k in table}

@@ -9,7 +9,7 @@ from ..gcode.limits import check_axis, check_blocks, check_settings
 from ..gcode.numbers import fixed
 from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
-from .model import Const, Op, Sqrt, Var, variables, written
+from .model import Const, Op, Round, Sqrt, Var, variables, written
 
 __all__ = ["number_variables", "expression", "literal", "iso_start", "iso_end", "header_comments", "check_text"]
 
@@ -102,6 +102,8 @@ def expression(e, name, precision: int) -> str:
         return literal(e.value, precision)
     if isinstance(e, Sqrt):
         return f"SQRT[{_inner(e.a, name, precision)}]"
+    if isinstance(e, Round):
+        return f"ROUND[{_inner(e.a, name, precision)}]"
     return f"[{_chain(e, name, precision)}]"
 
 

@@ -19,6 +19,7 @@ refuses.
 from __future__ import annotations
 
 import dataclasses
+from fractions import Fraction
 
 import numpy as np
 
@@ -30,9 +31,10 @@ from ..values import as_exact
 from .form import RowForm, row_form
 from .model import Assign, add, const, div, mul, sqrt, sub, var
 from .raster import MacroRaster, sample_positions
+from .rounding import tip_lift, tips_on_grid
 
 __all__ = ["is_ball", "refuse_flat_end", "ball_offsets", "contact_form", "offset_points", "offset_statements", "TIP_OUTPUTS",
-           "check_gouge", "check_gouge_over", "tip_points", "derivatives"]
+           "check_gouge", "check_gouge_over", "checked_tip_lift", "ball_tips", "tip_points", "derivatives"]
 
 TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is computed into
 
@@ -51,11 +53,12 @@ def refuse_flat_end(tool: Tool | None) -> None:
     surface slopes and the cutter would cut into the part (30.4 mm on paper
     example 1 at scale 10 with a 6 mm cutter).
     """
-    if tool is not None and tool.shape == "flat" and tool.diameter_mm > 0:
+    if tool is not None and tool.shape in ("flat", "bull") and tool.diameter_mm > 0:
+        what = "flat-end" if tool.shape == "flat" else "bull-nose"
         raise ToolpathError(
-            f"a flat-end cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
+            f"a {what} cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
             "which a macro cannot compute on the control: use the point-list toolpath "
-            "(lagsym toolpath --tool-shape flat), which drops the flat end onto the exact surface, "
+            f"(lagsym toolpath --tool-shape {tool.shape}), which drops the cutter onto the exact surface, "
             "or a ball end (--tool-shape ball), or --tool-diameter 0 for the surface itself")
 
 
@@ -85,6 +88,20 @@ def offset_points(form: RowForm, radius: float, offset: float, p, r):
     return np.asarray(p) - q * f["zp"], np.asarray(r) - q * f["zr"], f["z"] + q - radius
 
 
+def ball_tips(form: RowForm, radius: float, offset: float, p, r, resolution: Fraction = Fraction(0),
+              lift: Fraction = Fraction(0)):
+    """The tips the program moves to for contact points (p, r): offset, then rounded as on the control.
+
+    With a ``resolution`` (see :mod:`lagsym.macro.rounding`) the tip is
+    rounded to it and its height moved along the tangent plane and raised by ``lift``.
+    """
+    pt, rt, zt = offset_points(form, radius, offset, p, r)
+    if not resolution:
+        return pt, rt, zt
+    f = derivatives(form, p, r)
+    return tips_on_grid(pt, rt, zt, f["zp"], f["zr"], float(resolution), float(lift))
+
+
 def offset_statements(radius: float, offset: float) -> tuple:
     """Statements run once per point after the height and slopes: the tip into :data:`TIP_OUTPUTS`."""
     p, r, z = var("p"), var("r"), var("z")
@@ -99,11 +116,12 @@ def offset_statements(radius: float, offset: float) -> tuple:
     )
 
 
-def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", unit: float = 1.0) -> None:
+def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", unit: float = 1.0):
     """Refuse a normal offset where the surface is concave tighter than the ball (radius in program units).
 
     The larger principal curvature of the graph ``Z(P, R)`` (positive where the
     surface is concave, seen from the tool) is checked at every point (p, r).
+    Returns it, and ``Zp**2 + Zr**2`` there.
     """
     f = derivatives(form, p, r)
     fx, fy, fxx, fxy, fyy = f["zp"], f["zr"], f["zpp"], f["zpr"], f["zrr"]
@@ -120,13 +138,21 @@ def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", u
             f"({pp:.3f}, {rr:.3f}) mm, below the offset radius {radius / unit:g} mm (ball radius plus stock): "
             f"an offset along the normal would gouge there; use a ball of diameter at most {2 * rc:.3g} mm, "
             f"or the point-list toolpath (lagsym toolpath, drop-cutter)")
+    return kmax, g - 1.0
 
 
-def check_gouge_over(form: RowForm, raster: MacroRaster, offset: float, source: str, unit: float) -> None:
+def check_gouge_over(form: RowForm, raster: MacroRaster, offset: float, source: str, unit: float):
     """:func:`check_gouge` over the raster: every position, or 1001 x 1001 of them evenly spread."""
     xs, ys = sample_positions(raster, 1001)
     p, r = (xs, ys) if raster.direction == "x" else (ys, xs)
-    check_gouge(form, p, r, offset, source, unit)
+    return check_gouge(form, p, r, offset, source, unit)
+
+
+def checked_tip_lift(form: RowForm, raster: MacroRaster, offset: float, resolution: Fraction, source: str = "<surface>",
+                     unit: float = 1.0) -> Fraction:
+    """:func:`check_gouge_over`, then the lift of the rounded tips (:func:`lagsym.macro.rounding.tip_lift`)."""
+    kmax, slopes_sq = check_gouge_over(form, raster, offset, source, unit)
+    return tip_lift(kmax, slopes_sq, offset, resolution) if resolution else Fraction(0)
 
 
 def tip_points(surface: LagrangeSurface, settings: MachineSettings, tool: Tool, x, y) -> np.ndarray:

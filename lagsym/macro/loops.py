@@ -18,7 +18,10 @@
 
 so positions are always ``start + count * step`` and never drift.  For a
 ball-end cutter the point statements go on to the slopes and the tool tip
-(:mod:`lagsym.macro.ballend`), and the move goes to the tip.
+(:mod:`lagsym.macro.ballend`), and the move goes to the tip.  Where the
+macro language has ``ROUND``, the positions moved to are rounded to the
+program's last decimal before their height is computed, and the height is
+raised by half a unit (:mod:`lagsym.macro.rounding`).
 """
 
 from __future__ import annotations
@@ -30,11 +33,12 @@ import numpy as np
 
 from ..lagrange import LagrangeSurface, horner2
 from ..machine import MachineSettings, RasterSpec, Tool
-from .ballend import TIP_OUTPUTS, ball_offsets, check_gouge_over, contact_form, is_ball, offset_points, \
+from .ballend import TIP_OUTPUTS, ball_offsets, ball_tips, checked_tip_lift, contact_form, is_ball, offset_points, \
     offset_statements, refuse_flat_end
 from .form import RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, mul, sub, var
 from .raster import MacroRaster, macro_raster
+from .rounding import resolution, round_statement, tip_statements
 
 __all__ = ["MacroLoops", "macro_loops", "zigzag_loops", "exact_height"]
 
@@ -56,11 +60,17 @@ class MacroLoops:
     row_code, point_code : tuple
         The straight-line statements run once per row (from ``r``) and once per
         point (from ``p``); :func:`~lagsym.macro.accuracy.predicted_error` runs them on the PC.
+    finish_code : tuple
+        Run after ``point_code``: the tip rounded to the program's resolution
+        and the height raised by half a unit (see :mod:`lagsym.macro.rounding`).
     outputs : tuple of str
         The variables moved to, in the order (P, R, Z): along the row, across, height.
     ball_radius, ball_offset : float
         For a ball-end cutter, its radius and the distance of its centre from the
         surface (radius plus stock), in program units; 0 for a point on the surface.
+    resolution, tip_lift : Fraction
+        The unit positions are rounded to on the control (0: not rounded), and
+        what a rounded tip's height is raised by.
     """
 
     body: tuple
@@ -69,9 +79,12 @@ class MacroLoops:
     start: tuple
     row_code: tuple = ()
     point_code: tuple = ()
+    finish_code: tuple = ()
     outputs: tuple[str, str, str] = ("p", "r", "z")
     ball_radius: float = 0.0
     ball_offset: float = 0.0
+    resolution: Fraction = Fraction(0)
+    tip_lift: Fraction = Fraction(0)
 
     def reference(self, p: Fraction, r: Fraction) -> tuple:
         """The point (P, R, Z) the program should reach at raster position (p, r), computed on the PC.
@@ -91,7 +104,7 @@ def exact_height(form: RowForm, p: Fraction, r: Fraction) -> Fraction:
     return horner2(form.coefficients, (p - form.pc) * form.pk, (r - form.rc) * form.rk) + form.z0
 
 
-def zigzag_loops(raster: MacroRaster, row_code, point_code, outputs=("p", "r", "z")) -> tuple:
+def zigzag_loops(raster: MacroRaster, row_code, point_code, outputs=("p", "r", "z"), finish_code=()) -> tuple:
     """The counted zig-zag loops around the per-row and per-point statements (see the module docstring)."""
     rows, pts = raster.rows, raster.points
     j, d, i, k, t = var("j"), var("d"), var("i"), var("k"), var("t")
@@ -103,6 +116,7 @@ def zigzag_loops(raster: MacroRaster, row_code, point_code, outputs=("p", "r", "
         Assign(p, add(const(pts.start), mul(k, const(pts.step)))),
         Clamp(p, const(pts.end)),
         *point_code,
+        *finish_code,
         Move(mp, mr, mz) if raster.direction == "x" else Move(mr, mp, mz),
     ]
     row_body = [
@@ -132,12 +146,15 @@ def macro_loops(surface: LagrangeSurface, settings: MachineSettings, raster: Ras
     if is_ball(tool):
         return _ball_loops(surface, settings, counted, tool, form)
     rf = row_form(surface, settings, counted.direction, form)
-    row_code = tuple(row_statements(rf, var("r")))
-    point_code = tuple(point_statements(rf, var("p"), var("z")))
+    unit = resolution(settings)
+    rounding = (round_statement(var("r"), unit),) if unit else ()
+    row_code = rounding + tuple(row_statements(rf, var("r")))
+    point_code = ((round_statement(var("p"), unit),) if unit else ()) + tuple(point_statements(rf, var("p"), var("z")))
+    finish = (Assign(var("z"), add(var("z"), const(unit / 2))),) if unit else ()
     p0, r0 = counted.points.start, counted.rows.start
-    return MacroLoops(body=zigzag_loops(counted, row_code, point_code), raster=counted, form=rf,
-                      start=_in_xyz(counted, p0, r0, exact_height(rf, p0, r0)),
-                      row_code=row_code, point_code=point_code)
+    return MacroLoops(body=zigzag_loops(counted, row_code, point_code, finish_code=finish), raster=counted, form=rf,
+                      start=_in_xyz(counted, p0, r0, exact_height(rf, p0, r0) + unit / 2),
+                      row_code=row_code, point_code=point_code, finish_code=finish, resolution=unit)
 
 
 def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: MacroRaster, tool: Tool,
@@ -145,12 +162,14 @@ def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: Ma
     """The loops for a ball-end cutter: height, exact slopes and the normal offset on the control."""
     rf = contact_form(surface, settings, counted.direction, form)
     radius, offset = ball_offsets(settings, tool)
-    check_gouge_over(rf, counted, offset, surface.grid.source, settings.unit_factor)
+    unit = resolution(settings)
+    lift = checked_tip_lift(rf, counted, offset, unit, surface.grid.source, settings.unit_factor)
     row_code = tuple(row_statements(rf, var("r"), slopes=True))
     point_code = tuple(point_statements(rf, var("p"), var("z"), slopes=True)) + offset_statements(radius, offset)
-    p0, r0, z0 = offset_points(rf, radius, offset, np.array([float(counted.points.start)]),
-                               np.array([float(counted.rows.start)]))
-    return MacroLoops(body=zigzag_loops(counted, row_code, point_code, TIP_OUTPUTS), raster=counted, form=rf,
+    finish = tip_statements(unit, lift) if unit else ()
+    p0, r0, z0 = ball_tips(rf, radius, offset, np.array([float(counted.points.start)]),
+                           np.array([float(counted.rows.start)]), unit, lift)
+    return MacroLoops(body=zigzag_loops(counted, row_code, point_code, TIP_OUTPUTS, finish), raster=counted, form=rf,
                       start=_in_xyz(counted, float(p0[0]), float(r0[0]), float(z0[0])),
-                      row_code=row_code, point_code=point_code, outputs=TIP_OUTPUTS,
-                      ball_radius=radius, ball_offset=offset)
+                      row_code=row_code, point_code=point_code, finish_code=finish, outputs=TIP_OUTPUTS,
+                      ball_radius=radius, ball_offset=offset, resolution=unit, tip_lift=lift)

@@ -11,13 +11,13 @@ predicts a program's arithmetic error before it is written.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from decimal import ROUND_HALF_EVEN, Context, Decimal, localcontext
+from decimal import ROUND_HALF_EVEN, ROUND_HALF_UP, Context, Decimal, localcontext
 from fractions import Fraction
 from typing import Union
 
 from ..errors import ProgramError
 
-__all__ = ["Var", "Const", "Op", "Sqrt", "div", "sqrt", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
+__all__ = ["Var", "Const", "Op", "Sqrt", "Round", "div", "sqrt", "round_", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
            "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables", "written"]
 
 
@@ -51,7 +51,14 @@ class Sqrt:
     a: "Expr"
 
 
-Expr = Union[Var, Const, Op, Sqrt]
+@dataclass(frozen=True)
+class Round:
+    """The nearest integer, halves away from zero (Fanuc and LinuxCNC ``ROUND[..]``)."""
+
+    a: "Expr"
+
+
+Expr = Union[Var, Const, Op, Sqrt, Round]
 
 
 @dataclass(frozen=True)
@@ -126,6 +133,11 @@ def sqrt(a: Expr) -> Sqrt:
     return Sqrt(a)
 
 
+def round_(a: Expr) -> Round:
+    """``ROUND[a]``."""
+    return Round(a)
+
+
 def decimal_context(precision: int) -> Context:
     """Decimal arithmetic with ``precision`` significant digits, rounding half to even."""
     return Context(prec=precision, rounding=ROUND_HALF_EVEN, Emin=-999, Emax=999)
@@ -167,6 +179,8 @@ def _eval(e: Expr, env: dict, ctx: Context) -> Decimal:
         return _constant(e.value, ctx)
     if isinstance(e, Sqrt):
         return ctx.sqrt(_eval(e.a, env, ctx))
+    if isinstance(e, Round):
+        return _eval(e.a, env, ctx).to_integral_value(rounding=ROUND_HALF_UP)
     a, b = _eval(e.a, env, ctx), _eval(e.b, env, ctx)
     if e.op == "+":
         return ctx.add(a, b)

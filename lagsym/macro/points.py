@@ -14,8 +14,9 @@ from ..evaluate import evaluate_points
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ._placement import placement
-from .ballend import is_ball, refuse_flat_end, tip_points
+from .ballend import ball_offsets, ball_tips, checked_tip_lift, contact_form, is_ball, refuse_flat_end, tip_points
 from .raster import macro_raster, raster_positions
+from .rounding import resolution, round_half_away
 
 __all__ = ["points_at", "planned_points"]
 
@@ -44,7 +45,24 @@ def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: 
     """The points a macro program should move through, computed on the PC: an (N, 3) array in program units.
 
     Every raster position in the order the program visits them, through
-    :func:`points_at`.  The program's first feed move (the plunge) ends at the
-    first of these points.
+    :func:`points_at`, rounded as the program rounds them on the control
+    (:mod:`lagsym.macro.rounding`): the position to the last decimal first
+    and the height there, raised by half a unit; for a ball end the tip
+    rounded, its height moved along the tangent plane and raised.  The
+    program's first feed move (the plunge) ends at the first of these points.
     """
-    return points_at(surface, settings, tool, *raster_positions(macro_raster(surface, settings, raster)))
+    counted = macro_raster(surface, settings, raster)
+    x, y = raster_positions(counted)
+    unit = resolution(settings)
+    if not is_ball(tool):
+        if unit:
+            x, y = round_half_away(x, float(unit)), round_half_away(y, float(unit))
+        pts = points_at(surface, settings, tool, x, y)
+        pts[:, 2] += float(unit / 2)
+        return pts
+    radius, offset = ball_offsets(settings, tool)
+    form = contact_form(surface, settings, counted.direction)
+    lift = checked_tip_lift(form, counted, offset, unit)
+    p, r = (x, y) if counted.direction == "x" else (y, x)
+    pt, rt, zt = ball_tips(form, radius, offset, p, r, unit, lift)
+    return np.column_stack([pt, rt, zt] if counted.direction == "x" else [rt, pt, zt])

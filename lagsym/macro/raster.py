@@ -2,7 +2,8 @@
 
 A macro raster is the control points' box, scaled by ``scale`` and moved by
 ``origin_mm``, cut in rows along ``direction`` at the side step, each row
-sampled at the forward step.  Rows and points are counted with integers: the
+sampled at the forward step; the box edges are moved inward onto the
+program's last decimal.  Rows and points are counted with integers: the
 ``j``-th row sits at ``r0 + j * dr`` and the ``k``-th point at ``p0 + k * dp``,
 so no error accumulates; the last row and the last point, which usually
 overshoot the box, are clamped to its edge.  Rows alternate in direction
@@ -104,11 +105,11 @@ def macro_raster(surface: LagrangeSurface, settings: MachineSettings, raster: Ra
     x0, x1, y0, y1 = surface.grid.bounds
     place = placement(settings)
     s, (ox, oy, _) = place.scale, place.origin
-    xa = (x0 * s + ox, x1 * s + ox)
-    ya = (y0 * s + oy, y1 * s + oy)
+    unit = Fraction(1, 10 ** settings.digits)
+    xa = _inward(x0 * s + ox, x1 * s + ox, unit)
+    ya = _inward(y0 * s + oy, y1 * s + oy, unit)
     side = as_exact(raster.stepover_mm, "side step") * place.per_mm
     forward = as_exact(raster.step_mm, "forward step") * place.per_mm
-    unit = Fraction(1, 10 ** settings.digits)
     for what, step in (("side step", side), ("forward step", forward)):
         if step < unit:  # the control would repeat the previous block, to the program's last decimal
             raise ToolpathError(f"{what} {float(step):g} is below the program's resolution {float(unit):g} "
@@ -116,6 +117,12 @@ def macro_raster(surface: LagrangeSurface, settings: MachineSettings, raster: Ra
     if raster.direction == "x":
         return MacroRaster("x", rows=_axis("Y", *ya, side), points=_axis("X", *xa, forward))
     return MacroRaster("y", rows=_axis("X", *xa, side), points=_axis("Y", *ya, forward))
+
+
+def _inward(lo: Fraction, hi: Fraction, unit: Fraction) -> tuple[Fraction, Fraction]:
+    """The box edges on the program's resolution, moved inward: a rounded position then stays inside the box."""
+    a, b = math.ceil(lo / unit) * unit, math.floor(hi / unit) * unit
+    return (a, b) if a < b else (lo, hi)
 
 
 def raster_positions(raster: MacroRaster) -> tuple[np.ndarray, np.ndarray]:

@@ -27,7 +27,11 @@ The modules, one concern each:
 - :mod:`~lagsym.plot.compare`: methods side by side, and deviation maps;
 - :mod:`~lagsym.plot.growth`: the deviation against the degree (Figure 11);
 - :mod:`~lagsym.plot.toolpath`: a cutter path over its surface;
+- :mod:`~lagsym.plot.machined`: the block after each stage of a job, coloured
+  by the material left;
 - :mod:`~lagsym.plot.output`: image formats and writing images;
+- :mod:`~lagsym.plot.inline`: the rich display of a surface or a curve in
+  Jupyter (imported on the first display, not here);
 - :mod:`~lagsym.plot.style`, :mod:`~lagsym.plot.meshes` and
   :mod:`~lagsym.plot.checks`: the look, the pyvista data and the argument
   checks the figures share.
@@ -38,6 +42,7 @@ from __future__ import annotations
 from .backend import DEFAULT_WINDOW_SIZE, rendering_backend
 from .compare import DEVIATION_WINDOW_SIZE, compare_figure, deviation_figure
 from .growth import DegreeGrowth, degree_growth, growth_figure
+from .machined import machined_figure
 from .output import IMAGE_FORMATS, deviation_map, image_format, save_figure
 from .style import BASIS_CMAP, DEVIATION_CMAP, FEED_COLOR, NET_COLOR, POINT_COLOR, RAPID_COLOR, SURFACE_CMAP
 from .surface import basis_figure, curve_basis_figure, curve_figure, surface_figure
@@ -49,6 +54,7 @@ __all__ = [
     "basis_figure",
     "compare_figure",
     "toolpath_figure",
+    "machined_figure",
     "deviation_figure",
     "deviation_map",
     "curve_basis_figure",

@@ -94,7 +94,7 @@ def surface_figure(surface, *, samples: int = 61, units: str | None = None, titl
                show_scalar_bar=scalar_bar, scalar_bar_args=bar_args(name, h))
     if control_net:
         g = surface.grid
-        _add_control(p, g.x_array, g.y_array, g.z_array)
+        add_control(p, g.x_array, g.y_array, g.z_array)
     factor = z_factor(z_exaggeration, np.ptp(xs), np.ptp(ys), float(np.ptp(zz)))
     p.set_scale(zscale=factor)
     axis_labels(p, units, font_size=text_size(h, 1 / 45), axes_ranges=true_ranges(p))
@@ -106,7 +106,8 @@ def surface_figure(surface, *, samples: int = 61, units: str | None = None, titl
     return p
 
 
-def _add_control(p, x, y, z, size: float = 12.0) -> None:
+def add_control(p, x, y, z, size: float = 12.0) -> None:
+    """The control points ``z[i, k]`` at ``(x[i], y[k])`` as dots, and the net joining them."""
     net = structured(x, y, z)
     p.add_mesh(net.extract_all_edges(), color=NET_COLOR, line_width=2, lighting=False)
     p.add_mesh(pointcloud(np.asarray(net.points)), color=POINT_COLOR, point_size=size,

@@ -71,7 +71,9 @@ class PointProgram:
 def point_program(toolpath, settings: MachineSettings, title: str = "") -> PointProgram:
     """The program model of a :class:`~lagsym.toolpath.Toolpath` for one machine."""
     t = toolpath.tool
-    tool = f"T{settings.tool_number} {t.shape.upper()} END D{t.diameter_mm:g} MM"
+    tool = f"T{settings.tool_number} {t.label}"
+    if toolpath.cusp_mm is not None:  # rows from a scallop height: the worst cusp they are predicted to leave
+        tool += f" CUSP AT MOST {toolpath.cusp_mm:.4f} MM NORMAL TO SURFACE"
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
 
 

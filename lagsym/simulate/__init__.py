@@ -14,7 +14,9 @@ constant.  It returns the moves the control would make, or raises
   0.012 mm; lagsym refuses it rather than guess);
 * a variable outside the range the dialect allows;
 * a block longer than the control reads; division by zero, the square root of
-  a negative number, a jump to a missing sequence number or label, a runaway loop.
+  a negative number, a jump to a missing sequence number or label;
+* a runaway loop (:mod:`~lagsym.simulate.runaway`): back at a block with
+  nothing changed, too many blocks without a move, or too many blocks in all.
 
 The simulator covers what lagsym emits plus the common core of each language
 (``IF [..] GOTO n``, ``IF [..] THEN``, ``GOTO``, the functions every Macro B
@@ -26,6 +28,7 @@ into typed :mod:`~lagsym.simulate.blocks` with one parser per dialect
 :mod:`~lagsym.simulate.heidenhain`) and the expressions of
 :mod:`~lagsym.simulate.expressions`; :mod:`~lagsym.simulate.executor` runs
 them on the arithmetic and variables of :mod:`~lagsym.simulate.control`;
+:mod:`~lagsym.simulate.runaway` stops a program that would never end;
 :mod:`~lagsym.simulate.result` holds what comes back.
 """
 
@@ -36,7 +39,9 @@ from .alarms import ControlAlarm
 from .executor import MAX_DO, simulate
 from .expressions import MAX_BRACKETS
 from .reader import SIM_DIALECTS, detect_dialect
-from .result import SimMove, Simulation, moves_csv
+from .result import BYTES_PER_MOVE, SimMove, SimMoves, Simulation, moves_csv
+from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS
 
-__all__ = ["ControlAlarm", "SimMove", "Simulation", "simulate", "detect_dialect", "moves_csv",
-           "SIM_DIALECTS", "VARIABLE_RANGES", "MAX_BLOCK", "MAX_BRACKETS", "MAX_DO"]
+__all__ = ["ControlAlarm", "SimMove", "SimMoves", "Simulation", "simulate", "detect_dialect", "moves_csv",
+           "SIM_DIALECTS", "VARIABLE_RANGES", "MAX_BLOCK", "MAX_BRACKETS", "MAX_DO",
+           "MAX_BLOCKS", "MAX_IDLE_BLOCKS", "BYTES_PER_MOVE"]

@@ -11,7 +11,7 @@ import math
 from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND_UP, Context, Decimal
 
 from .alarms import BlockAlarm
-from .result import SimMove
+from .result import SimMoves
 
 __all__ = ["Control"]
 
@@ -28,7 +28,7 @@ class Control:
         self.motion = "G0"
         self.feed = Decimal(0)
         self.absolute = True
-        self.moves: list[SimMove] = []
+        self.moves = SimMoves()
 
     def const(self, text: str) -> Decimal:
         value = self.constants.get(text)
@@ -109,5 +109,14 @@ class Control:
                 v = words[letter]
                 self.pos[axis] = v if self.absolute else self.ctx.add(self.pos[axis], v)
         if any(k in words for k in "XYZ"):
-            self.moves.append(SimMove(line, self.motion, float(self.pos[0]), float(self.pos[1]),
-                                      float(self.pos[2]), float(self.feed)))
+            self.moves.append(line, self.motion == "G0", float(self.pos[0]), float(self.pos[1]),
+                              float(self.pos[2]), float(self.feed))
+
+    def same_state(self, other: tuple) -> bool:
+        """Whether everything that decides what runs next is as in ``other`` (a :meth:`state`)."""
+        return (self.pos == other[0] and self.vars == other[1] and self.names == other[2]
+                and (self.motion, self.feed, self.absolute) == other[3])
+
+    def state(self) -> tuple:
+        """A copy of the variables, the position and the modes: with the block to run, all a run depends on."""
+        return list(self.pos), dict(self.vars), dict(self.names), (self.motion, self.feed, self.absolute)

@@ -14,6 +14,7 @@ from .blocks import (Assign, AssignNamed, Block, End, Goto, IfGoto, IfGotoLabel,
 from .control import Control
 from .reader import SIM_DIALECTS, detect_dialect, read_blocks
 from .result import Simulation
+from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS, Runaway, endless_jumps
 
 __all__ = ["simulate", "MAX_DO"]
 
@@ -21,7 +22,7 @@ MAX_DO = 3  # Fanuc: DO1..DO3
 
 
 def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
-             variable_ranges=None, max_blocks: int = 20_000_000) -> Simulation:
+             variable_ranges=None, max_blocks: int = MAX_BLOCKS, max_idle_blocks: int = MAX_IDLE_BLOCKS) -> Simulation:
     """Execute ``text`` as the control would, with ``precision`` significant digits.
 
     Parameters
@@ -36,7 +37,13 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         Variable numbers the program may use; by default the dialect's (Fanuc
         #1-#33, #100-#199, #500-#999; LinuxCNC #1-#5602; Heidenhain Q0-Q99).
     max_blocks : int
-        Blocks executed before the run is stopped as a runaway loop.
+        Blocks executed before the run is stopped as a runaway loop; the
+        moves take at most :data:`~lagsym.simulate.result.BYTES_PER_MOVE` bytes
+        each, one move a block at most.
+    max_idle_blocks : int
+        Blocks executed without a move before the run is stopped as a runaway
+        loop.  A run that comes back to a block with every variable and the
+        position unchanged is stopped at once (see :mod:`~lagsym.simulate.runaway`).
 
     Raises
     ------
@@ -59,13 +66,11 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     labels = _labels(blocks)
     m = Control(dialect, int(precision), variable_ranges or VARIABLE_RANGES[dialect])
     handlers = [_RUN[type(b)] for b in blocks]
+    runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, dialect, int(precision)), blocks)
     pc, executed = 0, 0
     while pc < len(blocks):
         b = blocks[pc]
         executed += 1
-        if executed > max_blocks:
-            raise ControlAlarm("runaway", f"more than {max_blocks} blocks executed; a loop that never ends?",
-                               b.line, b.text)
         try:
             nxt = handlers[pc](m, blocks, pc, b, labels)
         except BlockAlarm as e:
@@ -74,8 +79,10 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
             raise ControlAlarm("111", f"calculated data out of range ({type(e).__name__})", b.line, b.text) from None
         if nxt is None:
             break
+        if nxt <= pc:  # a run that never ends jumps back again and again: the guard looks only here
+            runaway.check(m, executed, nxt, b)
         pc = nxt
-    return Simulation(dialect=dialect, precision=int(precision), moves=tuple(m.moves), blocks=executed)
+    return Simulation(dialect=dialect, precision=int(precision), moves=m.moves, blocks=executed)
 
 
 # --------------------------------------------------------------------------- linking

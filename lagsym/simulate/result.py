@@ -1,10 +1,20 @@
-"""What a dry run returns: the moves the control makes, and those moves as CSV."""
+"""What a dry run returns: the moves the control makes, and those moves as CSV.
+
+The moves are kept in a :class:`SimMoves` table of plain arrays, 37 bytes a
+move (a block number, a rapid flag and four doubles) rather than an object
+each, so the longest run the block limit allows has a memory bound known
+before it starts (:data:`BYTES_PER_MOVE` times ``max_blocks``).
+"""
 
 from __future__ import annotations
 
+from array import array
+from collections.abc import Sequence
 from dataclasses import dataclass
 
-__all__ = ["SimMove", "Simulation", "moves_csv"]
+__all__ = ["SimMove", "SimMoves", "Simulation", "moves_csv", "BYTES_PER_MOVE"]
+
+BYTES_PER_MOVE = 37  # array('i') line, array('b') rapid flag, four array('d') columns
 
 
 @dataclass(frozen=True)
@@ -19,20 +29,80 @@ class SimMove:
     feed: float
 
 
+class SimMoves(Sequence):
+    """The moves of a run as columns; indexing and iterating give :class:`SimMove` values.
+
+    Only the executor appends (while the run lasts); the table it hands back
+    in a :class:`Simulation` is not changed again.
+    """
+
+    __slots__ = ("_line", "_rapid", "_x", "_y", "_z", "_feed")
+
+    def __init__(self):
+        self._line, self._rapid = array("i"), array("b")
+        self._x, self._y, self._z, self._feed = array("d"), array("d"), array("d"), array("d")
+
+    def append(self, line: int, rapid: bool, x: float, y: float, z: float, feed: float) -> None:
+        """Add one move (the executor's use only)."""
+        self._line.append(line)
+        self._rapid.append(rapid)
+        self._x.append(x)
+        self._y.append(y)
+        self._z.append(z)
+        self._feed.append(feed)
+
+    def __len__(self) -> int:
+        return len(self._line)
+
+    def _move(self, i: int) -> SimMove:
+        return SimMove(self._line[i], "G0" if self._rapid[i] else "G1", self._x[i], self._y[i], self._z[i],
+                       self._feed[i])
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self._move(k) for k in range(*i.indices(len(self)))]
+        if i < 0:
+            i += len(self)
+        if not 0 <= i < len(self):
+            raise IndexError("move index out of range")
+        return self._move(i)
+
+    def __iter__(self):
+        return (self._move(i) for i in range(len(self)))
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, SimMoves) and list(self) == list(other)
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"SimMoves({len(self)} moves)"
+
+    def feeds(self) -> int:
+        """How many of the moves are feed (``G1``) moves."""
+        return len(self) - sum(self._rapid)
+
+    def feed_points(self):
+        """The end points of the feed moves as an (N, 3) float array."""
+        import numpy as np
+
+        keep = np.frombuffer(self._rapid, dtype=np.int8) == 0 if len(self) else np.zeros(0, bool)
+        cols = [np.frombuffer(c, dtype=float) if len(self) else np.zeros(0) for c in (self._x, self._y, self._z)]
+        return np.column_stack(cols)[keep].reshape(-1, 3).copy()
+
+
 @dataclass(frozen=True)
 class Simulation:
     """The result of a dry run: the moves in order and how many blocks were executed."""
 
     dialect: str
     precision: int
-    moves: tuple[SimMove, ...]
+    moves: SimMoves
     blocks: int
 
     def feed_points(self):
         """The end points of the feed (``G1``) moves as an (N, 3) float array."""
-        import numpy as np
-
-        return np.array([(m.x, m.y, m.z) for m in self.moves if m.motion == "G1"], dtype=float).reshape(-1, 3)
+        return self.moves.feed_points()
 
 
 def moves_csv(sim: Simulation, decimals: int = 6) -> str:

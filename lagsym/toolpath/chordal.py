@@ -184,8 +184,8 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
     """Check the moves marked ``dense`` against the true cutter path; with a tolerance, split those that dip more.
 
     ``cl(x, y, **search)`` gives the cutter locations (mm) over surface
-    positions, and ``cl.on_grid(x, y)``, where it has one, the position a
-    new point is written at.  The sag of a checked move becomes the larger of the dip found
+    positions, and ``cl.snap_between(x, y, ax, ay, bx, by)``, where it has
+    one, the position a new point on the move ``a -> b`` is written at.  The sag of a checked move becomes the larger of the dip found
     and the sag its fine samples show (``seen``).  A move whose sag exceeds
     ``tol`` gets the cutter location at its worst point as a new point, and
     both halves are checked again.  Returns the points and each move's sag.
@@ -204,9 +204,10 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
         if not split.size:
             break
         w = u[over]
-        nx, ny = vx[split] + w * (vx[split + 1] - vx[split]), vy[split] + w * (vy[split + 1] - vy[split])
-        if hasattr(cl, "on_grid"):
-            nx, ny = cl.on_grid(nx, ny)
+        nx = vx[split] + w * (vx[split + 1] - vx[split])
+        ny = vy[split] + w * (vy[split + 1] - vy[split])
+        if hasattr(cl, "snap_between"):  # a new point is written: on the program's resolution, along its move
+            nx, ny = cl.snap_between(nx, ny, vx[split], vy[split], vx[split + 1], vy[split + 1])
         vx, vy = np.insert(vx, split + 1, nx), np.insert(vy, split + 1, ny)
         # Few points are added, so their cutter locations get a three times finer, more thorough search.
         vz = np.insert(vz, split + 1, cl(nx, ny, lattice=24, starts=8))

@@ -4,7 +4,11 @@ For a ball of radius ``R`` centred over ``c = (cx, cy)`` the tip height is
 
     CL(c) = max over p in D(c, R) ∩ B of  F(p) + sqrt(R**2 - |p - c|**2) - R,
 
-and for a flat end ``max F(p)`` over the same set; ``D`` is the disc under the
+for a flat end ``max F(p)`` over the same set, and for a bull-nose end mill of
+corner radius ``r`` the same maximum of ``F(p) - P(|p - c|)``, ``P`` its profile
+(0 across the flat, ``r - sqrt(r**2 - (d - R + r)**2)`` on the corner; the ball
+and the flat end are its limits ``r = R`` and ``r = 0``,
+:func:`lagsym.machine.cutter_profile`); ``D`` is the disc under the
 tool and ``B`` the box spanned by the control points.  Only the surface inside
 the box counts: the polynomial is never evaluated outside it (beyond the box
 lies no part, not a cliff and not an extrapolated surface), so near an edge the
@@ -32,7 +36,7 @@ from numpy.polynomial import chebyshev as C
 
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
-from ..machine import TOOL_SHAPES
+from ..machine import TOOL_SHAPES, cutter_profile
 from ..values import choice, positive
 
 __all__ = ["CL_MARGIN", "drop_cutter"]
@@ -46,8 +50,8 @@ _SIGNS = np.array([1.0, -1.0])[None, :, None]
 _HALF = math.sqrt(0.5)
 
 
-def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: int = 8, starts: int = 3,
-                margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: float | None = None, lattice: int = 8,
+                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
     Parameters
@@ -59,8 +63,11 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
         from the box.
     radius : float
         Tool radius in surface units (0: a point, the surface itself).
-    shape : {"ball", "flat"}
+    shape : {"ball", "flat", "bull"}
         Cutter shape.
+    corner : float, optional
+        Corner radius of a bull-nose cutter (``shape="bull"``), in surface
+        units, more than 0 and less than ``radius``; not given for the others.
     lattice : int
         Candidate contact points per tool radius in the first, dense search.
     starts : int
@@ -86,7 +93,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     0.0
     """
     radius = positive(radius, "tool radius", allow_zero=True)
-    choice(shape, TOOL_SHAPES, "tool shape")
+    corner = _corner(shape, radius, corner)
     ev = evaluator or surface_evaluator(surface)
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
@@ -103,9 +110,22 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, lattice: i
     span = _height_scale(ev) + radius + 1.0
     out = np.empty(cx.size)
     for s in range(0, cx.size, _CHUNK):
-        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, shape, offsets,
+        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, corner, offsets,
                                         (inside, nearest), spacing, starts, box, 0.01 * CL_MARGIN * span)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+def _corner(shape: str, radius: float, corner: float | None) -> float:
+    """The corner radius of the cutter: ``radius`` for a ball, 0 for a flat end, checked for a bull nose."""
+    choice(shape, TOOL_SHAPES, "tool shape")
+    if shape != "bull":
+        if corner is not None:
+            raise ToolpathError(f"a corner radius ({corner!r}) is for a bull-nose cutter, not a {shape} end")
+        return radius if shape == "ball" else 0.0
+    if corner is None or not 0.0 < float(corner) < radius:
+        raise ToolpathError(f"a bull-nose cutter of radius {radius:g} needs a corner radius more than 0 and less "
+                            f"than {radius:g}, not {corner!r}")
+    return float(corner)
 
 
 def _inside_box(cx, cy, box, radius=0.0):
@@ -259,26 +279,26 @@ def _edge_points(cx, cy, radius, box):
     return np.stack(xs, axis=1), np.stack(ys, axis=1)
 
 
-def _height(ev, px, py, d2, radius, shape):
+def _height(ev, px, py, d2, radius, corner):
     """Tip height of the tool in contact at ``(px, py)``, ``d2`` the squared distance from its axis."""
     z = ev.fast_points(px, py)
-    if shape == "ball":
-        z = z + np.sqrt(np.maximum(radius * radius - d2, 0.0)) - radius
+    if corner > 0.0:
+        z = z - cutter_profile(d2, radius, corner)
     return z
 
 
-def _drop_chunk(ev, cx, cy, radius, shape, offsets, lattice, spacing, starts, box, settle):
+def _drop_chunk(ev, cx, cy, radius, corner, offsets, lattice, spacing, starts, box, settle):
     """Drop-cutter over one chunk of positions: dense candidates, then a local search from the best of each basin."""
-    val, px, py = _candidates(ev, cx, cy, radius, shape, offsets, box)
+    val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box)
     order = _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts)
     rows = np.arange(cx.size)[:, None]
     found = _refine(ev, px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel(),
-                    np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1]), radius, shape, box,
+                    np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1]), radius, corner, box,
                     spacing, settle)
     return np.maximum(found.reshape(cx.size, -1).max(axis=1), val.max(axis=1))
 
 
-def _candidates(ev, cx, cy, radius, shape, offsets, box):
+def _candidates(ev, cx, cy, radius, corner, offsets, box):
     """Heights and contact points of the lattice and rim under each tool, then of the corners of the region under it.
 
     The corners are the box corners and where the rim crosses a box edge.
@@ -291,11 +311,11 @@ def _candidates(ev, cx, cy, radius, shape, offsets, box):
     for s in range(0, k, block):
         ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
         qx, qy, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
-        val[:, s:s + block] = _height(ev, qx, qy, d2, radius, shape)
+        val[:, s:s + block] = _height(ev, qx, qy, d2, radius, corner)
         px[:, s:s + block], py[:, s:s + block] = qx, qy
     ex, ey = _edge_points(cx, cy, radius, box)
     qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
-    return (np.concatenate([val, _height(ev, qx, qy, d2, radius, shape)], axis=1),
+    return (np.concatenate([val, _height(ev, qx, qy, d2, radius, corner)], axis=1),
             np.concatenate([px, qx], axis=1), np.concatenate([py, qy], axis=1))
 
 
@@ -318,7 +338,7 @@ def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
     return _spread_starts(val, px, py, starts, 2.5 * spacing, rank)
 
 
-def _refine(ev, px, py, val, ccx, ccy, radius, shape, box, spacing, settle):
+def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, spacing, settle):
     """Pattern search from each start, in place: the best contact height found from each.
 
     Eight steps a round, along the axes and along and across the radius;
@@ -344,7 +364,7 @@ def _refine(ev, px, py, val, ccx, ccy, radius, shape, box, spacing, settle):
         qx = px[ia, None] + h[ia, None] * dirs[:, :, 0]
         qy = py[ia, None] + h[ia, None] * dirs[:, :, 1]
         qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
-        qv = _height(ev, qx, qy, d2, radius, shape)
+        qv = _height(ev, qx, qy, d2, radius, corner)
         j = np.argmax(qv, axis=1)
         bv = qv[np.arange(ia.size), j]
         up = bv > val[ia]

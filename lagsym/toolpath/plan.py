@@ -21,7 +21,9 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from . import chordal
 from .dropcutter import drop_cutter
 from .filter import filter_rows
-from .pattern import raster_pattern, scallop_stepover, tool_reach, within_reach
+from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
+from .resolution import ResolutionGrid, without_repeats
+from .scallop import scallop_levels
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
@@ -45,7 +47,8 @@ class Toolpath:
     tool : Tool
     raster : RasterSpec
     stepover_mm, step_mm : float
-        The side step and forward step actually used (with a chordal
+        The side step and forward step actually used (with a scallop height,
+        ``stepover_mm`` is the widest gap between rows; with a chordal
         tolerance, ``step_mm`` is the sampling step the filter started from).
     bounds_mm : tuple of float
         The control points' box on the machine, ``(x0, x1, y0, y1)``.  The
@@ -55,6 +58,11 @@ class Toolpath:
     fine_points : int
         How many cutter locations the filter chose the points from (the
         blocks a program would have without filtering).
+    cusp_mm : float or None
+        With a scallop height, the worst cusp predicted between the rows,
+        measured normal to the surface (mm); None for a fixed side step.
+    cusp_at_mm : tuple of float or None
+        Where that cusp is, ``(x, y)`` on the machine.
     """
 
     points_mm: np.ndarray
@@ -66,6 +74,8 @@ class Toolpath:
     step_mm: float
     bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
     fine_points: int = 0
+    cusp_mm: float | None = None
+    cusp_at_mm: tuple[float, float] | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -119,16 +129,15 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     tol = raster.chordal_tolerance_mm
     cl = _Cutter.of(surface, ev, tool, settings)
     # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
-    past = min(_past_reach(ev, tool.shape, cl.radius), cl.radius - 2 * cl.grid) if raster.boundary == "past" else None
+    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner_radius), cl.radius - 2 * cl.unit)) \
+        if raster.boundary == "past" else None
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
-    stepover = _side_step(tool, raster)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
-    _check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
-    levels, along = raster_pattern(reach, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
+    scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
     path = _fine_path(cl, levels, along, raster.direction, fine, past)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
-    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm)
+    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
     vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
     # Where the tool meets a box edge the path may bend between samples; where it does not bend near
@@ -143,37 +152,56 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     return Toolpath(
-        **_without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
-                           _place(settings, vx, vy, vz)[2], cl.grid * mm_per_unit),
+        **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                          _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
         tool=tool,
         raster=raster,
-        stepover_mm=float((levels[1] - levels[0]) * mm_per_unit) if len(levels) > 1 else float(stepover),
+        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(_side_step(tool, raster)),
         step_mm=float(step),
         bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
         fine_points=len(path.x),
+        **_cusp(scallop, raster.direction, settings),
     )
 
 
-def _without_repeats(points_mm, rows, exact_mm, unit_mm: float) -> dict:
-    """The points without those at the same X and Y as the one before and within a unit of its Z.
+def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
+             max_points: int | None):
+    """The rows over the reach: ``(scallop, levels, along, every)``, checked for size first.
 
-    Beyond a box corner several samples can land on one point of the
-    program's grid; the program would write no block for the repeat.  The
-    point kept takes the higher of the two heights.
+    ``scallop`` is the rows from a scallop height (None for a side step),
+    ``every`` how many samples along a row make one move with a fixed step
+    (None with a tolerance alone).
     """
-    same = np.zeros(len(points_mm), dtype=bool)
-    same[1:] = ((points_mm[1:, 0] == points_mm[:-1, 0]) & (points_mm[1:, 1] == points_mm[:-1, 1])
-                & (np.abs(np.diff(points_mm[:, 2])) < unit_mm))
-    if not same.any():
-        return dict(points_mm=points_mm, rows=rows, exact_mm=exact_mm)
-    first = np.cumsum(~same) - 1  # the kept point each one merges into
-    keep = np.flatnonzero(~same)
-    z, e = np.full(len(keep), -np.inf), np.full(len(keep), -np.inf)
-    np.maximum.at(z, first, points_mm[:, 2])
-    np.maximum.at(e, first, exact_mm)
-    p = points_mm[keep].copy()
-    p[:, 2] = z
-    return dict(points_mm=p, rows=rows[keep], exact_mm=e)
+    mm_per_unit = cl.mm_per_unit
+    stepover = _side_step(tool, raster)
+    scallop = None if raster.stepover_mm is not None else scallop_levels(
+        ev, raster.direction, tool.radius_mm, raster.scallop_mm, mm_per_unit)
+    if scallop is not None:  # rows walked across the surface: the size check counts them
+        stepover = _span(ev.bounds, raster.direction) * mm_per_unit / max(len(scallop.levels) - 1, 1)
+    _check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
+    levels, along = raster_pattern(reach, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
+    if scallop is not None:  # the rows across the box, then as far as the tool reaches on either side
+        levels = reach_levels(scallop.levels, *(reach[2:] if raster.direction == "x" else reach[:2]))
+    every = None
+    if raster.step_mm is not None:
+        along, every = _fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
+                                           lambda v: cl.snap_axis(v, 0 if raster.direction == "x" else 1))
+    return scallop, levels, along, every
+
+
+def _span(bounds, direction: str) -> float:
+    """The box's extent across the rows (surface units)."""
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    return y1 - y0 if direction == "x" else x1 - x0
+
+
+def _cusp(scallop, direction: str, settings: MachineSettings) -> dict:
+    """The worst predicted cusp and where it is on the machine, for a plan from a scallop height."""
+    if scallop is None:
+        return {}
+    p, c = scallop.worst_at
+    x, y = settings.placement.to_machine(*((p, c) if direction == "x" else (c, p)))
+    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y))}
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
@@ -202,30 +230,6 @@ def _check_size(bounds, direction: str, stepover: float, fine: float, scale: flo
             f"or raise the limit (--max-points)")
 
 
-_SLOPE_SAMPLES = 257  # points along each box edge where the steepest slope is measured
-
-
-def _past_reach(ev: SurfaceEvaluator, shape: str, radius: float) -> float:
-    """How far beyond the box the tool axis goes with ``--boundary past`` (surface units).
-
-    A flat end touches the box edge up to its radius beyond it.  A ball
-    touches a slope of angle ``a`` at ``radius * sin(a)`` from its axis, so
-    beyond ``radius * sin(a)`` for the steepest slope ``a`` on the box edges
-    it reaches nothing the positions nearer the box have not; further out it
-    would touch the part's edge only near its equator, where a sideways
-    rounding of the position moves the tool a long way down the edge.
-    """
-    if shape != "ball" or radius == 0:
-        return radius
-    x0, x1, y0, y1 = ev.bounds
-    t = np.linspace(0.0, 1.0, _SLOPE_SAMPLES)
-    ex = np.concatenate([x0 + t * (x1 - x0), x0 + t * (x1 - x0), np.full_like(t, x0), np.full_like(t, x1)])
-    ey = np.concatenate([np.full_like(t, y0), np.full_like(t, y1), y0 + t * (y1 - y0), y0 + t * (y1 - y0)])
-    slope = float(np.hypot(ev.fast_points(ex, ey, dx=1), ev.fast_points(ex, ey, dy=1)).max())
-    # A little further than the samples show, for the slope between them.
-    return min(radius, 1.02 * radius * slope / math.hypot(1.0, slope))
-
-
 def _side_step(tool: Tool, raster: RasterSpec) -> float:
     """The side step asked for (mm), or the one a ball leaves the scallop height with."""
     if raster.stepover_mm is not None:
@@ -247,57 +251,80 @@ def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float)
     return raster.step_mm, min(raster.step_mm / 2.0, fine)
 
 
+def _fixed_step_samples(a0: float, a1: float, step: float, fine: float, snap):
+    """Samples along a row for a fixed step, and how many samples make one move (surface units).
+
+    The row is cut into equal moves no longer than ``step`` once moved onto
+    the program's resolution (``snap``), each sampled at least twice and no
+    further apart than ``fine``.
+    """
+    moves = max(int(math.ceil((a1 - a0) / step - 1e-9)), 1)
+    while True:
+        every = max(2, int(math.ceil((a1 - a0) / moves / fine - 1e-9)))
+        along = np.linspace(a0, a1, moves * every + 1)
+        if np.diff(snap(along[::every])).max() <= step * (1 + 1e-9):
+            return along, every
+        moves += 1
+
+
 @dataclass(frozen=True)
 class _Cutter:
     """Tool-tip heights (mm) over surface positions, as the planner computes them.
 
-    The radius (surface units) includes the stock to leave for a ball, which
-    then rides that much higher; a flat end is lifted by the stock instead.
-    :meth:`on_grid` moves the points to emit beyond the box (``--boundary
-    past``) to the program's grid (their X and Y as the program writes them),
-    before their cutter locations are computed: there the tool touches the
-    part's edges with its side, where rounding X or Y by half a unit of the
-    last decimal would lower it against the edge by many units.
+    The radius (surface units) includes the stock to leave for a ball or a
+    bull nose (whose corner grows by it too), which then rides that much
+    higher; a flat end is lifted by the stock instead.
+    ``snap`` moves positions onto the program's resolution (``grid``): the
+    rows, the samples along them and any point added are put there before
+    the tool is dropped, so an emitted height is that of a position the
+    program writes.
     """
 
     surface: object
     ev: SurfaceEvaluator
     radius: float
     shape: str
+    corner: float | None
     lift_tip: float
     mm_per_unit: float
-    settings: MachineSettings | None = None
+    grid: ResolutionGrid | None = None
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
         r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
-        r = (r_mm + (stock if tool.shape == "ball" else 0.0)) / mm_per_unit
-        lift_tip = r - r_mm / mm_per_unit if tool.shape == "ball" else stock / mm_per_unit
-        return cls(surface, ev, r, tool.shape, lift_tip, mm_per_unit, settings)
-
-    @property
-    def grid(self) -> float:
-        """The program's unit of the last decimal, in surface units."""
-        s = self.settings
-        return 10.0 ** -s.digits / s.unit_factor / self.mm_per_unit if s is not None else 0.0
-
-    def on_grid(self, x, y):
-        """The positions beyond the box moved to the program's grid; those over the box as they are."""
-        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        x0, x1, y0, y1 = self.ev.bounds
-        out = (x < x0) | (x > x1) | (y < y0) | (y > y1)
-        if self.settings is None or not out.any():
-            return x, y
-        place, k = self.settings.placement, self.settings.unit_factor * 10 ** self.settings.digits
-        mx, my = place.to_machine(x[out], y[out])
-        sx, sy = place.to_surface(np.rint(np.asarray(mx) * k) / k, np.rint(np.asarray(my) * k) / k)
-        x, y = x.copy(), y.copy()
-        x[out], y[out] = sx, sy
-        return x, y
+        grid = ResolutionGrid.of(settings, ev.bounds)
+        if tool.shape == "flat":
+            return cls(surface, ev, r_mm / mm_per_unit, "flat", None, stock / mm_per_unit, mm_per_unit, grid)
+        # The tool grown by the stock all round touches the part where the tool touches the part grown by it.
+        r = (r_mm + stock) / mm_per_unit
+        corner = (tool.corner_mm + stock) / mm_per_unit if tool.shape == "bull" else None
+        return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
+
+    @property
+    def unit(self) -> float:
+        """One unit of the program's last decimal, in surface units (0 without a program grid)."""
+        return 0.0 if self.grid is None else self.grid.unit_mm / self.mm_per_unit
+
+    @property
+    def corner_radius(self) -> float:
+        """The corner radius (surface units): the radius for a ball, 0 for a flat end."""
+        return {"ball": self.radius, "flat": 0.0}.get(self.shape, self.corner)
+
+    def snap(self, x, y):
+        """The positions the program writes for surface positions ``x, y`` (see :mod:`.resolution`)."""
+        return (x, y) if self.grid is None else self.grid.snap(x, y)
+
+    def snap_between(self, x, y, ax, ay, bx, by):
+        """:meth:`snap` of points added on moves ``a -> b``, off their ends (see :mod:`.resolution`)."""
+        return (x, y) if self.grid is None else self.grid.snap_between(x, y, ax, ay, bx, by)
+
+    def snap_axis(self, v, axis: int):
+        """:meth:`snap` of positions on one axis (0: x, 1: y)."""
+        return v if self.grid is None else self.grid.snap_axis(v, axis)
 
 
 @dataclass(frozen=True)
@@ -348,21 +375,26 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     fa, fl, frow = (np.concatenate(v) for v in (fa, fl, frow))
     fx, fy = (fa, fl) if direction == "x" else (fl, fa)
     if past is not None:
-        fx, fy = cl.on_grid(*within_reach(fx, fy, cl.ev.bounds, past))
+        fx, fy = within_reach(fx, fy, cl.ev.bounds, past)
+    # Every position on the program's resolution before the tool is dropped there (one inside the box stays
+    # inside): the written X and Y are then the positions whose heights were computed.
+    fx, fy = cl.snap(fx, fy)
     fz = cl(fx, fy)
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
 
-def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float | None) -> np.ndarray:
+def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float | None,
+             every: int | None = None) -> np.ndarray:
     """Indices of the fine samples to emit.
 
     With a chordal tolerance alone, the filter keeps the moves within it.
-    With a fixed step (the longest move), every fine sample a step apart is
-    kept (the samples are at most half a step apart) and, where a move's sag
-    exceeds the tolerance, the samples inside it too: points are added where
-    the path bends.  ``extra`` is the sag between samples added to what the
-    samples show.
+    With a fixed step (the longest move), every ``every``-th sample of a
+    row is kept (:func:`_fixed_step_samples`), and along a link the samples
+    a move apart (:func:`_every_step`); where a move's sag exceeds the
+    tolerance, the samples inside it too: points are added where the path
+    bends.  ``extra`` is the sag between samples added to what the samples
+    show.
     """
     s_mm, z = path.s_mm, path.z
     if longest_mm is None:
@@ -371,12 +403,8 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
             k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], z[lo:hi + 1], tol, extra[lo:hi + 1]) + lo
             kept.extend(int(v) for v in k[1:])
         return np.array(kept, dtype=int)
-    every = []
-    for lo, hi, _ in path.pieces:
-        widest = float(np.diff(s_mm[lo:hi + 1]).max()) if hi > lo else longest_mm
-        e = max(1, int(longest_mm * (1 + 1e-9) // widest))
-        every.append(np.append(np.arange(lo, hi, e), hi))
-    kept = np.unique(np.concatenate(every))
+    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else _every_step(s_mm, lo, hi, longest_mm)
+                                     for lo, hi, is_row in path.pieces]))
     sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
     split = np.flatnonzero((sag > tol) & (np.diff(kept) > 1))
     if not split.size:
@@ -385,3 +413,12 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
     return np.union1d(kept, inner)
 
 
+def _every_step(s_mm: np.ndarray, lo: int, hi: int, longest_mm: float) -> np.ndarray:
+    """The samples ``lo..hi`` of one piece a move apart: from each, the furthest no more than ``longest_mm`` on."""
+    s = s_mm[lo:hi + 1] - s_mm[lo]
+    reach = np.maximum(np.searchsorted(s, s + longest_mm * (1 + 1e-9), side="right") - 1, np.arange(len(s)) + 1)
+    out, i = [0], 0
+    while i < len(s) - 1:
+        i = int(min(reach[i], len(s) - 1))
+        out.append(i)
+    return np.array(out, dtype=int) + lo

@@ -45,8 +45,12 @@ from ..values import choice, finite, positive
 from .chordal import check_moves, crosses_box_edge, lift
 from .dropcutter import drop_cutter
 from .pattern import levels as spaced
+from .plan import MAX_PLAN_POINTS
 
-__all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around"]
+__all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
+           "MAX_ROUGH_SAMPLES"]
+
+MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (about 1 ms each): minutes at most
 
 MILLING = ("zigzag", "climb", "conventional")
 _SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
@@ -154,7 +158,8 @@ class RoughPath:
 
 
 def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings,
-                   evaluator: SurfaceEvaluator | None = None) -> RoughPath:
+                   evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS,
+                   max_samples: int | None = MAX_ROUGH_SAMPLES) -> RoughPath:
     """Plan z-level roughing of ``stock`` down to the surface plus the stock to leave.
 
     Parameters
@@ -167,6 +172,12 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     spec : RoughSpec
     settings : MachineSettings
         Scale and work offset (its stock to leave is not used: ``spec`` has the roughing one).
+    max_points : int or None
+        Refuse a path of more points than this (rows times samples per row,
+        times the levels) before it is assembled; None: no limit.
+    max_samples : int or None
+        Refuse, before any drop-cutter work, more samples than this in one
+        level (rows times samples per row: the slow part); None: no limit.
 
     Examples
     --------
@@ -190,6 +201,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     place = settings.placement
     box = place.box_mm(ev.bounds)
     _check_stock(stock, box, ev, place)
+    _check_points(stock, tool, spec, 1, max_samples, "--max-samples")
     rows = _rows(stock, box, tool.radius_mm, spec)
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
     rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev, place,
@@ -197,6 +209,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     reachable = np.concatenate([f for f in floors])
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
+    _check_points(stock, tool, spec, count, max_points, "--max-points")
     z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
     depth = stock.top_mm - float(z_levels[-1])
     if spec.reach_mm is not None and depth > spec.reach_mm:
@@ -204,6 +217,29 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
                             f"the tool reaches {spec.reach_mm:g} mm below its holder")
     pts, kinds, floor = _assemble(rows, floors, lifts, z_levels, stock, spec)
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def _check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
+                  option: str) -> None:
+    """Refuse a path of more than ``max_points`` (rows times samples per row, times ``levels``) before making it."""
+    if max_points is None:
+        return
+    along, cross = ((stock.x1 - stock.x0, stock.y1 - stock.y0) if spec.direction == "x"
+                    else (stock.y1 - stock.y0, stock.x1 - stock.x0))
+    # floats: a side step of 1e-308 mm gives a count no int conversion takes, and it is refused all the same
+    rows = _whole(cross / spec.stepover_mm) + 1
+    per_row = _whole((along + 2 * (spec.clearance_mm + tool.radius_mm)) / spec.step_mm) + 1
+    total = rows * per_row * levels
+    if total > max_points:
+        what = f"{rows:.4g} rows of {per_row:.4g} samples" + (f" at {levels} levels" if levels > 1 else "")
+        raise ToolpathError(f"{what} is {total:.3g} points, more than the limit of {max_points:.3g} (side step "
+                            f"{spec.stepover_mm:g} mm, step {spec.step_mm:g} mm, step-down {spec.stepdown_mm:g} mm); "
+                            f"use larger steps or raise the limit ({option})")
+
+
+def _whole(v: float) -> float:
+    """``ceil(v)``, kept a float: an infinity stays one."""
+    return float(math.ceil(v)) if math.isfinite(v) else v
 
 
 def _check_stock(stock: Stock, box, ev: SurfaceEvaluator, place) -> None:
@@ -276,7 +312,9 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **sea
     out = np.full(x.size, -np.inf)
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
-        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, evaluator=ev, **search)
+        corner = tool.corner_mm / place.mm_per_unit if tool.shape == "bull" else None
+        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner, evaluator=ev,
+                        **search)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 

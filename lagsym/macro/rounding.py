@@ -1,0 +1,91 @@
+"""Positions rounded on the control before the height is computed there, and the matching model on the PC.
+
+A control goes to X and Y at its input resolution, not to the value a macro
+computes: a Fanuc rounds a variable used as an axis address to the least
+input increment.  On a steep surface the height computed at the unrounded
+position is then not the height at the position the tool reaches.  Where the
+macro language has ``ROUND`` (Fanuc Custom Macro B, LinuxCNC), the program
+rounds every X and Y to the program's last decimal itself, ``ROUND[p*S]/S``
+with ``S = 10**decimals``, and computes Z there:
+
+* a point on the surface (tool diameter 0): the row position and the point
+  position are rounded, then the surface is evaluated at them;
+* a ball end: the tip, one radius off the surface along its normal, is
+  rounded, and its height moved along the tangent plane of the tip's path to
+  the rounded position, ``Z' + Zp dP + Zr dR`` (the tip's path has the
+  surface's slopes at the contact point), plus a bound of that plane's error
+  over the half unit moved, ``c dmax**2 / 2`` with ``c`` the largest upward
+  bend of the tip's path over the raster (rounded up to a thousandth of a unit).
+
+Z is then raised by half a unit, so that a control rounding it to the
+nearest unit still goes at or above it.  Heidenhain FN arithmetic has no
+rounding, so those programs move to the values as computed (the TNC takes
+them at its own resolution).
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+
+from ..machine import MachineSettings
+from .model import Assign, Var, add, const, div, mul, round_, sub, var
+
+__all__ = ["ROUNDING_DIALECTS", "resolution", "round_statement", "round_half_away", "tip_statements",
+           "tips_on_grid", "tip_lift"]
+
+ROUNDING_DIALECTS = ("fanuc", "linuxcnc")  # macro languages with ROUND[..]
+
+
+def resolution(settings: MachineSettings) -> Fraction:
+    """One unit of the program's last decimal where the control rounds positions itself, else 0."""
+    if settings.dialect not in ROUNDING_DIALECTS:
+        return Fraction(0)
+    return Fraction(1, 10 ** settings.digits)
+
+
+def round_statement(v: Var, unit: Fraction, target: Var | None = None) -> Assign:
+    """``target = ROUND[v*S]/S``: ``v`` to the nearest multiple of ``unit`` (into ``v`` itself by default)."""
+    s = const(1 / unit)
+    return Assign(v if target is None else target, div(round_(mul(v, s)), s))
+
+
+def round_half_away(x: np.ndarray, unit: float) -> np.ndarray:
+    """``x`` to the nearest multiple of ``unit``, halves away from zero, as ``ROUND[x*S]/S`` on the control."""
+    v = np.asarray(x, dtype=float) / unit
+    return np.sign(v) * np.floor(np.abs(v) + 0.5) * unit
+
+
+def tip_statements(unit: Fraction, lift: Fraction) -> tuple:
+    """After the tip ``(pt, rt, zt)``: the tip rounded, its height moved along the tangent plane and lifted."""
+    pt, rt, zt, zp, zr, q = var("pt"), var("rt"), var("zt"), var("zp"), var("zr"), var("q")
+    out = [Assign(zt, add(zt, const(lift)))]
+    for v, slope in ((pt, zp), (rt, zr)):
+        out += [round_statement(v, unit, q), Assign(zt, add(zt, mul(slope, sub(q, v)))), Assign(v, q)]
+    return tuple(out)
+
+
+def tips_on_grid(pt, rt, zt, zp, zr, unit: float, lift: float):
+    """The PC's model of :func:`tip_statements`: rounded tip positions and their heights (floats)."""
+    pr, rr = round_half_away(pt, unit), round_half_away(rt, unit)
+    return pr, rr, np.asarray(zt) + lift + zp * (pr - pt) + zr * (rr - rt)
+
+
+def tip_lift(kmax: np.ndarray, slopes_sq: np.ndarray, offset: float, unit: Fraction) -> Fraction:
+    """Half a unit plus the bound of the tangent plane's error over the rounding, as an exact constant.
+
+    ``kmax`` is the surface's larger principal curvature at the raster
+    positions (positive where it is concave, seen from the tool) and
+    ``slopes_sq`` is ``Zp**2 + Zr**2`` there.  The tip's path bends up by at
+    most ``k / (1 - offset k)`` along the surface, so by at most that times
+    ``w**3`` per horizontal unit squared, ``w = sqrt(1 + Zp**2 + Zr**2)``;
+    over the rounding's horizontal move of at most ``unit / sqrt(2)`` the
+    plane's error is below half that times ``unit**2 / 2``.
+    """
+    k = np.maximum(np.asarray(kmax, dtype=float), 0.0)
+    bend = k / np.maximum(1.0 - offset * k, 1e-12) * (1.0 + np.asarray(slopes_sq)) ** 1.5
+    c2 = 0.5 * float(bend.max(initial=0.0)) * float(unit) ** 2 / 2.0
+    step = unit / 1000  # the bound rounded up to a thousandth of a unit
+    return unit / 2 + step * math.ceil(c2 / float(step))

@@ -1,0 +1,179 @@
+"""Row levels from a scallop height measured normal to the surface: walked across the rows, one gap at a time.
+
+Between two passes of a ball of radius ``R`` whose centres run on parallel
+lines ``d`` apart, over a cross-section of the surface with normal curvature
+``k`` across the passes (positive where it bends up, a hollow), the cusp left
+standing, measured along the normal, is
+
+    h(d) = (2 R - k R**2 + k d**2 / 4) / (1 + sqrt((1 - k R)**2 - k**2 d**2 / 4)) - sqrt(R**2 - d**2 / 4)
+
+(the circle of the ball's section about each centre, the centres on the
+offset of the section at ``R``; ``k = 0`` gives the flat floor's
+``R - sqrt(R**2 - d**2 / 4)``).  On a surface sloping with gradient
+``(fp, fc)`` along and across the rows, passes a horizontal distance ``s``
+apart run ``d = s * sqrt(1 + fp**2 + fc**2) / sqrt(1 + fp**2)`` apart, so a
+flank leaves a cusp many times the flat floor's at the same side step.
+
+:func:`scallop_levels` samples slope and curvature on a grid over the box,
+finds at each sample the largest ``s`` whose cusp is at most the request,
+and walks across the box: the gap after a row is the smallest allowed ``s``
+over every sample along the row and across the band the two passes touch
+(from one tool radius before the row to one radius past the next), so the
+request holds wherever that band's worst sample holds it.  Where the section
+is a hollow tighter than the ball (``k R >= 1``) the ball cannot reach its
+bottom at any step, and where it barely fits (a radius within 1.6 % of the
+ball's: the centre distance allowed is below an eighth of the flat floor's)
+no practical step meets the request; those samples do not limit the gap and
+are counted apart.  The cusp predicted for the gaps chosen elsewhere is
+reported with where it is worst.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..evaluate import SurfaceEvaluator
+from .pattern import scallop_stepover
+
+__all__ = ["cusp_height", "ScallopRows", "scallop_levels"]
+
+_ALONG_SAMPLES = 401  # samples along a row (slopes and curvature are polynomials of low degree)
+_CROSS_PER_STEP = 4  # cross samples per flat-floor side step
+_MAX_CROSS = 4001
+_FLOOR = 1.0 / 50  # the smallest gap, as a fraction of the flat floor's side step
+_TIGHT = 1.0 / 8  # a centre distance below this fraction of the flat floor's: a hollow the ball barely fits
+
+
+def cusp_height(d, k, radius: float) -> np.ndarray:
+    """Cusp height normal to the surface between ball centres ``d`` apart over a section of curvature ``k``.
+
+    ``nan`` where the section is a hollow too tight for the centres to be
+    ``d`` apart on its offset.
+
+    Examples
+    --------
+    >>> round(float(cusp_height(0.4895, 0.0, 3.0)), 4)  # the flat floor
+    0.01
+    >>> bool(cusp_height(0.4895, 0.1, 3.0) > 0.01 > cusp_height(0.4895, -0.1, 3.0))
+    True
+    """
+    d, k = np.broadcast_arrays(np.asarray(d, dtype=float), np.asarray(k, dtype=float))
+    r = radius
+    a = (1.0 - k * r) ** 2 - k * k * d * d / 4.0
+    b = r * r - d * d / 4.0
+    ok = (a >= 0) & (b >= 0) & (k * r < 1.0)
+    with np.errstate(invalid="ignore"):
+        h = (2.0 * r - k * r * r + k * d * d / 4.0) / (1.0 + np.sqrt(np.where(ok, a, 0.0))) - np.sqrt(np.where(ok, b, 0))
+    return np.where(ok, h, np.nan)
+
+
+def _allowed_d(k, radius: float, scallop: float) -> np.ndarray:
+    """The largest centre distance whose cusp is at most ``scallop`` (bisection; ``nan`` where ``k R >= 1``)."""
+    k = np.asarray(k, dtype=float)
+    fits = k * radius < 1.0
+    hi = np.where(k > 0, np.minimum(2 * radius, 2 * (1 - np.minimum(k * radius, 1.0)) / np.where(k > 0, k, 1.0)),
+                  2 * radius)
+    lo = np.zeros_like(hi)
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        h = cusp_height(mid, k, radius)
+        good = np.isfinite(h) & (h <= scallop)
+        lo, hi = np.where(good, mid, lo), np.where(good, hi, mid)
+    return np.where(fits, lo, np.nan)
+
+
+@dataclass(frozen=True)
+class ScallopRows:
+    """Row levels (surface units) and the worst cusp predicted between them (mm, normal to the surface).
+
+    ``worst_at`` is ``(p, c)``, the surface position (along the rows, across
+    them) of the worst predicted cusp; ``tight`` the number of samples where
+    the section is a hollow tighter than the ball.
+    """
+
+    levels: np.ndarray
+    worst_mm: float
+    worst_at: tuple[float, float]
+    tight: int
+
+
+def _samples(ev: SurfaceEvaluator, direction: str, mm_per_unit: float, flat_step_mm: float):
+    """Along and cross sample positions (surface units) and the gap allowed per unit of centre distance.
+
+    Returns ``(along, cross, stretch, k)``: ``stretch = sqrt(1 + fp**2) / w``
+    turns a centre distance into a horizontal gap; ``k`` the normal
+    curvature (1/mm) across the rows; both shaped ``(cross, along)``.
+    """
+    x0, x1, y0, y1 = (float(v) for v in ev.bounds)
+    (a0, a1), (c0, c1) = ((x0, x1), (y0, y1)) if direction == "x" else ((y0, y1), (x0, x1))
+    along = np.linspace(a0, a1, _ALONG_SAMPLES)
+    n_cross = int(min(_MAX_CROSS, max(3, math.ceil((c1 - c0) * mm_per_unit / flat_step_mm * _CROSS_PER_STEP) + 1)))
+    cross = np.linspace(c0, c1, n_cross)
+    cg, ag = np.meshgrid(cross, along, indexing="ij")
+    xy = (ag, cg) if direction == "x" else (cg, ag)
+
+    def d(i, j):  # partial derivative in the (along, cross) frame, per mm
+        dx, dy = (i, j) if direction == "x" else (j, i)
+        return ev.fast_points(*xy, dx=dx, dy=dy) / mm_per_unit ** (i + j - 1)
+
+    fp, fc, fpp, fpc, fcc = d(1, 0), d(0, 1), d(2, 0), d(1, 1), d(0, 2)
+    w = np.sqrt(1.0 + fp * fp + fc * fc)
+    # The tangent direction across the passes: perpendicular to the path (1, 0, fp) in the tangent plane.
+    a, b = -fp * fc, 1.0 + fp * fp
+    k = (fpp * a * a + 2 * fpc * a * b + fcc * b * b) / (w * (a * a + b * b + (a * fp + b * fc) ** 2))
+    return along, cross, np.sqrt(1.0 + fp * fp) / w, k
+
+
+def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scallop_mm: float,
+                   mm_per_unit: float) -> ScallopRows:
+    """Row levels across the box whose cusps, normal to the surface, are at most ``scallop_mm`` (see the module)."""
+    flat = scallop_stepover(radius_mm, scallop_mm)
+    along, cross, stretch, k = _samples(ev, direction, mm_per_unit, flat)
+    d = _allowed_d(k, radius_mm, scallop_mm)
+    d = np.where(d < _TIGHT * flat, np.nan, d)
+    k = np.where(np.isnan(d), np.nan, k)  # left out of the prediction too
+    gap_mm = d * stretch
+    tight = int(np.isnan(gap_mm).sum())
+    per_sample = np.where(np.isnan(gap_mm), np.inf, gap_mm).min(axis=1) / mm_per_unit  # (cross,), surface units
+    r = radius_mm / mm_per_unit
+    floor = flat * _FLOOR / mm_per_unit
+    finite = per_sample[np.isfinite(per_sample)]
+    top = max(float(finite.max()) if finite.size else 0.0, flat / mm_per_unit)
+    per_sample = np.where(np.isfinite(per_sample), per_sample, top)
+    c0, c1 = float(cross[0]), float(cross[-1])
+    levels = [c0]
+    while levels[-1] < c1:
+        c = levels[-1]
+        j0 = int(np.searchsorted(cross, c - r, side="left"))
+        run = np.minimum.accumulate(per_sample[j0:])
+
+        def allowed(s):  # the smallest gap allowed over the band the passes at c and c + s touch
+            j = int(np.searchsorted(cross, c + s + r, side="right")) - 1 - j0
+            return run[min(max(j, 0), len(run) - 1)]
+
+        lo, hi = 0.0, top
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if mid <= allowed(mid) else (lo, mid)
+        s = max(lo, floor)
+        levels.append(min(c + s, c1) if c1 - (c + s) > 1e-9 * (c1 - c0) else c1)
+    levels = np.array(levels)
+    worst, at = _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit)
+    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight)
+
+
+def _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit):
+    """The largest cusp predicted between the rows at ``levels``, over each gap's band, and where."""
+    worst, at = 0.0, (float(along[0]), float(cross[0]))
+    for c, nxt in zip(levels[:-1], levels[1:]):
+        band = slice(int(np.searchsorted(cross, c - r)), int(np.searchsorted(cross, nxt + r, side="right")))
+        h = cusp_height((nxt - c) * mm_per_unit / stretch[band], k[band], radius_mm)
+        if np.isfinite(h).any():
+            i = np.nanargmax(h)
+            if h.flat[i] > worst:
+                jc, ja = np.unravel_index(i, h.shape)
+                worst, at = float(h.flat[i]), (float(along[ja]), float(cross[band][jc]))
+    return worst, at
