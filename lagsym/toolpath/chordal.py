@@ -177,7 +177,35 @@ def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
     est = d + np.maximum(0.0, 2.0 * d - left - right) / 4.0
     order = np.lexsort((-est, idx))
     worst = order[start]  # the worst sample of each move
-    return np.maximum(est[worst], 0.0), u[worst], zc[worst]
+    du, dz, zw = _zoom(cl, (ax, ay, az, bx, by, bz), u[worst], d[worst], zc[worst], 1.0 / (n_move + 1))
+    return np.maximum(np.maximum(est[worst], dz), 0.0), du, zw
+
+
+_ZOOM_SAMPLES, _ZOOM_ROUNDS = 6, 3
+
+
+def _zoom(cl, move, u, d, z, half):
+    """The dip of each move searched closer around its worst sample ``u`` (fraction along it; ``half`` apart).
+
+    A path that bends sharply next to a sample (where the tool starts to
+    rest on a box edge) can rise above the move between two samples by more
+    than their second differences show; :data:`_ZOOM_ROUNDS` rounds of
+    :data:`_ZOOM_SAMPLES` samples, each over a third of the span before,
+    find that peak.  Returns the best fraction, the dip there and the cutter
+    location there.
+    """
+    ax, ay, az, bx, by, bz = move
+    t = np.linspace(-1.0, 1.0, _ZOOM_SAMPLES)
+    for _ in range(_ZOOM_ROUNDS):
+        q = np.clip(u[:, None] + half[:, None] * t[None, :], 0.0, 1.0)
+        zq = cl(ax[:, None] + q * (bx - ax)[:, None], ay[:, None] + q * (by - ay)[:, None])
+        dq = zq - (az[:, None] + q * (bz - az)[:, None])
+        k = np.argmax(dq, axis=1)
+        rows = np.arange(len(u))
+        better = dq[rows, k] > d
+        u, d, z = np.where(better, q[rows, k], u), np.where(better, dq[rows, k], d), np.where(better, zq[rows, k], z)
+        half = half / 3.0
+    return u, d, z
 
 
 def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
