@@ -99,7 +99,10 @@ def test_a_signal_stops_a_long_write_with_one_line_and_no_partial_file(tmp_path,
     proc = subprocess.Popen(
         [sys.executable, "-m", "lagsym", "sample", str(EXAMPLES / "paper-example-4.json"),
          "--nx", "3000", "--ny", "3000", "-o", str(out)],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        # A shell's background job starts with SIGINT ignored, and Python then leaves it so: a command run
+        # from a terminal has it at its default, which is what this checks.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while not any(p.name.endswith(".part.csv") for p in tmp_path.iterdir()):
         assert proc.poll() is None, proc.communicate()

@@ -558,7 +558,7 @@ def test_cli_units_reach_the_axes(run_cli, tmp_path, monkeypatch):
     (["--show", "growth"], "--show growth needs exactly one FORMULA"),
     (["--scale", "20", "-o", "x.png"], "--scale and --origin place a program on the machine"),
     (["--show", "basis", "--z-exaggeration", "2", "-o", "x.png"], "--z-exaggeration applies to a surface"),
-    (["--z-exaggeration", "0", "-o", "x.png"], "z exaggeration 0.0 must be a positive number"),
+    (["--z-exaggeration", "0", "-o", "x.png"], "argument --z-exaggeration: '0' is out of range"),
     (["--show", "toolpath", "part.ngc", "-o", "x.png"], "part.ngc: no such file"),
     (["--show", "wireframe"], "--show 'wireframe' is not one of: surface, basis, compare, toolpath, growth"),
     (["--show", "basis", "extra"], "--show basis takes no file, but got 'extra'"),

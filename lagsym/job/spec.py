@@ -135,7 +135,8 @@ def _choice(value, options, key: str, source: str):
 # The ranges of the command line's options (lagsym.cli._common), by the last part of the key: every number
 # of a job file is finite and one a program word and the planners can hold.
 _RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plunge_feed": (1.0, 1e5),
-           "spindle": (1.0, 2e5), "diameter": (0.0, 1000.0), "flute_length": (0.0, 1e4), "reach": (0.0, 1e4),
+           "spindle": (1.0, 2e5), "diameter": (0.0, 1000.0), "corner_radius": (0.0, 500.0), "flute_length": (0.0, 1e4),
+           "reach": (0.0, 1e4),
            "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
            "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
            "tolerance": (1e-6, 1000.0)}
