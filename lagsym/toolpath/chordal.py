@@ -198,7 +198,8 @@ def _zoom(cl, move, u, d, z, half):
     t = np.linspace(-1.0, 1.0, _ZOOM_SAMPLES)
     for _ in range(_ZOOM_ROUNDS):
         q = np.clip(u[:, None] + half[:, None] * t[None, :], 0.0, 1.0)
-        zq = cl(ax[:, None] + q * (bx - ax)[:, None], ay[:, None] + q * (by - ay)[:, None])
+        zq = cl((ax[:, None] + q * (bx - ax)[:, None]).ravel(), (ay[:, None] + q * (by - ay)[:, None]).ravel())
+        zq = np.asarray(zq).reshape(q.shape)
         dq = zq - (az[:, None] + q * (bz - az)[:, None])
         k = np.argmax(dq, axis=1)
         rows = np.arange(len(u))
