@@ -35,7 +35,7 @@ from .evaluate import evaluate_grid
 from .gcode import Moves
 from .machine import Placement, Tool, cutter_profile
 
-__all__ = ["CutReport", "simulate_cut", "press_moves", "MAX_CELLS", "MAX_CONTACTS"]
+__all__ = ["CutReport", "simulate_cut", "press_moves", "height_map_axes", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
@@ -152,23 +152,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
         Refuse, before any work, more cells (``--max-cells``) or tool
         positions times cells under the tool (``--max-contacts``); None: no limit.
     """
-    x0, x1, y0, y1 = placement.box_mm(surface.grid.bounds)
-    if cell_mm is None:
-        cell_mm = max(x1 - x0, y1 - y0) / 400.0
-    if not cell_mm > 0:
-        raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
-    nx, ny = _cells(x1 - x0, y1 - y0, cell_mm, max_cells)
-    xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+    xs, ys = height_map_axes(placement.box_mm(surface.grid.bounds), cell_mm, max_cells)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
     surf = placement.height_mm(evaluate_grid(surface, sx, sy))
-    r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
-    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
-    ds = 0.5 * min(hx, hy)
-    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
-    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
-    limit = program_resolution_mm + resolution if gouge_limit_mm is None else float(gouge_limit_mm)
-    cut = np.full((nx, ny), np.inf)
+    cut = np.full((len(xs), len(ys)), np.inf)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
     known = np.asarray(moves.z_known, dtype=bool)
     path = moves.path_mm
@@ -176,8 +164,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     a_all, b_all = path[:-1][use], path[1:][use]
     if not len(a_all):
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
-    _check_work(a_all, b_all, ds, dz_mm, r, hx, hy, max_contacts)
-    positions = _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm)
+    positions, resolution = press_moves(cut, xs, ys, a_all, b_all, tool, dz_mm, max_contacts)
+    limit = program_resolution_mm + resolution if gouge_limit_mm is None else float(gouge_limit_mm)
     reached = np.isfinite(cut)
     diff = np.where(reached, cut - surf, np.nan)
     if reached.any():
@@ -217,14 +205,22 @@ def _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm) -> int:
     return positions
 
 
-def _cells(width: float, depth: float, cell_mm: float, max_cells: int | None) -> tuple[int, int]:
-    """Cells of the height map in x and y, refused beyond ``max_cells``."""
-    nx = max(int(math.ceil(width / cell_mm)) + 1, 2)
-    ny = max(int(math.ceil(depth / cell_mm)) + 1, 2)
+def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """Cell centres in x and y of a height map over ``box_mm`` ``(x0, x1, y0, y1)``, refused beyond ``max_cells``.
+
+    ``cell_mm`` defaults to the longer side / 400.
+    """
+    x0, x1, y0, y1 = box_mm
+    if cell_mm is None:
+        cell_mm = max(x1 - x0, y1 - y0) / 400.0
+    if not cell_mm > 0:
+        raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
+    nx = max(int(math.ceil((x1 - x0) / cell_mm)) + 1, 2)
+    ny = max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
     if max_cells is not None and nx * ny > max_cells:
         raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
                          f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
-    return nx, ny
+    return np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
 
 
 def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_contacts: int | None) -> None:
@@ -290,6 +286,7 @@ def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, 
     r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
     corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
     ds = 0.5 * min(hx, hy)
+    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
     resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
     if not len(a):
         return 0, resolution
