@@ -22,13 +22,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import freeze_fields
-from .errors import InputError, ToolpathError
+from .errors import InputError
 from .evaluate import evaluate_grid
-from .gcode import Moves
+from .gcode import Moves, parse_moves, tool_changes
+from .io import read_points
+from .job.operations import job_stock
+from .lagrange import lagrange_surface
 from .machine import Placement, Tool
-from .verify import MAX_CELLS, press_moves
+from .verify import MAX_CELLS, height_map_axes, press_moves
 
-__all__ = ["Stage", "MachinedPart", "machine_part", "LEFT_BINS_MM"]
+__all__ = ["Stage", "MachinedPart", "machine_part", "machine_job", "LEFT_BINS_MM"]
 
 LEFT_BINS_MM = (0.01, 0.05, 0.1, 0.5, 1.0, 2.0, 5.0)
 """Upper edges (mm) of the material-left histogram; the last bin holds everything above 5 mm."""
@@ -142,7 +145,7 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
         rounding plus the finest stage's resolution).
     """
     x0, x1, y0, y1, top = (float(v) for v in block)
-    xs, ys = _cells(x0, x1, y0, y1, cell_mm, max_cells)
+    xs, ys = height_map_axes((x0, x1, y0, y1), cell_mm, max_cells)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     surf = _surface_on(surface, placement, xs, ys)
     inside = np.isfinite(surf)
@@ -170,16 +173,18 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
                         max(resolutions))
 
 
-def _cells(x0, x1, y0, y1, cell_mm, max_cells):
-    if cell_mm is None:
-        cell_mm = max(x1 - x0, y1 - y0) / 400.0
-    if not cell_mm > 0:
-        raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
-    nx, ny = max(int(math.ceil((x1 - x0) / cell_mm)) + 1, 2), max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
-    if max_cells is not None and nx * ny > max_cells:
-        raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
-                         f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
-    return np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+def machine_job(spec, text: str, source: str = "<program>", **options) -> MachinedPart:
+    """Simulate a job's program ``text`` from the block of the job ``spec`` (:func:`lagsym.job.read_job`).
+
+    The surface is read from the job's points file, the block and the
+    placement are the job's, each tool number its cutter; ``options`` go to
+    :func:`machine_part` (``cell_mm``, ``gouge_limit_mm``, ``max_cells``).
+    """
+    surface = lagrange_surface(read_points(spec.points))
+    stock = job_stock(spec, surface)
+    return machine_part(surface, parse_moves(text, source=source), tool_changes(text, source=source),
+                        {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
+                        Placement(spec.mm_per_unit, spec.origin_mm), **options)
 
 
 def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:

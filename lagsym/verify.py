@@ -46,8 +46,8 @@ from .evaluate import evaluate_grid, surface_evaluator
 from .gcode import Moves
 from .machine import MAX_LEFT_MM, Placement, Tool, cutter_profile
 
-__all__ = ["CutReport", "simulate_cut", "press_moves", "gouge_limit", "program_resolution_mm", "MAX_CELLS",
-           "MAX_CONTACTS", "MAX_LEFT_MM"]
+__all__ = ["CutReport", "simulate_cut", "press_moves", "height_map_axes", "gouge_limit", "program_resolution_mm",
+           "MAX_CELLS", "MAX_CONTACTS", "MAX_LEFT_MM"]
 
 _MOVES_PER_PASS = 20_000
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
@@ -254,22 +254,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     max_scallop_mm : float, optional
         Scallop (normal to the surface) above which the program fails; by default not checked.
     """
-    x0, x1, y0, y1 = placement.box_mm(surface.grid.bounds)
-    if cell_mm is None:
-        cell_mm = max(x1 - x0, y1 - y0) / 400.0
-    if not cell_mm > 0:
-        raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
-    nx, ny = _cells(x1 - x0, y1 - y0, cell_mm, max_cells)
-    xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+    xs, ys = height_map_axes(placement.box_mm(surface.grid.bounds), cell_mm, max_cells)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
     surf = placement.height_mm(evaluate_grid(surface, sx, sy))
     slope = _slopes(surface, sx, sy)
-    r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
-    corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
-    ds = 0.5 * min(hx, hy)
-    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
-    resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
     limit = gouge_limit(program_resolution_mm, float(slope.max())) if gouge_limit_mm is None else float(gouge_limit_mm)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
     known = np.asarray(moves.z_known, dtype=bool)
@@ -277,10 +266,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     use = known & np.concatenate([[False], known[:-1]]) if len(moves) else known
     if not use.any():
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
+    r, corner, ds, resolution = _tool_grid(tool, xs, ys, dz_mm)
     _check_work(path[:-1][use], path[1:][use], ds, dz_mm, r, hx, hy, max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
-    cut = np.full((nx, ny), np.inf)
-    positions = _sweep(cut, path[:-1][use & ~rapid], path[1:][use & ~rapid], xs, ys, r, corner, ds, dz_mm)
+    cut = np.full((len(xs), len(ys)), np.inf)
+    positions, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, dz_mm, None)
     crash, crash_positions = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner, ds, dz_mm))
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
                      rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
@@ -370,14 +360,22 @@ def _sweep(cut, a_all, b_all, xs, ys, r, corner, ds, dz_mm) -> int:
     return positions
 
 
-def _cells(width: float, depth: float, cell_mm: float, max_cells: int | None) -> tuple[int, int]:
-    """Cells of the height map in x and y, refused beyond ``max_cells``."""
-    nx = max(int(math.ceil(width / cell_mm)) + 1, 2)
-    ny = max(int(math.ceil(depth / cell_mm)) + 1, 2)
+def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """Cell centres in x and y of a height map over ``box_mm`` ``(x0, x1, y0, y1)``, refused beyond ``max_cells``.
+
+    ``cell_mm`` defaults to the longer side / 400.
+    """
+    x0, x1, y0, y1 = box_mm
+    if cell_mm is None:
+        cell_mm = max(x1 - x0, y1 - y0) / 400.0
+    if not cell_mm > 0:
+        raise ToolpathError(f"cell size {cell_mm!r} must be a positive number of mm")
+    nx = max(int(math.ceil((x1 - x0) / cell_mm)) + 1, 2)
+    ny = max(int(math.ceil((y1 - y0) / cell_mm)) + 1, 2)
     if max_cells is not None and nx * ny > max_cells:
         raise InputError(f"a height map of {nx} x {ny} cells of {cell_mm:g} mm is {nx * ny:.3g} cells, more than the "
                          f"limit of {max_cells:.3g}; use a larger cell (--cell) or raise the limit (--max-cells)")
-    return nx, ny
+    return np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
 
 
 def _check_work(a, b, ds: float, dz: float, r: float, hx: float, hy: float, max_contacts: int | None) -> None:
@@ -439,12 +437,19 @@ def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, 
     centres.  Returns the number of tool positions simulated and the
     simulation's vertical resolution (as :func:`simulate_cut` states it).
     """
+    r, corner, ds, resolution = _tool_grid(tool, xs, ys, dz_mm)
+    if not len(a):
+        return 0, resolution
+    _check_work(a, b, ds, dz_mm, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts)
+    return _sweep(cut, a, b, xs, ys, r, corner, ds, dz_mm), resolution
+
+
+def _tool_grid(tool: Tool, xs: np.ndarray, ys: np.ndarray, dz_mm: float) -> tuple[float, float, float, float]:
+    """The simulated tool's radius and corner, the sample step along a move and the simulation's vertical resolution."""
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     r = tool.radius_mm if tool.radius_mm > 0 else 0.5 * min(hx, hy)
     corner = tool.corner_mm if tool.radius_mm > 0 else 0.0
     ds = 0.5 * min(hx, hy)
+    # Between two samples the tool's lower surface can rise by its corner's sag over half a sample step.
     resolution = (corner - math.sqrt(max(corner * corner - (ds / 2) ** 2, 0.0)) if corner > 0 else 0.0) + dz_mm / 2
-    if not len(a):
-        return 0, resolution
-    _check_work(a, b, ds, dz_mm, r, hx, hy, max_contacts)
-    return _sweep(cut, a, b, xs, ys, r, corner, ds, dz_mm), resolution
+    return r, corner, ds, resolution

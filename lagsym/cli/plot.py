@@ -6,7 +6,7 @@ import argparse
 
 from ..errors import InputError
 from ..grid import CurvePoints
-from ..io import read_any_points, read_points
+from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
 from ._common import SCALE, count, number
 
@@ -180,23 +180,14 @@ def _growth_figure(plot, grid, formula, opts):
 
 def _machined_figure(plot, job_file, program, args):
     """The block after each tool of a job, coloured by the material left (the paper's Figures 13 and 15)."""
-    from ..gcode import parse_moves, tool_changes
     from ..io import read_program
     from ..job import read_job
-    from ..job.operations import job_stock
-    from ..machine import Placement
-    from ..machined import machine_part
+    from ..machined import machine_job
 
     for option in ("scale", "origin", "units", "samples"):
         if getattr(args, option) is not None:
             raise InputError(f"--{option} is not for --show machined: the job file {job_file} places the part")
-    spec = read_job(job_file)
-    surface = lagrange_surface(read_points(spec.points))
-    stock = job_stock(spec, surface)
-    text = read_program(program)
-    part = machine_part(surface, parse_moves(text, source=program), tool_changes(text, source=program),
-                        {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
-                        Placement(spec.mm_per_unit, spec.origin_mm), cell_mm=args.cell)
+    part = machine_job(read_job(job_file), read_program(program), source=program, cell_mm=args.cell)
     opts = dict(window_size=args.size, off_screen=True if args.output else None)
     if args.z_exaggeration is not None:
         opts["z_exaggeration"] = args.z_exaggeration

@@ -6,7 +6,7 @@
 from __future__ import annotations
 
 from ..errors import ExitStatus, InputError
-from ..gcode import parse_moves, tool_changes
+from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
@@ -97,8 +97,7 @@ def run(args, out, err) -> int:
 
 def _run_job(args, out) -> int:
     from ..job import read_job
-    from ..job.operations import job_stock
-    from ..machined import machine_part
+    from ..machined import machine_job
 
     if args.max_scallop is not None:
         raise InputError("--max-scallop is for a single program; with --job verify checks the material left "
@@ -108,15 +107,8 @@ def _run_job(args, out) -> int:
         option = "--" + given[0].replace("_", "-")
         raise InputError(f"{option} is not for --job: the job file {args.surface} names the tools, scale and origin")
     spec = read_job(args.surface)
-    surface = lagrange_surface(read_points(spec.points))
-    stock = job_stock(spec, surface)
-    text = read_program(args.program)
-    moves = parse_moves(text, source=args.program)
-    changes = tool_changes(text, source=args.program)
-    tools = {t.number: t.tool for t in spec.tools.values()}
-    part = machine_part(surface, moves, changes, tools, stock.box + (stock.top_mm,),
-                        Placement(spec.mm_per_unit, spec.origin_mm), cell_mm=args.cell,
-                        gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells)
+    part = machine_job(spec, read_program(args.program), source=args.program, cell_mm=args.cell,
+                       gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells)
     out.write("\n".join(part.summary()) + "\n")
     too_much = args.max_left is not None and part.left_mm > args.max_left
     if too_much:
