@@ -42,7 +42,7 @@ def page() -> str:
         "Every command of `lagsym`, as its `--help` prints it.  This page is generated from the",
         "parser (`python3 docs/gen_cli.py`), and the tests check that it is current and run the",
         "examples under each command, so neither can drift from the program.\n",
-        "Exit statuses: 0 success; 1 a finding (`check --strict` warning, `verify` gouge);",
+        "Exit statuses: 0 success; 1 a finding (`check --strict` warning, `verify` gouge, rapid crash or material left);",
         "2 bad input or options (one line on standard error naming the file and value, nothing",
         "written); 3 a fault on the serial line or at the machine (the message says what to do",
         "next); 129, 130, 143 stopped by SIGHUP, Ctrl-C, SIGTERM (no partial file left); 70 an",

@@ -19,7 +19,7 @@ from .values import as_exact, choice, finite, positive
 
 __all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
-           "cutter_profile"]
+           "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
 DIALECTS = ("fanuc", "linuxcnc", "heidenhain", "grbl")
 TOOL_SHAPES = ("ball", "flat", "bull")  # bull: a bull-nose (corner-radius) end mill
@@ -30,6 +30,11 @@ UNITS = ("mm", "inch")
 COOLANTS = ("off", "flood", "mist")  # M08 flood, M07 mist, M09 off at the end
 _WORK_OFFSET = re.compile(r"G5[4-9]|G59\.[1-3]|G54\.1 P[1-9]\d{0,2}")
 DIRECTIONS = ("x", "y")
+BOUNDARIES = ("inside", "centre", "past")
+DEFAULT_TOLERANCE_MM = 0.005
+"""Chordal tolerance of a finishing pass given a fixed forward step and no tolerance of its own."""
+MAX_LEFT_MM = 0.1
+"""Material left above the surface from which a finishing program fails verification, by default."""
 MM_PER_INCH = Fraction(254, 10)
 MM_PER = {"mm": Fraction(1), "inch": MM_PER_INCH}
 
@@ -330,7 +335,17 @@ class RasterSpec:
 
     Give ``stepover_mm`` or ``scallop_mm`` (side step from the cusp height of a
     ball-end cutter), and ``step_mm`` or ``tolerance_mm`` (forward step from the
-    chordal error).  All in millimetres on the machine.
+    chordal error).  All in millimetres on the machine.  A step is the longest
+    move: points are added where the path bends, so that every move keeps the
+    chordal tolerance (:data:`DEFAULT_TOLERANCE_MM` unless one is given).
+
+    ``boundary`` says where the tool may go, as in CAM: ``inside`` keeps the
+    whole tool inside the control points' box, ``centre`` keeps the tool axis
+    inside it, ``past`` (the default) lets the tool axis go beyond it, as far
+    as the tool can still touch the part there (for a ball, the tool radius
+    times the sine of the surface's steepest slope angle; for a flat end, the
+    tool radius), so that the tool reaches the box edges also where the surface
+    is steep there.
     """
 
     direction: str = "x"
@@ -338,9 +353,11 @@ class RasterSpec:
     step_mm: float | None = 0.2
     scallop_mm: float | None = None
     tolerance_mm: float | None = None
+    boundary: str = "past"
 
     def __post_init__(self):
         choice(self.direction, DIRECTIONS, "raster direction")
+        choice(self.boundary, BOUNDARIES, "boundary")
         if self.stepover_mm is None and self.scallop_mm is None:
             raise ToolpathError("give a side step (--stepover) or a scallop height (--scallop)")
         if self.step_mm is None and self.tolerance_mm is None:
@@ -349,3 +366,8 @@ class RasterSpec:
             v = getattr(self, name)
             if v is not None:
                 positive(v, name.replace("_mm", "").replace("_", " "))
+
+    @property
+    def chordal_tolerance_mm(self) -> float:
+        """The chordal tolerance the moves keep: the one given, or :data:`DEFAULT_TOLERANCE_MM`."""
+        return DEFAULT_TOLERANCE_MM if self.tolerance_mm is None else float(self.tolerance_mm)

@@ -168,6 +168,12 @@ def test_the_bull_nose_program_reads_in_the_interpreter_and_verifies(run_cli, bu
     assert len(feeds) > 400
     status, out, err = run_cli("verify", EX2, bull_program, "--scale", "10", "--tool-shape", "bull",
                                "--tool-diameter", "10", "--corner-radius", "2")
+    # A 2 mm side step with a 2 mm corner leaves cusps of over a millimetre on the 74 degree flanks: beyond the
+    # default --max-left of 0.1 mm, and the only finding.
+    assert status == 1 and "worst gouge" in out and ": none" in out.split("worst gouge")[1].splitlines()[0], out
+    assert "TOO MUCH" in out.split("material left")[1].splitlines()[0] and "rapid into part" in out, out
+    status, out, err = run_cli("verify", EX2, bull_program, "--scale", "10", "--tool-shape", "bull",
+                               "--tool-diameter", "10", "--corner-radius", "2", "--max-left", "2")
     assert status == 0, out + err
     # verify draws the tool it is told: a flat end of the same diameter on this path cuts into the part
     status, out, _ = run_cli("verify", EX2, bull_program, "--scale", "10", "--tool-shape", "flat",

@@ -51,7 +51,7 @@ def moves_near_edges(tp, within_mm):
 def example1_corner():
     """Example 1 at scale 10 with a 6 mm ball: the tool rolls onto the steep box edge x = 50 and the corner."""
     surf = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
-    tp = plan(surf, raster=RasterSpec("x", None, None, 0.01, 0.005), scale=10.0)
+    tp = plan(surf, raster=RasterSpec("x", None, None, 0.01, 0.005, boundary="centre"), scale=10.0)
     return surf, tp
 
 
@@ -92,8 +92,8 @@ def test_example1_program_does_not_gouge_at_the_corner(example1_corner):
     assert report.gouge_mm <= report.gouge_limit_mm
 
 
-# Derandomized: a random search found the dip in test_known_dip_in_tolerance_mode below, a planner
-# defect still open; until it is fixed this property runs the same ten examples every time.
+# Derandomized: a random search found the dip in test_known_dip_in_tolerance_mode below (now fixed);
+# this property runs the same ten examples every time.
 @settings(max_examples=10, derandomize=True)
 @given(surfaces(), st.floats(0.5, 3.0), st.sampled_from(["ball", "flat"]), st.sampled_from(["x", "y"]),
        st.sampled_from([None, 0.02]), st.integers(0, 2**31))
@@ -101,9 +101,9 @@ def test_no_move_dips_below_the_cutter_path(surf, radius, shape, direction, tol,
     _no_move_dips(surf, radius, shape, direction, tol, seed)
 
 
-@pytest.mark.xfail(strict=True, reason="open defect: in tolerance mode a move dips 0.71 um below the cutter path "
-                                       "(limit 0.1 um) where the ball meets a box edge")
 def test_known_dip_in_tolerance_mode():
+    # Regression: in tolerance mode a move dipped 0.71 um below the cutter path (limit 0.1 um) where the
+    # ball meets a box edge; the checks now take the bend between their samples into account.
     surf = lagrange_surface(grid_from_table([0, 2], [0, Fraction(3, 2), 3],
                                             [[Fraction(-5, 2), -1, 1], [Fraction(5, 2), Fraction(5, 2), 3]]))
     _no_move_dips(surf, 1.375, "ball", "y", 0.02, 2)
@@ -121,4 +121,12 @@ def _no_move_dips(surf, radius, shape, direction, tol, seed):
     # planner's own samples miss is far below the program's resolution of 0.001 mm.
     assert above.max() <= 1e-4
     if tol is not None:
-        assert tp.lift_mm.max() <= tol + 1e-12
+        # A move a few units of the program's last decimal long cannot be split; where it still bends more
+        # than the tolerance (a flat end's rim leaving a box corner beyond the box: its height falls 0.1 mm
+        # within one unit) it is lifted by its dip, as Toolpath.lift_mm and the command's output say.
+        p = tp.points_mm
+        short = np.hypot(*np.diff(p[:, :2], axis=0).T) < 0.003
+        at_short = np.zeros(len(p), dtype=bool)
+        at_short[:-1] |= short
+        at_short[1:] |= short
+        assert tp.lift_mm[~at_short].max() <= tol + 1e-12

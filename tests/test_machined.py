@@ -108,6 +108,7 @@ def test_verify_job_reports_each_tool_and_exits_by_what_it_finds(run_cli, tmp_pa
 @pytest.mark.parametrize("args, message", [
     (["--tool-diameter", "6"], "--tool-diameter is not for --job"),
     (["--scale", "2"], "--scale is not for --job"),
+    (["--max-scallop", "0.1"], "--max-scallop is for a single program"),
 ])
 def test_verify_job_refuses_the_single_tool_options(run_cli, tmp_path, args, message):
     job, prog = _job(tmp_path)
@@ -123,5 +124,3 @@ def test_verify_job_refuses_a_program_with_an_unknown_tool_or_no_tool_change(run
     prog.write_text(SLOT.replace("T1 M06\n", "").replace("T2 M06\n", ""))
     status, _, err = run_cli("verify", "--job", job, prog)
     assert status == 2 and "no tool change" in err
-    status, _, err = run_cli("verify", EXAMPLES / "paper-example-2.json", prog, "--max-left", "1")
-    assert status == 2 and "--max-left is for a whole job" in err

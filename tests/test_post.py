@@ -207,7 +207,7 @@ def test_cli_inch_surface_is_programmed_at_25_4_mm_a_unit(rs274, run_cli, tmp_pa
     data["units"] = "inch"
     f = tmp_path / "inch.json"
     f.write_text(json.dumps(data))
-    args = ("--stepover", 5, "--step", 5, "--safe-z", 120, "--dialect", "linuxcnc")
+    args = ("--stepover", 5, "--step", 5, "--safe-z", 120, "--dialect", "linuxcnc", "--boundary", "centre")
     status, text, err = run_cli("toolpath", f, *args)
     assert status == 0, err
     same = run_cli("toolpath", EXAMPLES / "paper-example-4.json", "--scale", 25.4, *args)[1]

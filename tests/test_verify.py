@@ -15,9 +15,10 @@ from lagsym.lagrange import lagrange_surface
 from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.post.program import PointProgram, point_program, write_program
 from lagsym.toolpath import plan_toolpath
-from lagsym.verify import simulate_cut
+from lagsym.verify import gouge_limit, program_resolution_mm, simulate_cut
 
 from conftest import EXAMPLES
+from cutters import exact_heights, swept_ball
 
 EX2 = EXAMPLES / "paper-example-2.json"
 
@@ -41,9 +42,11 @@ def test_lagsyms_program_does_not_gouge(ex2_program):
     surf, tp, _, text = ex2_program
     report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.25)
     assert not report.gouges
-    assert report.gouge_mm <= 1e-4
+    # Within the program's rounding: X and Y are rounded to the nearest unit of the last decimal over the box.
+    assert report.gouge_mm <= 0.0005
     assert report.unreached_mm2 == 0.0
     assert 0.0 < report.scallop_mm < 10.0
+    assert not report.crashes and report.rapid_mm == 0.0
     with pytest.raises(ValueError):
         report.cut_mm[0, 0] = 0.0
 
@@ -95,8 +98,9 @@ def test_verify_command_exit_statuses(run_cli, tmp_path, ex2_program):
     _, _, _, text = ex2_program
     good = tmp_path / "good.ngc"
     good.write_text(text)
-    status, out, err = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3")
-    assert status == 0, err
+    status, out, err = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3",
+                               "--max-left", "1")
+    assert status == 0, out + err
     assert "worst gouge" in out and "none" in out
     status, out, _ = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "8", "--cell", "0.3")
     assert status == 1 and "GOUGE" in out  # the program was made for a smaller ball
@@ -126,3 +130,108 @@ def test_toolpath_command_writes_a_program_the_interpreter_accepts(run_cli, tmp_
     assert status == 2 and "ball" in err
     status, out, _ = run_cli("toolpath", EX2, "--scale", "5", "--stepover", "3", "--step", "2", "--dialect", "grbl")
     assert status == 0 and out.startswith("(PAPER-EXAMPLE-2.JSON)")
+
+
+def test_a_5_um_gouge_at_one_point_fails_under_the_default_limit(ex2_program):
+    # Regression: the default limit was the program's rounding plus the simulation's resolution, 5.5 um here.
+    surf, tp, s, _ = ex2_program
+    p = np.array(tp.points_mm)
+    k = int(np.argmin(np.abs(p[:, 0] - 25.0) + np.abs(p[:, 1] - 25.0)))
+    p[k, 2] = tp.exact_mm[k] - 0.005  # 5 um below its cutter location (the plan may have lifted it)
+    text = write_program(PointProgram(p, s))
+    report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.1,
+                          program_resolution_mm=program_resolution_mm(text))
+    assert report.gouges and report.fails, report.summary()
+    assert 0.003 <= report.gouge_mm <= 0.005 + 0.001
+    # The limit is what the rounding of a correct program can cause, computed here on its own.
+    t, h = np.linspace(1.0, 4.0, 31), 1e-5
+    lo, hi = np.clip(t - h, 1.0, 4.0), np.clip(t + h, 1.0, 4.0)
+    fx = (exact_heights(surf, hi, t) - exact_heights(surf, lo, t)) / (hi - lo)[:, None]
+    fy = (exact_heights(surf, t, hi) - exact_heights(surf, t, lo)) / (hi - lo)[None, :]
+    slope = np.hypot(fx, fy).max()
+    assert report.gouge_limit_mm == pytest.approx(0.0005 * (1 + np.sqrt(2) * slope), rel=0.05)
+    assert report.gouge_limit_mm < 0.003
+
+
+def test_program_resolution_and_limit():
+    assert program_resolution_mm("(TOOL 6.00000)\nG21 G90\nG01 X1.000 Y2.000 Z-0.125 F600.0\n") == 0.0005
+    assert program_resolution_mm("G20\nG01 X1.0000 Y2.0000\n") == pytest.approx(0.00127)
+    assert gouge_limit(0.0005, 0.0) == 0.0005
+
+
+def test_a_rapid_into_the_part_is_a_rapid_crash_with_its_line(ex2_program, run_cli, tmp_path):
+    surf, tp, s, text = ex2_program
+    lines = text.splitlines()
+    # A rapid straight across the part at 5 mm below its top, after the program's first moves.
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("G01")) + 1
+    z = float(tp.points_mm[:, 2].max()) - 5.0
+    lines[k:k] = [f"G00 Z{z:.3f}", "G00 X25.000 Y25.000", "G00 Z60.000"]
+    bad = "\n".join(lines) + "\n"
+    report = simulate_cut(surf, parse_moves(bad), tp.tool, Placement(10.0), cell_mm=0.3)
+    assert report.crashes and report.fails
+    assert report.rapid_line in (k + 1, k + 2)
+    assert report.rapid_mm > 1.0
+    f = tmp_path / "crash.ngc"
+    f.write_text(bad)
+    status, out, _ = run_cli("verify", EX2, f, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3")
+    assert status == 1 and "RAPID CRASH" in out and f"(line {report.rapid_line})" in out
+
+
+def test_material_left_is_reported_apart_from_the_gouge(run_cli, tmp_path):
+    surf = lagrange_surface(read_points(EX2))
+    s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0, stock_to_leave_mm=0.3)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s)
+    text = write_program(point_program(tp, s))
+    report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.3)
+    assert not report.gouges and not report.crashes and report.leaves_material
+    # Independently: a ball swept along the program's points over the exact surface, on a row of cells.
+    xs, ys = np.linspace(10.0, 40.0, 61), np.array([24.5, 25.0, 25.5])
+    above = swept_ball(tp.points_mm, 3.0, xs, ys) - exact_heights(surf, xs / 10, ys / 10) * 10
+    assert above.min() >= 0.3 - 0.01 and report.left_height_mm >= above.max() - 0.01
+    assert 0.3 * 0.5 <= report.left_mm <= report.left_height_mm
+    f = tmp_path / "stock.ngc"
+    f.write_text(text)
+    status, out, _ = run_cli("verify", EX2, f, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3")
+    assert status == 1 and "TOO MUCH" in out and "worst gouge" in out and "GOUGE" not in out
+    status, out, _ = run_cli("verify", EX2, f, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3",
+                             "--max-left", "2")
+    assert status == 0, out
+
+
+@pytest.mark.slow
+def test_readme_finishing_example(run_cli, tmp_path):
+    """The README's finishing example finishes the part's edges; the figures docs/toolpaths.md quotes."""
+    import re
+
+    ex4 = EXAMPLES / "paper-example-4.json"
+    prog = tmp_path / "O1000.nc"
+    status, _, err = run_cli("toolpath", ex4, "--scale", "20", "--tool-diameter", "6", "--stepover", "0.4",
+                             "--step", "0.2", "--feed", "600", "--safe-z", "80", "--dialect", "fanuc", "-o", prog)
+    assert status == 0, err
+    status, out, _ = run_cli("verify", ex4, prog, "--scale", "20", "--tool-diameter", "6")
+    num = r"([0-9.]+)"
+    gouge, limit = map(float, re.search(rf"worst gouge +{num} mm at .* \(limit {num} mm\): none", out).groups())
+    assert re.search(r"rapid into part +0\.0000 mm .*: none", out)
+    left, height, y = map(float, re.search(
+        rf"material left +{num} mm normal to the surface \({num} mm above it\) at X[0-9.]+ Y{num}", out).groups())
+    scallop = float(re.search(rf"scallop \(normal\) +{num} mm", out).group(1))
+    doc = " ".join((EXAMPLES.parent / "docs" / "toolpaths.md").read_text().split())
+    assert f"no gouge ({gouge * 1000:.1f} um, limit {limit * 1000:.1f} um)" in doc, out
+    assert f"at most {left:.2f} mm of material normal to the surface ({height:.2f} mm above it)" in doc, out
+    assert (f"on the {np.degrees(np.arccos(left / height)):.0f} degree flanks (at Y{y:.1f}, beside the edge "
+            f"y = {20 if y < 60 else 100})") in doc, out
+    assert f"in the interior the scallop is {scallop:.3f} mm" in doc, out
+    assert status == (0 if left <= 0.1 else 1)
+    # Independently: a ball swept along the program's moves, against the exact polynomial, on the cells of
+    # the four box edges: nothing is left there beyond a cusp between passes (on flat ground 0.010 mm).
+    moves = parse_moves(prog.read_text())
+    p = moves.points_mm[np.asarray(moves.z_known)]
+    p = p[p[:, 2] < 79.0]
+    surf = lagrange_surface(read_points(ex4))
+    t = np.linspace(20.0, 100.0, 321)
+    for a, b in ((t, np.array([20.0, 20.25])), (t, np.array([99.75, 100.0])),
+                 (np.array([20.0, 20.25]), t), (np.array([99.75, 100.0]), t)):
+        above = swept_ball(p, 3.0, a, b) - exact_heights(surf, a / 20, b / 20) * 20
+        edge = above[:, 0 if b[0] == 20.0 else 1] if len(b) == 2 and len(a) > 2 else above[0 if a[0] == 20.0 else 1]
+        assert edge.min() >= -0.002  # no gouge (the swept ball's sampling errs by about 1 um)
+        assert edge.max() <= height + 0.01

@@ -64,7 +64,7 @@ COMMANDS = {
     "toolpath": "plan a raster toolpath over the exact surface and write it as G-code",
     "rough": "rough a block down to the surface in z levels and write it as G-code",
     "job": "write one program for a whole job file: roughing, finishing, tool changes, cycle time",
-    "verify": "simulate a G-code program's cut on a height map and report gouge, scallop and area not reached",
+    "verify": "simulate a G-code program's cut on a height map: gouge, rapids into the part, material left",
     "macro": "write a macro program that evaluates the surface on the control (Fanuc, LinuxCNC, Heidenhain)",
     "simulate": "dry-run a macro program at the control's precision and write the moves it makes",
     "send": "send a program to a CNC control over RS-232 (upload to memory or drip feed)",

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
-from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec, Tool
+from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec,
+                       Tool)
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
@@ -19,7 +20,7 @@ tool tip; the tool stays down between rows.
 
 examples:
   lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
-      --stepover 0.5 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
+      --stepover 0.4 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
   lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 --safe-z 400 \\
       --dialect linuxcnc -o part.ngc"""
 
@@ -34,12 +35,19 @@ def add_arguments(p) -> None:
     g = p.add_argument_group("raster")
     g.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
     g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")
-    g.add_argument("--step", type=STEP_MM, metavar="MM", help="forward step along a row (default 0.2)")
+    g.add_argument("--step", type=STEP_MM, metavar="MM",
+                   help="longest move along a row (default 0.2, or none with --tolerance alone); points are "
+                        "added where the path bends")
     g.add_argument("--scallop", type=SMALL_MM, metavar="MM",
                    help="rows spaced so that a ball-end cutter's cusp, measured normal to the surface, is at "
                         "most this (on slopes too), instead of --stepover")
     g.add_argument("--tolerance", type=SMALL_MM, metavar="MM",
-                   help="forward steps from this chordal error, instead of a fixed --step")
+                   help=f"chordal error of the moves: points are added where the path bends and, without "
+                        f"--step, left out where it is straight (default {DEFAULT_TOLERANCE_MM})")
+    g.add_argument("--boundary", choices=BOUNDARIES, default="past",
+                   help="past (default: the tool axis goes beyond the box as far as the tool still touches "
+                        "the part, so the whole part is finished), centre (the axis stays in the box) or "
+                        "inside (the whole tool stays in the box)")
     t = p.add_argument_group("cutter")
     t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default), flat or bull (bull nose: give --corner-radius)")
     t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
@@ -75,14 +83,15 @@ def run(args, out, err) -> int:
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
-    raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance)
+    raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary)
     tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
     if args.output and args.output != "-":
         write_text(args.output, text, newline="")
-        err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} rows, "
-                  f"side step {tp.stepover_mm:.4f} mm, largest lift for chordal error {tp.lift_mm.max():.4f} mm"
+        err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
+                  f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
+                  f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"
                   + _cusp_note(tp) + "\n")
     else:
         out.write(text)

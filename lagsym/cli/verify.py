@@ -10,14 +10,21 @@ from ..gcode import parse_moves
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
-from ..verify import MAX_CELLS, MAX_CONTACTS, simulate_cut
+from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
 from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
 result with the exact surface: the worst gouge (the cut below the surface),
-the largest scallop left above it, and the area the tool never reached.  Any
-point-list program can be checked this way, lagsym's or not.
+the deepest rapid (G00) into the part, the most material left anywhere on the
+part (its edges included) and where, the scallop between passes (normal to
+the surface, a tool radius or more from the edges) and the area the tool never
+reached.  Any point-list program can be checked this way, lagsym's or not.
+
+exit status: 0 the program passes; 1 it gouges or a rapid goes into the part
+(deeper than the gouge limit), or it leaves more material than --max-left
+(or a scallop above --max-scallop); 2 bad input (an unreadable file, a
+program with arcs or canned cycles).
 
 With --job the first file is a job file (TOML, as for lagsym job): the
 program is simulated from the job's block, each part of it (from one M06 to
@@ -25,10 +32,8 @@ the next) with the cutter its T number names in the job, and verify reports
 what each tool removed, any rapid move through material, the worst gouge and
 the material left above the surface (largest, where, and a histogram).  The
 job gives the tools, scale and origin, so those options are refused with it.
-
-exit status: 0 no gouge; 1 the program gouges (deeper than the limit), or
-with --job a rapid moves through material or more is left than --max-left;
-2 bad input (an unreadable file, a program with arcs or canned cycles).
+It exits 1 on a gouge, a rapid through material, or, when --max-left is
+given, more material left than that.
 
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
@@ -55,10 +60,15 @@ def add_arguments(p) -> None:
     p.add_argument("--cell", type=number(1e-3, 1_000.0, "mm"), metavar="MM",
                    help="height-map cell size (default: box side / 400; with --job, block side / 400)")
     p.add_argument("--gouge-limit", type=number(0.0, 1_000.0, "mm"), metavar="MM",
-                   help="depth from which a cut counts as a gouge "
-                        "(default: program rounding plus simulation resolution)")
+                   help="depth from which a cut counts as a gouge (default: what the program's rounding can "
+                        "cause: half a unit of its last decimal, and as much sideways times the steepest slope; "
+                        "with --job, program rounding plus simulation resolution)")
     p.add_argument("--max-left", type=number(0.0, 1_000.0, "mm"), metavar="MM",
-                   help="with --job: exit 1 when more material than this is left above the surface")
+                   help=f"material left anywhere above which the program fails (default {MAX_LEFT_MM}; with "
+                        f"--job, checked only when given)")
+    p.add_argument("--max-scallop", type=number(0.0, 1_000.0, "mm"), metavar="MM",
+                   help="scallop between passes (normal to the surface) above which the program fails "
+                        "(default: reported, not checked; not with --job)")
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
     p.add_argument("--max-contacts", type=count(1, 10**14), metavar="N",
@@ -69,8 +79,6 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     if args.job:
         return _run_job(args, out)
-    if args.max_left is not None:
-        raise InputError("--max-left is for a whole job (--job); a single program reports its largest scallop")
     for key, default in _SINGLE_TOOL.items():
         if getattr(args, key) is None:
             setattr(args, key, default)
@@ -79,16 +87,21 @@ def run(args, out, err) -> int:
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
     report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter, args.corner_radius), place,
-                          cell_mm=args.cell, gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells,
-                          max_contacts=args.max_contacts)
+                          cell_mm=args.cell, program_resolution_mm=program_resolution_mm(text),
+                          gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells, max_contacts=args.max_contacts,
+                          max_left_mm=MAX_LEFT_MM if args.max_left is None else args.max_left,
+                          max_scallop_mm=args.max_scallop)
     out.write("\n".join(report.summary()) + "\n")
-    return ExitStatus.WARNING if report.gouges else ExitStatus.OK
+    return ExitStatus.WARNING if report.fails else ExitStatus.OK
 
 
 def _run_job(args, out) -> int:
     from ..job import read_job
     from ..machined import machine_job
 
+    if args.max_scallop is not None:
+        raise InputError("--max-scallop is for a single program; with --job verify checks the material left "
+                         "(--max-left)")
     given = [key for key in _SINGLE_TOOL if getattr(args, key) is not None]
     if given:
         option = "--" + given[0].replace("_", "-")

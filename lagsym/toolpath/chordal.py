@@ -14,20 +14,21 @@ by how far the true path may rise above it:
   the samples show plus that bound is a bound of the move's sag
   (:func:`move_sags`).  (A quarter of the path's downward second difference
   at each sample, :func:`bends`, is taken too, when larger.)
-* where the tool crosses a box edge across the move (:func:`crosses_box_edge`),
-  it starts to rest on the edge or a corner between two samples and the path
+* where the tool crosses a box edge across the move (:func:`crosses_box_edge`)
+  and the samples show the path bending there (:func:`bent_moves`), it may
+  start to rest on the edge or a corner between two samples and the path
   can bend down sharply (a square-root onset, or a bend a few hundredths of a
   millimetre wide); no such bound holds.  Each of these moves is checked
   against the true path (:func:`check_moves`): drop-cutter at evenly spaced
   interior points (at least six, at most a sixteenth of the tool radius apart
-  or else 48), then three rounds of denser samples around the worst one.
-  With a tolerance, a move that dips more than the tolerance gets the cutter
-  location at its worst point as a new point, and both halves are checked
-  again, until every move is within the tolerance.  The move is then lifted
-  by the dip found.
+  or else 48), each taken with a quarter of the downward second difference
+  of the samples there.  A move that dips more than the tolerance gets the
+  cutter location at its worst point as a new point, and both halves are
+  checked again, until every move is within the tolerance.  The move is then
+  lifted by the dip found.
 
 Emitted points thus lie on or above the exact drop-cutter value and at most the
-chordal error (the tolerance, when one is given) above it, and no move passes
+chordal tolerance above it, and no move passes
 below the true cutter path by more than what the checks may miss between their
 samples (in the tests, never above ``1e-4`` mm, a tenth of a program's
 resolution).
@@ -44,10 +45,10 @@ import numpy as np
 
 from ..evaluate import SurfaceEvaluator
 
-__all__ = ["tolerance_step", "bends", "semi_convex_sag", "move_sags", "crosses_box_edge", "check_moves", "lift"]
+__all__ = ["tolerance_step", "bends", "semi_convex_sag", "move_sags", "crosses_box_edge", "bent_moves", "check_moves",
+           "lift"]
 
 _CHECK_SAMPLES = 6  # interior samples of a checked move, at least
-_CHECK_ZOOM = 6  # rounds of local refinement around the worst sample
 _CHECK_SPLITS = 40  # at most this many rounds of splitting
 
 
@@ -89,14 +90,18 @@ def move_sags(t, z, keep, extra, kappa):
     the bound of the sag between two samples ``h`` apart of a path that bends
     down no faster than ``kappa``.
     """
-    sag = np.zeros(len(keep) - 1)
-    seen = np.zeros(len(keep) - 1)
-    for m, (i, j) in enumerate(zip(keep[:-1], keep[1:])):
-        s = (t[i:j + 1] - t[i]) / (t[j] - t[i])
-        dev = z[i:j + 1] - (z[i] + s * (z[j] - z[i]))
-        seen[m] = max(0.0, float(dev.max()))
-        semi = kappa * float(np.diff(t[i:j + 1]).max()) ** 2 / 8.0
-        sag[m] = max(float(np.max(dev[1:-1] + extra[i + 1:j], initial=0.0)), seen[m] + semi)
+    keep = np.asarray(keep, dtype=int)
+    if len(keep) < 2:
+        return np.zeros(0), np.zeros(0)
+    k = np.arange(keep[0], keep[-1])
+    m = np.searchsorted(keep, k, side="right") - 1  # the move each fine sample starts or lies inside
+    i, j = keep[m], keep[m + 1]
+    dev = z[k] - (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i]))
+    starts = keep[:-1] - keep[0]
+    seen = np.maximum(np.maximum.reduceat(dev, starts), 0.0)
+    inner = np.where(k == i, -np.inf, dev + extra[k])
+    semi = kappa * np.maximum.reduceat(t[k + 1] - t[k], starts) ** 2 / 8.0
+    sag = np.maximum(np.maximum(np.maximum.reduceat(inner, starts), 0.0), seen + semi)
     return sag, seen
 
 
@@ -117,15 +122,41 @@ def crosses_box_edge(vx, vy, bounds, radius):
             | ((near_y[:-1] | near_y[1:]) & (vy[:-1] != vy[1:])))
 
 
+BENT_MM = 1e-5
+"""A quarter of a downward second difference of the fine samples above which the path counts as bent there."""
+
+
+def bent_moves(keep: np.ndarray, bend: np.ndarray, threshold: float = BENT_MM) -> np.ndarray:
+    """Which kept moves have a fine sample within one of them where the path bends down more than ``threshold``.
+
+    ``bend`` is :func:`bends` of the fine samples.  A bend hidden between two
+    samples shows in their second differences: where the path rises to a
+    ridge between samples ``h`` apart with slopes ``s1`` and ``-s2``, the
+    ridge stands at most ``(s1 + s2) h / 4`` above their chord, and the
+    quarter second differences at the two samples add up to that; so a
+    move with no bent sample near it has no such ridge above ``2 * threshold``.
+    """
+    b = np.asarray(bend, dtype=float)
+    near = b.copy()
+    near[1:] = np.maximum(near[1:], b[:-1])
+    near[:-1] = np.maximum(near[:-1], b[1:])
+    # Largest value over each move's fine samples, its ends and one beyond them included.
+    top = np.maximum.reduceat(near, keep[:-1]) if len(keep) > 1 else np.zeros(0)
+    return np.maximum(top, near[keep[1:]]) > threshold
+
+
 def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
-    """Largest height of the true cutter path above each straight move ``a -> b``, where, and the path there.
+    """How far the true cutter path may rise above each straight move ``a -> b``, where, and the path there.
 
     Samples the path at evenly spaced interior points (at least
     :data:`_CHECK_SAMPLES`, no further apart than a sixteenth of the tool
-    radius unless that takes more than eight times as many), then, where the
-    path rises above the move, zooms in around the worst sample.  Returns the
-    dip (0 or more, mm), the fraction along the move where it was found and
-    the cutter location there (mm).
+    radius unless that takes more than eight times as many).  At each sample
+    the height above the move plus :func:`bends` of the samples (the move's
+    ends included) bounds the path between it and its neighbours, as for the
+    fine samples of a row (see :func:`bent_moves` for a ridge between two
+    samples); the largest is the move's dip.  Returns the dip (0 or more,
+    mm), the fraction along the move where it was found and the cutter
+    location there (mm).
     """
     m = len(ax)
     if m == 0:
@@ -136,37 +167,54 @@ def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
     idx = np.repeat(np.arange(m), n_move)
     start = np.concatenate([[0], np.cumsum(n_move)[:-1]])
     u = (np.arange(idx.size) - start[idx] + 1) / (n_move[idx] + 1)
+    zc = cl(ax[idx] + u * (bx[idx] - ax[idx]), ay[idx] + u * (by[idx] - ay[idx]))
+    d = zc - (az[idx] + u * (bz[idx] - az[idx]))
+    # Neighbours of each sample along its move; the ends of the move lie on it (0 above it).
+    first, last = u == u[start][idx], np.zeros(idx.size, dtype=bool)
+    last[np.cumsum(n_move) - 1] = True
+    left = np.where(first, 0.0, np.roll(d, 1))
+    right = np.where(last, 0.0, np.roll(d, -1))
+    est = d + np.maximum(0.0, 2.0 * d - left - right) / 4.0
+    order = np.lexsort((-est, idx))
+    worst = order[start]  # the worst sample of each move
+    du, dz, zw = _zoom(cl, (ax, ay, az, bx, by, bz), u[worst], d[worst], zc[worst], 1.0 / (n_move + 1))
+    return np.maximum(np.maximum(est[worst], dz), 0.0), du, zw
 
-    def dips(idx, u):
-        zc = cl(ax[idx] + u * (bx[idx] - ax[idx]), ay[idx] + u * (by[idx] - ay[idx]))
-        return zc - (az[idx] + u * (bz[idx] - az[idx])), zc
 
-    d, zc = dips(idx, u)
-    order = np.lexsort((-d, idx))
-    first = order[start]  # the worst sample of each move
-    best_d, best_u, best_z = d[first], u[first], zc[first]
-    # Zoom in where the path rises above the move; elsewhere the samples show it below all along.
-    zoom = np.flatnonzero(best_d > 0.0)
-    width = 1.0 / (n_move[zoom] + 1)
-    offs = np.array([-2.0, -1.0, 1.0, 2.0]) / 3.0
-    for _ in range(_CHECK_ZOOM):
-        uu = np.clip(best_u[zoom, None] + width[:, None] * offs, 0.0, 1.0)
-        d, zc = dips(np.repeat(zoom, len(offs)), uu.ravel())
-        d, zc = d.reshape(uu.shape), zc.reshape(uu.shape)
-        j = np.argmax(d, axis=1)
-        r = np.arange(zoom.size)
-        better = d[r, j] > best_d[zoom]
-        k = zoom[better]
-        best_d[k], best_u[k], best_z[k] = d[r, j][better], uu[r, j][better], zc[r, j][better]
-        width = width / 3.0
-    return np.maximum(best_d, 0.0), best_u, best_z
+_ZOOM_SAMPLES, _ZOOM_ROUNDS = 6, 3
+
+
+def _zoom(cl, move, u, d, z, half):
+    """The dip of each move searched closer around its worst sample ``u`` (fraction along it; ``half`` apart).
+
+    A path that bends sharply next to a sample (where the tool starts to
+    rest on a box edge) can rise above the move between two samples by more
+    than their second differences show; :data:`_ZOOM_ROUNDS` rounds of
+    :data:`_ZOOM_SAMPLES` samples, each over a third of the span before,
+    find that peak.  Returns the best fraction, the dip there and the cutter
+    location there.
+    """
+    ax, ay, az, bx, by, bz = move
+    t = np.linspace(-1.0, 1.0, _ZOOM_SAMPLES)
+    for _ in range(_ZOOM_ROUNDS):
+        q = np.clip(u[:, None] + half[:, None] * t[None, :], 0.0, 1.0)
+        zq = cl((ax[:, None] + q * (bx - ax)[:, None]).ravel(), (ay[:, None] + q * (by - ay)[:, None]).ravel())
+        zq = np.asarray(zq).reshape(q.shape)
+        dq = zq - (az[:, None] + q * (bz - az)[:, None])
+        k = np.argmax(dq, axis=1)
+        rows = np.arange(len(u))
+        better = dq[rows, k] > d
+        u, d, z = np.where(better, q[rows, k], u), np.where(better, dq[rows, k], d), np.where(better, zq[rows, k], z)
+        half = half / 3.0
+    return u, d, z
 
 
 def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
     """Check the moves marked ``dense`` against the true cutter path; with a tolerance, split those that dip more.
 
     ``cl(x, y, **search)`` gives the cutter locations (mm) over surface
-    positions.  The sag of a checked move becomes the larger of the dip found
+    positions, and ``cl.snap_between(x, y, ax, ay, bx, by)``, where it has
+    one, the position a new point on the move ``a -> b`` is written at.  The sag of a checked move becomes the larger of the dip found
     and the sag its fine samples show (``seen``).  A move whose sag exceeds
     ``tol`` gets the cutter location at its worst point as a new point, and
     both halves are checked again.  Returns the points and each move's sag.

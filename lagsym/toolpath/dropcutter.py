@@ -59,7 +59,8 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     surface : LagrangeSurface
         The exact surface; only its part inside the control points' box counts.
     x, y : array_like
-        Tool axis positions in surface units, inside the box.
+        Tool axis positions in surface units, no further than ``radius``
+        from the box.
     radius : float
         Tool radius in surface units (0: a point, the surface itself).
     shape : {"ball", "flat", "bull"}
@@ -97,7 +98,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
     box = ev.bounds
-    cx, cy = _inside_box(x.ravel(), y.ravel(), box)
+    cx, cy = _inside_box(x.ravel(), y.ravel(), box, radius)
     if radius == 0:
         return ev.fast_points(cx, cy).reshape(shape_out)
     x0, x1, y0, y1 = box
@@ -127,16 +128,26 @@ def _corner(shape: str, radius: float, corner: float | None) -> float:
     return float(corner)
 
 
-def _inside_box(cx, cy, box):
-    """The tool positions, refused if outside the box (beyond rounding), clipped onto it."""
+def _inside_box(cx, cy, box, radius=0.0):
+    """The tool positions, refused if further than ``radius`` from the box (beyond rounding).
+
+    A position within reach of the box keeps the box under part of the tool;
+    those beyond the box are kept within ``radius`` of it.
+    """
     x0, x1, y0, y1 = box
-    eps_box = 1e-9 * max(x1 - x0, y1 - y0)
-    outside = (cx < x0 - eps_box) | (cx > x1 + eps_box) | (cy < y0 - eps_box) | (cy > y1 + eps_box)
+    eps_box = 1e-9 * max(x1 - x0, y1 - y0, radius)
+    nx, ny = np.clip(cx, x0, x1), np.clip(cy, y0, y1)
+    d = np.hypot(cx - nx, cy - ny)
+    outside = d > radius + eps_box
     if np.any(outside):
         bad = int(np.flatnonzero(outside)[0])
+        reach = f" by more than the tool radius {radius:g}" if radius > 0 else ""
         raise ToolpathError(f"tool position ({cx[bad]:g}, {cy[bad]:g}) lies outside the control points' box "
-                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
-    return np.clip(cx, x0, x1), np.clip(cy, y0, y1)
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}{reach}")
+    if radius == 0:
+        return nx, ny
+    f = np.where(d > radius, radius / np.where(d > 0, d, 1.0), 1.0)
+    return nx + (cx - nx) * f, ny + (cy - ny) * f
 
 
 _HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator, float] = weakref.WeakKeyDictionary()
@@ -208,19 +219,42 @@ def _peaks(val, inside, nearest):
 
 
 def _project(px, py, cx, cy, radius, box):
-    """Move candidate contact points into the box, then into the disc (the box is convex and holds the centre)."""
+    """Move candidate contact points into the region under the tool: the box, then the disc.
+
+    With the axis inside the box, a point outside the disc is pulled towards
+    the axis onto the rim (the box is convex and holds the axis).  With the
+    axis beyond the box (``--boundary past``), it is pulled along the line to
+    the box point nearest the axis (in both, the two being convex) until it
+    meets the rim.
+    """
     x0, x1, y0, y1 = box
     px = np.clip(px, x0, x1)
     py = np.clip(py, y0, y1)
     dx, dy = px - cx, py - cy
     d2 = dx * dx + dy * dy
     over = d2 > radius * radius
-    if np.any(over):
-        f = np.where(over, radius / np.sqrt(np.where(over, d2, 1.0)), 1.0)
+    if not np.any(over):
+        return px, py, d2
+    beyond = np.broadcast_to((cx < x0) | (cx > x1) | (cy < y0) | (cy > y1), px.shape)
+    radial = over & ~beyond
+    if np.any(radial):
+        f = np.where(radial, radius / np.sqrt(np.where(radial, d2, 1.0)), 1.0)
         px, py = cx + dx * f, cy + dy * f
-        dx, dy = px - cx, py - cy
-        d2 = dx * dx + dy * dy
-    return px, py, d2
+    line = over & beyond
+    if np.any(line):
+        cxb, cyb = np.broadcast_to(cx, px.shape)[line], np.broadcast_to(cy, px.shape)[line]
+        ax, ay = np.clip(cxb, x0, x1), np.clip(cyb, y0, y1)
+        wx, wy = ax - cxb, ay - cyb
+        ex, ey = px[line] - ax, py[line] - ay
+        ee = ex * ex + ey * ey
+        ee = np.where(ee > 0, ee, 1.0)
+        we = wx * ex + wy * ey
+        t = (-we + np.sqrt(np.maximum(we * we - ee * (wx * wx + wy * wy - radius * radius), 0.0))) / ee
+        t = np.clip(t, 0.0, 1.0)
+        px, py = px.copy(), py.copy()
+        px[line], py[line] = ax + t * ex, ay + t * ey
+    dx, dy = px - cx, py - cy
+    return px, py, np.minimum(dx * dx + dy * dy, radius * radius)
 
 
 def _edge_points(cx, cy, radius, box):

@@ -9,14 +9,17 @@ from ..values import finite
 __all__ = ["filter_rows"]
 
 
-def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.ndarray | None = None) -> np.ndarray:
+def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.ndarray | None = None,
+                longest: float | None = None) -> np.ndarray:
     """Indices of the points of one row to keep so that straight moves stay within ``tolerance`` of ``z``.
 
     Greedy, as OpenCAMLib's line filter: from each kept point the move reaches
     as far as every skipped point lies within ``tolerance`` (vertically) of it.
     The first and last points are always kept.  ``extra`` (per point) is added
     to a skipped point's distance below the chord: the part of the true path's
-    bend between samples that they do not show.
+    bend between samples that they do not show.  With ``longest``, no move
+    is longer than that along the row (a fixed forward step is then the
+    longest move, and the tolerance adds points where the path bends).
 
     Examples
     --------
@@ -28,12 +31,19 @@ def filter_rows(along: np.ndarray, z: np.ndarray, tolerance: float, extra: np.nd
     if extra is None:
         extra = np.zeros(n)
     keep = [0]
+    if longest is not None and n > 1:
+        # Each point's farthest reach within the longest move, at least its neighbour.
+        last = np.maximum(np.searchsorted(along, along + longest * (1 + 1e-9), side="right") - 1,
+                          np.minimum(np.arange(n) + 1, n - 1))
+    else:
+        last = np.full(n, n - 1)
     i = 0
     while i < n - 1:
-        lo, hi = i + 1, min(n - 1, i + 2)
+        end = int(last[i])
+        lo, hi = i + 1, min(end, i + 2)
         # Grow the reach by doubling, then bisect back to the last good end.
-        while hi < n - 1 and _within(along, z, i, hi, tolerance, extra):
-            lo, hi = hi, min(n - 1, i + 2 * (hi - i))
+        while hi < end and _within(along, z, i, hi, tolerance, extra):
+            lo, hi = hi, min(end, i + 2 * (hi - i))
         if _within(along, z, i, hi, tolerance, extra):
             lo = hi
         else:

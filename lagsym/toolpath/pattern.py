@@ -12,10 +12,10 @@ import math
 import numpy as np
 
 from ..errors import ToolpathError
-from ..machine import DIRECTIONS
+from ..machine import BOUNDARIES, DIRECTIONS
 from ..values import choice, finite, positive
 
-__all__ = ["raster_pattern", "levels", "scallop_stepover"]
+__all__ = ["raster_pattern", "levels", "scallop_stepover", "tool_reach", "within_reach", "past_reach", "reach_levels"]
 
 
 def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
@@ -67,3 +67,94 @@ def raster_pattern(bounds, direction: str, stepover: float, step: float):
     if direction == "x":
         return levels(y0, y1, stepover), levels(x0, x1, step)
     return levels(x0, x1, stepover), levels(y0, y1, step)
+
+
+def tool_reach(bounds, radius: float, boundary: str, past: float | None = None):
+    """The box the tool axis ranges over, ``(x0, x1, y0, y1)``, for a boundary mode (see :class:`~lagsym.machine.RasterSpec`).
+
+    ``inside`` shrinks the control points' box by the tool radius (surface
+    units), ``centre`` keeps it, ``past`` widens it by ``past`` (by default
+    the radius); with ``past`` the rows round the box corners
+    (:func:`within_reach`).
+
+    Examples
+    --------
+    >>> tool_reach((0.0, 4.0, 0.0, 2.0), 0.5, "past")
+    (-0.5, 4.5, -0.5, 2.5)
+    """
+    choice(boundary, BOUNDARIES, "boundary")
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    grow = {"inside": -radius, "centre": 0.0, "past": radius if past is None else past}[boundary]
+    if x1 - x0 + 2 * grow < 0 or y1 - y0 + 2 * grow < 0:
+        raise ToolpathError(f"a tool of radius {radius:g} does not fit inside the control points' box "
+                            f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}; choose another boundary")
+    return (x0 - grow, x1 + grow, y0 - grow, y1 + grow)
+
+
+def within_reach(x, y, bounds, radius: float):
+    """Positions brought within ``radius`` of the box: beyond a corner, onto the arc around it.
+
+    Examples
+    --------
+    >>> [round(float(v), 6) for v in within_reach(3.0, 3.0, (0.0, 2.0, 0.0, 2.0), 1.0)]
+    [2.707107, 2.707107]
+    """
+    x0, x1, y0, y1 = bounds
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    nx, ny = np.clip(x, x0, x1), np.clip(y, y0, y1)
+    d = np.hypot(x - nx, y - ny)
+    f = np.where(d > radius, radius / np.where(d > 0, d, 1.0), 1.0)
+    return nx + (x - nx) * f, ny + (y - ny) * f
+
+
+_SLOPE_SAMPLES = 257  # points along each box edge where the steepest slope is measured
+
+
+def past_reach(ev, radius: float, corner: float) -> float:
+    """How far beyond the box the tool axis goes with ``--boundary past`` (surface units).
+
+    ``ev`` is the surface's evaluator, ``corner`` the corner radius (the
+    radius for a ball, 0 for a flat end).  A cutter touches a slope of angle
+    ``a`` on its corner, at ``(radius - corner) + corner * sin(a)`` from its
+    axis: a flat end touches the box edge up to its radius beyond it, a ball
+    at ``radius * sin(a)``.  Beyond that distance for the steepest slope on
+    the box edges the tool reaches nothing the positions nearer the box have
+    not; further out it would touch the part's edge only low on its corner,
+    where a sideways rounding of the position moves the tool a long way down
+    the edge.
+    """
+    if corner <= 0 or radius == 0:
+        return radius
+    x0, x1, y0, y1 = ev.bounds
+    t = np.linspace(0.0, 1.0, _SLOPE_SAMPLES)
+    ex = np.concatenate([x0 + t * (x1 - x0), x0 + t * (x1 - x0), np.full_like(t, x0), np.full_like(t, x1)])
+    ey = np.concatenate([np.full_like(t, y0), np.full_like(t, y1), y0 + t * (y1 - y0), y0 + t * (y1 - y0)])
+    slope = float(np.hypot(ev.fast_points(ex, ey, dx=1), ev.fast_points(ex, ey, dy=1)).max())
+    # A little further than the samples show, for the slope between them.
+    return min(radius, radius - corner + 1.02 * corner * slope / math.hypot(1.0, slope))
+
+
+def reach_levels(inner, lo: float, hi: float) -> np.ndarray:
+    """Row levels across the box (``inner``, ascending, from edge to edge) fitted to the reach ``lo..hi``.
+
+    A reach inside the box keeps the rows within it and adds its ends; one
+    beyond the box continues the rows past each edge with the gap of the
+    first (last) one inside, ending on the reach.
+
+    Examples
+    --------
+    >>> reach_levels([0.0, 0.4, 1.0], -0.5, 1.25).tolist()
+    [-0.5, -0.25, 0.0, 0.4, 1.0, 1.25]
+    >>> reach_levels([0.0, 0.4, 1.0], 0.1, 0.9).tolist()
+    [0.1, 0.4, 0.9]
+    """
+    inner = np.asarray(inner, dtype=float)
+    if len(inner) < 2 or hi <= lo:
+        return np.array([lo, hi]) if hi > lo else np.array([lo])
+    gap_lo, gap_hi = inner[1] - inner[0], inner[-1] - inner[-2]
+    before = levels(lo, inner[0], gap_lo)[:-1] if lo < inner[0] else np.zeros(0)
+    after = levels(inner[-1], hi, gap_hi)[1:] if hi > inner[-1] else np.zeros(0)
+    eps = 1e-9 * (inner[-1] - inner[0])
+    mid = inner[(inner > lo + eps) & (inner < hi - eps)]
+    ends = ([lo] if lo >= inner[0] else []), ([hi] if hi <= inner[-1] else [])
+    return np.concatenate([before, ends[0], mid, ends[1], after])

@@ -21,9 +21,8 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from . import chordal
 from .dropcutter import drop_cutter
 from .filter import filter_rows
-from .pattern import levels as _levels
-from .pattern import raster_pattern, scallop_stepover
-from .resolution import ResolutionGrid
+from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
+from .resolution import ResolutionGrid, without_repeats
 from .scallop import scallop_levels
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
@@ -52,8 +51,13 @@ class Toolpath:
         ``stepover_mm`` is the widest gap between rows; with a chordal
         tolerance, ``step_mm`` is the sampling step the filter started from).
     bounds_mm : tuple of float
-        The control points' box on the machine, ``(x0, x1, y0, y1)``: the
-        envelope of the tool positions.
+        The control points' box on the machine, ``(x0, x1, y0, y1)``.  The
+        tool positions stay inside it (``raster.boundary`` ``centre``), the
+        tool radius inside it (``inside``) or within the tool radius of it
+        (``past``).
+    fine_points : int
+        How many cutter locations the filter chose the points from (the
+        blocks a program would have without filtering).
     cusp_mm : float or None
         With a scallop height, the worst cusp predicted between the rows,
         measured normal to the surface (mm); None for a fixed side step.
@@ -69,6 +73,7 @@ class Toolpath:
     stepover_mm: float
     step_mm: float
     bounds_mm: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+    fine_points: int = 0
     cusp_mm: float | None = None
     cusp_at_mm: tuple[float, float] | None = None
 
@@ -121,48 +126,67 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     """
     ev = evaluator or surface_evaluator(surface)
     mm_per_unit = settings.mm_per_unit
-    tol = raster.tolerance_mm
-    stepover = _side_step(tool, raster)
+    tol = raster.chordal_tolerance_mm
+    cl = _Cutter.of(surface, ev, tool, settings)
+    # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
+    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner_radius), cl.radius - 2 * cl.unit)) \
+        if raster.boundary == "past" else None
+    reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
+    scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
+    path = _fine_path(cl, levels, along, raster.direction, fine, past)
+    kappa = ev.curvature_bound() / mm_per_unit
+    bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
+    kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
+    sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
+    vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
+    # Where the tool meets a box edge the path may bend between samples; where it does not bend near
+    # a move, the samples show its sag.  A move whose estimated sag exceeds the tolerance is split too.
+    # Beyond a corner the rows follow an arc around it, and a move's chord passes nearer the corner than the
+    # samples on the arc: checked too.
+    x0, x1, y0, y1 = ev.bounds
+    corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
+    dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
+             | corner[:-1] | corner[1:] | (sag > tol))
+    vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    b = ev.bounds
+    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
+    return Toolpath(
+        **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                          _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
+        tool=tool,
+        raster=raster,
+        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(_side_step(tool, raster)),
+        step_mm=float(step),
+        bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
+        fine_points=len(path.x),
+        **_cusp(scallop, raster.direction, settings),
+    )
+
+
+def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
+             max_points: int | None):
+    """The rows over the reach: ``(scallop, levels, along, every)``, checked for size first.
+
+    ``scallop`` is the rows from a scallop height (None for a side step),
+    ``every`` how many samples along a row make one move with a fixed step
+    (None with a tolerance alone).
+    """
+    mm_per_unit = cl.mm_per_unit
+    stepover = _side_step(tool, raster)
     scallop = None if raster.stepover_mm is not None else scallop_levels(
         ev, raster.direction, tool.radius_mm, raster.scallop_mm, mm_per_unit)
     if scallop is not None:  # rows walked across the surface: the size check counts them
         stepover = _span(ev.bounds, raster.direction) * mm_per_unit / max(len(scallop.levels) - 1, 1)
-    _check_size(ev.bounds, raster.direction, stepover, fine, mm_per_unit, max_points)
-    levels, along = raster_pattern(ev.bounds, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
-    if scallop is not None:
-        levels = scallop.levels
-    if tol is None:
-        along = _fixed_step_samples(along, step / mm_per_unit)
-    cl = _Cutter.of(surface, ev, tool, settings)
-    # Rows and samples on the program's resolution: every move then runs along a line the program can write.
-    levels, along = (cl.snap_axis(levels, 1), cl.snap_axis(along, 0)) if raster.direction == "x" else \
-        (cl.snap_axis(levels, 0), cl.snap_axis(along, 1))
-    path = _fine_path(cl, levels, along, raster.direction, fine)
-    kappa = ev.curvature_bound() / mm_per_unit
-    bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
-    # The sag a semi-convex path may hide between samples, for the longest sample step: on the program's
-    # resolution the steps differ by a unit, and a move's sag is bounded with its longest step.
-    semi = np.full(len(path.s_mm), kappa * float(np.diff(path.s_mm).max(initial=0.0)) ** 2 / 8.0)
-    kept = _emitted(path, tol, np.maximum(bend, semi))
-    sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
-    vx, vy, vz, vrow = path.x[kept], path.y[kept], path.z[kept], path.row[kept]
-    dense = chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius)
-    vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
-    vx, vy = cl.snap(vx, vy)  # where the heights were computed, and what the program writes
-    b = ev.bounds
-    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
-    return Toolpath(
-        points_mm=np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1),
-        rows=vrow,
-        exact_mm=_place(settings, vx, vy, vz)[2],
-        tool=tool,
-        raster=raster,
-        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(stepover),
-        step_mm=float(step),
-        bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
-        **_cusp(scallop, raster.direction, settings),
-    )
+    _check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
+    levels, along = raster_pattern(reach, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
+    if scallop is not None:  # the rows across the box, then as far as the tool reaches on either side
+        levels = reach_levels(scallop.levels, *(reach[2:] if raster.direction == "x" else reach[:2]))
+    every = None
+    if raster.step_mm is not None:
+        along, every = _fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
+                                           lambda v: cl.snap_axis(v, 0 if raster.direction == "x" else 1))
+    return scallop, levels, along, every
 
 
 def _span(bounds, direction: str) -> float:
@@ -216,26 +240,31 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
 
 
 def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float) -> tuple[float, float]:
-    """The forward step (mm) and the finer sampling step it is checked at (mm).
+    """The longest move (mm) and the finer sampling step the filter chooses points from (mm).
 
-    A fixed step is sampled four times finer; a chordal tolerance chooses a
-    sampling step whose own chordal error on the surface is a quarter of it.
+    The sampling step is one whose own chordal error on the surface is a
+    quarter of the tolerance, and with a fixed step at most half of it.
     """
-    tol = raster.tolerance_mm
+    fine = chordal.tolerance_step(ev, raster.chordal_tolerance_mm, mm_per_unit)
     if raster.step_mm is None:
-        fine = chordal.tolerance_step(ev, tol, mm_per_unit)
         return fine, fine
-    step = raster.step_mm
-    return step, step / 4.0 if tol is None else min(step, chordal.tolerance_step(ev, tol, mm_per_unit))
+    return raster.step_mm, min(raster.step_mm / 2.0, fine)
 
 
-_EMIT_EVERY = 2  # with a fixed forward step, a fine sample halfway along each move measures its sag
+def _fixed_step_samples(a0: float, a1: float, step: float, fine: float, snap):
+    """Samples along a row for a fixed step, and how many samples make one move (surface units).
 
-
-def _fixed_step_samples(along: np.ndarray, step: float) -> np.ndarray:
-    """Positions along a row for a fixed forward step: the emitted points and one sample halfway between each two."""
-    n = len(_levels(along[0], along[-1], step)) - 1
-    return np.linspace(along[0], along[-1], n * _EMIT_EVERY + 1)
+    The row is cut into equal moves no longer than ``step`` once moved onto
+    the program's resolution (``snap``), each sampled at least twice and no
+    further apart than ``fine``.
+    """
+    moves = max(int(math.ceil((a1 - a0) / step - 1e-9)), 1)
+    while True:
+        every = max(2, int(math.ceil((a1 - a0) / moves / fine - 1e-9)))
+        along = np.linspace(a0, a1, moves * every + 1)
+        if np.diff(snap(along[::every])).max() <= step * (1 + 1e-9):
+            return along, every
+        moves += 1
 
 
 @dataclass(frozen=True)
@@ -275,6 +304,16 @@ class _Cutter:
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
+    @property
+    def unit(self) -> float:
+        """One unit of the program's last decimal, in surface units (0 without a program grid)."""
+        return 0.0 if self.grid is None else self.grid.unit_mm / self.mm_per_unit
+
+    @property
+    def corner_radius(self) -> float:
+        """The corner radius (surface units): the radius for a ball, 0 for a flat end."""
+        return {"ball": self.radius, "flat": 0.0}.get(self.shape, self.corner)
+
     def snap(self, x, y):
         """The positions the program writes for surface positions ``x, y`` (see :mod:`.resolution`)."""
         return (x, y) if self.grid is None else self.grid.snap(x, y)
@@ -306,57 +345,80 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float) -> _FinePath:
-    """Drop the tool over every fine sample of every row and of the links between rows, in cutting order."""
-    a_grid, l_grid = np.meshgrid(along, levels, indexing="xy")  # (rows, along)
-    z_rows = cl(*((a_grid, l_grid) if direction == "x" else (l_grid, a_grid)))
-    gaps = np.diff(levels)  # rows from a scallop height are not evenly spaced
-    link_n = max(2, 2 * int(math.ceil((gaps.max() if len(gaps) else 0.0) * cl.mm_per_unit / fine / 2)))
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None) -> _FinePath:
+    """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
+
+    With the tool ``past`` the boundary (that far, surface units), positions
+    further than that from a box corner are brought back onto the arc around
+    it (the rows round the corners).
+    """
+    gap = (levels[1] - levels[0]) if len(levels) > 1 else 0.0
+    link_n = max(2, 2 * int(math.ceil(gap * cl.mm_per_unit / fine / 2)))
     u = np.linspace(0.0, 1.0, link_n + 1)[1:-1]
-    ends = np.where(np.arange(len(levels) - 1) % 2 == 0, along[-1], along[0])
-    link_a = np.repeat(ends, len(u))
-    link_l = cl.snap_axis((levels[:-1, None] + u[None, :] * gaps[:, None]).ravel(), 1 if direction == "x" else 0)
-    z_links = (cl(*((link_a, link_l) if direction == "x" else (link_l, link_a)))
-               if len(link_a) else np.zeros(0)).reshape(len(levels) - 1, len(u))
-    fa, fl, fz, frow, pieces = [], [], [], [], []
+    fa, fl, frow, pieces = [], [], [], []
     count = 0
     for i in range(len(levels)):
-        fwd = i % 2 == 0
-        t = along if fwd else along[::-1]
-        piece = [(t, np.full_like(t, levels[i]), z_rows[i] if fwd else z_rows[i][::-1])]
-        if i + 1 < len(levels):
-            piece.append((np.full_like(u, t[-1]), link_l.reshape(-1, len(u))[i], z_links[i]))
-        for pa, pl, pz in piece:
-            fa.append(pa)
-            fl.append(pl)
-            fz.append(pz)
-            frow.append(np.full(len(pa), i))
-        # The row runs over fine indices [count, count + len(t)), the link after it up to the next row's start.
+        t = along if i % 2 == 0 else along[::-1]
+        fa += [t]
+        fl += [np.full_like(t, levels[i])]
+        frow += [np.full(len(t), i)]
         row_end = count + len(t) - 1
         pieces.append((count, row_end, True))
+        count = row_end + 1
         if i + 1 < len(levels):
+            # The link runs along the row's end to the next row's start.
+            fa += [np.full_like(u, t[-1])]
+            fl += [levels[i] + u * gap]
+            frow += [np.full(len(u), i)]
             pieces.append((row_end, row_end + len(u) + 1, False))
-        count = row_end + len(u) + 1 if i + 1 < len(levels) else row_end + 1
-    fa, fl, fz, frow = (np.concatenate(v) for v in (fa, fl, fz, frow))
+            count += len(u)
+    fa, fl, frow = (np.concatenate(v) for v in (fa, fl, frow))
     fx, fy = (fa, fl) if direction == "x" else (fl, fa)
+    if past is not None:
+        fx, fy = within_reach(fx, fy, cl.ev.bounds, past)
+    # Every position on the program's resolution before the tool is dropped there (one inside the box stays
+    # inside): the written X and Y are then the positions whose heights were computed.
+    fx, fy = cl.snap(fx, fy)
+    fz = cl(fx, fy)
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
 
-def _emitted(path: _FinePath, tol: float | None, extra: np.ndarray) -> np.ndarray:
-    """Indices of the fine samples to emit: filtered to the tolerance, or every other one of a row for a fixed step.
+def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float | None,
+             every: int | None = None) -> np.ndarray:
+    """Indices of the fine samples to emit.
 
-    A link between rows is one move with a fixed step.  ``extra`` is the
-    sag between samples the filter adds to what the samples show.
+    With a chordal tolerance alone, the filter keeps the moves within it.
+    With a fixed step (the longest move), every ``every``-th sample of a
+    row is kept (:func:`_fixed_step_samples`), and along a link the samples
+    a move apart (:func:`_every_step`); where a move's sag exceeds the
+    tolerance, the samples inside it too: points are added where the path
+    bends.  ``extra`` is the sag between samples added to what the samples
+    show.
     """
-    kept = [0]
     s_mm, z = path.s_mm, path.z
-    for lo, hi, is_row in path.pieces:
-        if tol is not None:
+    if longest_mm is None:
+        kept = [0]
+        for lo, hi, _ in path.pieces:
             k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], z[lo:hi + 1], tol, extra[lo:hi + 1]) + lo
-        elif is_row:
-            k = np.arange(lo, hi + 1, _EMIT_EVERY)
-        else:
-            k = np.array([lo, hi])
-        kept.extend(int(v) for v in k[1:])
-    return np.array(kept, dtype=int)
+            kept.extend(int(v) for v in k[1:])
+        return np.array(kept, dtype=int)
+    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else _every_step(s_mm, lo, hi, longest_mm)
+                                     for lo, hi, is_row in path.pieces]))
+    sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
+    split = np.flatnonzero((sag > tol) & (np.diff(kept) > 1))
+    if not split.size:
+        return kept
+    inner = np.concatenate([np.arange(kept[m] + 1, kept[m + 1]) for m in split])
+    return np.union1d(kept, inner)
+
+
+def _every_step(s_mm: np.ndarray, lo: int, hi: int, longest_mm: float) -> np.ndarray:
+    """The samples ``lo..hi`` of one piece a move apart: from each, the furthest no more than ``longest_mm`` on."""
+    s = s_mm[lo:hi + 1] - s_mm[lo]
+    reach = np.maximum(np.searchsorted(s, s + longest_mm * (1 + 1e-9), side="right") - 1, np.arange(len(s)) + 1)
+    out, i = [0], 0
+    while i < len(s) - 1:
+        i = int(min(reach[i], len(s) - 1))
+        out.append(i)
+    return np.array(out, dtype=int) + lo

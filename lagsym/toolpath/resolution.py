@@ -18,7 +18,7 @@ import numpy as np
 
 from ..machine import MachineSettings
 
-__all__ = ["ResolutionGrid"]
+__all__ = ["ResolutionGrid", "without_repeats"]
 
 
 @dataclass(frozen=True)
@@ -92,3 +92,26 @@ class ResolutionGrid:
         n = np.where((v >= lo) & (n < n_lo), n_lo, n)
         n = np.where((v <= hi) & (n > n_hi), n_hi, n)
         return (n * q - origin) / s
+
+
+def without_repeats(points_mm, rows, exact_mm, unit_mm: float) -> dict:
+    """The points without those at the same X and Y as the one before and within ``unit_mm`` of its Z.
+
+    Beyond a box corner several samples can land on one position of the
+    program's grid; the program would write no block for the repeat.  The
+    point kept takes the higher of the heights.  Returns the keyword
+    arguments ``points_mm``, ``rows`` and ``exact_mm`` of a toolpath.
+    """
+    same = np.zeros(len(points_mm), dtype=bool)
+    same[1:] = ((points_mm[1:, 0] == points_mm[:-1, 0]) & (points_mm[1:, 1] == points_mm[:-1, 1])
+                & (np.abs(np.diff(points_mm[:, 2])) < unit_mm))
+    if not same.any():
+        return dict(points_mm=points_mm, rows=rows, exact_mm=exact_mm)
+    first = np.cumsum(~same) - 1  # the kept point each one merges into
+    keep = np.flatnonzero(~same)
+    z, e = np.full(len(keep), -np.inf), np.full(len(keep), -np.inf)
+    np.maximum.at(z, first, points_mm[:, 2])
+    np.maximum.at(e, first, exact_mm)
+    p = points_mm[keep].copy()
+    p[:, 2] = z
+    return dict(points_mm=p, rows=rows[keep], exact_mm=e)
