@@ -43,6 +43,7 @@ Run:  python3 benchmarks/bench_dnc.py [--baud 9600 115200] [--control fanuc room
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 from pathlib import Path
@@ -52,6 +53,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from lagsym.dnc import parse_program, profile, send_program, transfer_segments  # noqa: E402
+from lagsym.dnc.priority import PRIORITY  # noqa: E402
 from simcontrol import KernelPty, PtyPair, SimControl, chars_per_s, program_text  # noqa: E402
 
 # name: (buffer, DC3 mark, DC1 mark, headroom past DC3, sender window), characters
@@ -59,17 +61,20 @@ CONTROLS = {"fanuc": (256, 192, 64, 10, 4), "room64": (256, 192, 64, 64, 32), "r
 BAUDS = (9600, 19200, 38400, 57600, 115200)
 
 
-def run(baud: int, blocks: int, drain: float | None, rig: str, control: str) -> dict:
+def run(baud: int, blocks: int, drain: float | None, rig: str, control: str, realtime: bool = False) -> dict:
     """One drip feed; ``drain`` is the machine's rate over the line rate (None: it empties the buffer at once)."""
     buffer, high, low, headroom, window = CONTROLS[control]
     prog = parse_program(program_text(blocks))
-    settings = profile("fanuc", baud=baud, overrun_chars=window, buffer_chars=buffer, stall_timeout_s=30)
+    settings = profile("fanuc", baud=baud, overrun_chars=window, buffer_chars=buffer, stall_timeout_s=30,
+                       realtime=realtime)
     cps = chars_per_s(baud)
     with (KernelPty() if rig == "kernel" else PtyPair()) as pair:
         sim = SimControl(pair.far, pair=pair if rig == "socat" else None, baud=baud,
                          drain_cps=None if drain is None else drain * cps,
                          buffer_chars=buffer, high_water=high, low_water=low, tolerance=headroom)
         sim.start()
+        if realtime:  # a real control's UART and firmware answer at once: so does the simulated one here
+            os.sched_setscheduler(sim._proc.pid, os.SCHED_FIFO, os.sched_param(PRIORITY + 1))
         expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
         send_program(pair.near, prog, settings, "drip")
         sim.wait_for(len(expected))
@@ -105,16 +110,19 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=1, help="repeat each measurement; figures are min / median")
     ap.add_argument("--rig", choices=("kernel", "socat"), default="kernel",
                     help="pty pair: kernel (no relay, as a real UART) or socat (a relay process in between)")
+    ap.add_argument("--realtime", action="store_true",
+                    help="the sender at real-time priority (LineSettings.realtime), and the simulated control "
+                         "one above it, as a control's UART and firmware; needs root or CAP_SYS_NICE")
     args = ap.parse_args()
-    print(f"rig {args.rig}; machine at {args.drain:.0%} of the line rate for the XOFF columns; {args.runs} run(s), "
+    print(f"rig {args.rig}; sender {'at real-time priority' if args.realtime else 'an ordinary thread'}; machine at {args.drain:.0%} of the line rate for the XOFF columns; {args.runs} run(s), "
           "figures min / median")
     print(f"{'control':>8} {'window':>6} {'headroom':>8} {'baud':>6} {'bytes':>6} {'exact':>5} {'line rate':>15} "
           f"{'with XOFF':>15} {'XOFF':>7} {'overflow':>8} {'max past DC3':>12} {'starved s':>13}")
     for control in args.control:
         _, _, _, headroom, window = CONTROLS[control]
         for baud in args.baud:
-            free = [run(baud, args.blocks, None, args.rig, control) for _ in range(args.runs)]
-            held = [run(baud, args.blocks, args.drain, args.rig, control) for _ in range(args.runs)]
+            free = [run(baud, args.blocks, None, args.rig, control, args.realtime) for _ in range(args.runs)]
+            held = [run(baud, args.blocks, args.drain, args.rig, control, args.realtime) for _ in range(args.runs)]
             exact = all(r["exact"] for r in free + held)
             print(f"{control:>8} {window:>6} {headroom:>8} {baud:>6} {free[0]['bytes']:>6} {str(exact):>5} "
                   f"{spread([r['throughput'] for r in free], '.1%'):>15} "

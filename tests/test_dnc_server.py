@@ -129,6 +129,7 @@ def test_a_port_that_fails_does_not_stop_the_others(tmp_path):
 @pytest.mark.parametrize("edit, words", [
     (lambda c: c.replace("request_delay_s", "request_delay"), "port[0].request_delay: unknown key; the keys are"),
     (lambda c: c.replace("baud = 19200", "baud = 12"), "port[0].line: baud rate 12"),
+    (lambda c: c.replace("baud = 19200", 'baud = 19200\nrealtime = "yes"'), "port[0].line: realtime 'yes' must be true"),
     (lambda c: c.replace('profile = "haas"', 'profile = "mazak"'), "port[1].profile"),
     (lambda c: c + "\n[extra]\n", "extra: unknown key"),
 ])

@@ -120,6 +120,8 @@ def line_settings(args):
         overrides["overrun_chars"] = args.overrun_chars
     if getattr(args, "wait_for_xon", False):
         overrides["wait_for_xon"] = True
+    if getattr(args, "realtime", False):
+        overrides["realtime"] = True
     if args.profile:
         return profile(args.profile, **overrides)
     return LineSettings(**overrides)
@@ -185,6 +187,9 @@ def add_arguments(p) -> None:
                    help=f"most characters in flight: about half what the control takes past XOFF (default "
                         f"{d.overrun_chars}; a Fanuc takes ~10; a larger N keeps a fast line busy)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
+    t.add_argument("--realtime", action="store_true",
+                   help="send at real-time priority (SCHED_FIFO), so a busy computer keeps a small window "
+                        "busy at a high baud rate; needs root, CAP_SYS_NICE or an rtprio limit")
 
 
 def run(args, out, err) -> int:

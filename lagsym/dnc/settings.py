@@ -89,6 +89,10 @@ class LineSettings:
     iso_check : bool
         Refuse characters outside the ISO 840 tape code in what is sent, and
         report them in what is received.
+    realtime : bool
+        Send from a thread at real-time priority (:mod:`lagsym.dnc.priority`),
+        so that a loaded computer wakes the sender in time to keep a small
+        window busy at a high baud rate.
     """
 
     baud: int = 9600
@@ -109,6 +113,7 @@ class LineSettings:
     memory_chars: int | None = None
     tv_check: bool = False
     iso_check: bool = False
+    realtime: bool = False
 
     def __post_init__(self):
         if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
@@ -130,6 +135,9 @@ class LineSettings:
             raise InputError(f"control buffer {self.buffer_chars!r} must be 0 to 1000000 characters")
         if self.memory_chars is not None and (not isinstance(self.memory_chars, int) or self.memory_chars < 1):
             raise InputError(f"control memory {self.memory_chars!r} must be a positive number of characters")
+        for name in ("percent", "dtr", "wait_for_xon", "tv_check", "iso_check", "realtime"):
+            if not isinstance(getattr(self, name), bool):
+                raise InputError(f"{name} {getattr(self, name)!r} must be true or false")
         if not isinstance(self.overrun_chars, int) or not 1 <= self.overrun_chars <= 4096:
             raise InputError(f"overrun limit {self.overrun_chars!r} must be 1 to 4096 characters")
 

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from ..errors import InputError, TransferError
 from ..values import choice
 from .blocks import Program, check_drip, check_iso, frame, tv_padded
+from .priority import realtime
 from .results import LineFault, TransferProgress, TransferResult
 from .resume import first_resumable_block, resume_setup
 from .settings import MODES, LineSettings
@@ -101,14 +102,21 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
         On a stall, a lost line, Ctrl-C, SIGTERM or SIGHUP, naming the last block that surely
         arrived and the ``--start-block`` to resume with.
     TransferError
-        If the port cannot be opened.
+        If the port cannot be opened, or real-time priority
+        (``settings.realtime``) is refused.
     InputError
         For a bad mode, start block or resume.
     """
+    segments = transfer_segments(program, settings, mode, start_block, safe_z)
+    with realtime(settings.realtime):  # refused before the port opens
+        return _send(port, program, settings, mode, start_block, segments, progress, log, line)
+
+
+def _send(port, program, settings, mode, start_block, segments, progress, log, line) -> TransferResult:
+    """Open the line (unless given one), run the sender and name every fault truly."""
     from .port import LINE_ERRORS, Port, WriteTimeout  # serial loads only when a line is used
     from .sender import Sender
 
-    segments = transfer_segments(program, settings, mode, start_block, safe_z)
     timeout = None if settings.stall_timeout_s == float("inf") else settings.stall_timeout_s
     owned = line is None
     if owned:
