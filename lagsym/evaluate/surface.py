@@ -34,7 +34,7 @@ from .chebyshev import (
 __all__ = ["CHUNK_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
            "evaluate_grid"]
 
-CHUNK_POINTS = 1 << 16  # scattered points are evaluated in blocks of this many (bounded memory, warm caches)
+CHUNK_POINTS = 1 << 13  # scattered points are evaluated in blocks of this many: their long-double basis stays in cache
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
 PRODUCT_BLOCK = 1 << 15  # elements of one block of a grid product: computed in cache, then written once
 
