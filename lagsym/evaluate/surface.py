@@ -36,7 +36,9 @@ __all__ = ["CHUNK_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_eva
 
 CHUNK_POINTS = 1 << 13  # scattered points are evaluated in blocks of this many: their long-double basis stays in cache
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
-PRODUCT_BLOCK = 1 << 15  # elements of one block of a grid product: computed in cache, then written once
+# Multiply-adds in one block of a grid product: its rows are computed in cache and written once, and
+# it stays below the size from which OpenBLAS splits a product between threads (65536 * 4 = 262144).
+PRODUCT_BLOCK = 200_000
 
 
 def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -45,16 +47,17 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -
     One BLAS product over a whole large grid hands the work to BLAS's own
     threads, which on a loaded machine fight over the cores (a 2000 x 2000
     grid took 2-3 times as long as in blocks); each block here
-    (:data:`PRODUCT_BLOCK` elements, small enough for BLAS to run it in one
-    thread) is computed in cache and written to ``out`` once.  Every element
-    is the same dot product as in ``w @ ty``.
+    (:data:`PRODUCT_BLOCK` multiply-adds, small enough for BLAS to run it in
+    one thread) is computed in cache and written to ``out`` once.  Every
+    element is the same dot product as in ``w @ ty``.  Two threads of blocks
+    were tried: on a loaded 2-core machine they were no faster.
     """
     n = w.shape[0]
     out = np.empty((n, ty.shape[1])) if out is None else out
     if w.shape[1] == 0:
         out[...] = 0.0
         return out
-    rows = max(1, PRODUCT_BLOCK // max(ty.shape[1], 1))
+    rows = max(1, PRODUCT_BLOCK // max(ty.shape[1] * w.shape[1], 1))
     for r in range(0, n, rows):
         np.matmul(w[r:r + rows], ty, out=out[r:r + rows])
     return out
