@@ -69,25 +69,34 @@ class _BasisWork:
     def __init__(self, size: int, degree: int):
         self.s = np.empty(size, dtype=np.longdouble)
         self.s2 = np.empty(size, dtype=np.longdouble)
-        self.v = np.empty((max(degree, 2), size), dtype=np.longdouble)
+        self.v = np.empty((max(degree, 3), size), dtype=np.longdouble)
 
     def basis(self, x: np.ndarray, offset: float, scale: float, n: int, out: np.ndarray) -> np.ndarray:
-        """``T_k((x - offset) / scale)`` for ``k < n`` into ``out[:, :len(x)]``: :func:`chebyshev_matrix`'s arithmetic."""
+        """``T_k((x - offset) / scale)`` for ``k < n`` into ``out[:, :len(x)]``: :func:`chebyshev_matrix`'s arithmetic.
+
+        Long-double operations are the cost here (NumPy does not vectorize them), so
+        ``T_0 = 1`` and ``T_1 = s`` are not copied and the recurrence starts from them.
+        """
         k = x.size
         s, v = self.s[:k], self.v[:, :k]
+        out = out[:, :k]
         np.subtract(x, np.longdouble(offset), out=s)
         np.divide(s, np.longdouble(scale), out=s)
-        v[0] = 1.0
+        out[0] = 1.0
         if n > 1:
-            v[1] = s
+            out[1] = s
         if n > 2:
             s2 = self.s2[:k]
             np.multiply(2.0, s, out=s2)
-            for j in range(2, n):
+            np.multiply(s2, s, out=v[2])
+            v[2] -= 1.0
+            if n > 3:
+                np.multiply(s2, v[2], out=v[3])
+                v[3] -= s
+            for j in range(4, n):
                 np.multiply(s2, v[j - 1], out=v[j])
                 v[j] -= v[j - 2]
-        out = out[:, :k]
-        out[...] = v[:n]
+            out[2:] = v[2:n]
         return out
 
 
