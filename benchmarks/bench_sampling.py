@@ -5,10 +5,12 @@
     python3 benchmarks/bench_sampling.py --accuracy # accuracy only
 
 Speed: a 2000 x 2000 regular sample of the paper's 5x5 Example 4 against
-NumPy filling an array of the same size (the memory limit), SciPy's
+NumPy filling an array of the same size (the memory limit: ``sample`` and
+``np.full`` alternate, min and median of ``--runs`` runs each), SciPy's
 ``BarycentricInterpolator`` along both axes, and ``lambdify`` of the expanded
-expression; and 10**6 scattered points.  Each figure is the best of several
-runs; ratios are peer time / lagsym time.
+expression; and 10**6 scattered points (``bench_scatter.py`` measures those
+against ``lambdify`` alone).  The other figures are the best of several runs;
+ratios are peer time / lagsym time.
 
 Accuracy: the largest error against exact rational evaluation at random
 points, as a fraction of the data range, for node sets up to 20 x 20 (the
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import statistics
 import sys
 import time
 from fractions import Fraction
@@ -52,7 +55,18 @@ def best(fn, repeat: int = 7, number: int = 1) -> float:
     return min(times)
 
 
-def speed(n: int = 2000) -> None:
+def alternating(fns: dict, runs: int) -> dict[str, list[float]]:
+    """Times of ``runs`` runs of each function, taken in turn, so a busy spell falls on all alike."""
+    times: dict[str, list[float]] = {k: [] for k in fns}
+    for _ in range(runs):
+        for k, fn in fns.items():
+            t = time.perf_counter()
+            fn()
+            times[k].append(time.perf_counter() - t)
+    return times
+
+
+def speed(n: int = 2000, runs: int = 21) -> None:
     from scipy.interpolate import BarycentricInterpolator
 
     surface = lagrange_surface(read_points(ROOT / "examples" / "paper-example-4.json"))
@@ -73,9 +87,10 @@ def speed(n: int = 2000) -> None:
     assert np.abs(scipy_both_axes() - ours).max() < 1e-12
     assert np.abs(f(xs[:, None], ys[None, :]) - ours).max() < 1e-9
 
-    t_fill = best(lambda: np.full((n, n), 1.0), repeat=15)
-    t_grid = best(lambda: evaluate_grid(surface, xs, ys), repeat=15)
-    t_sample = best(lambda: sample(surface, n, n), repeat=15)
+    paired = alternating({"full": lambda: np.full((n, n), 1.0), "sample": lambda: sample(surface, n, n),
+                          "grid": lambda: evaluate_grid(surface, xs, ys)}, runs)
+    t_fill, t_sample, t_grid = (min(paired[k]) for k in ("full", "sample", "grid"))
+    med_fill, med_sample = statistics.median(paired["full"]), statistics.median(paired["sample"])
     t_scipy = best(scipy_both_axes, repeat=7)
     t_rows = best(scipy_row_by_row, repeat=3)
     t_lamb = best(lambda: f(xs[:, None], ys[None, :]), repeat=3)
@@ -87,6 +102,9 @@ def speed(n: int = 2000) -> None:
     t_scatter_lamb = best(lambda: f(px, py), repeat=3)
 
     print(f"## Speed: {n} x {n} regular sample of paper Example 4 (5x5 nodes)\n")
+    print(f"`sample(surface, {n}, {n})` against `np.full(({n}, {n}), 1.0)`, {runs} runs each, alternating: "
+          f"min {t_sample * 1e3:.2f} ms against {t_fill * 1e3:.2f} ms, **{t_sample / t_fill:.2f}x**; "
+          f"median {med_sample * 1e3:.2f} ms against {med_fill * 1e3:.2f} ms, **{med_sample / med_fill:.2f}x**\n")
     print("| method | time (ms) | ratio |")
     print("|---|---:|---:|")
     print(f"| NumPy `np.full` of the same size (the memory limit) | {t_fill * 1e3:.2f} | "
@@ -174,10 +192,11 @@ def main(argv=None) -> int:
     p.add_argument("--speed", action="store_true")
     p.add_argument("--accuracy", action="store_true")
     p.add_argument("--points", type=int, default=60, help="random points per accuracy case")
+    p.add_argument("--runs", type=int, default=21, help="runs of the sample and of np.full, alternating")
     a = p.parse_args(argv)
     both = not (a.speed or a.accuracy)
     if a.speed or both:
-        speed()
+        speed(runs=a.runs)
     if a.accuracy or both:
         accuracy(a.points)
     return 0

@@ -2,7 +2,10 @@
 
 ``render(obj, fmt)`` turns a :class:`~lagsym.lagrange.LagrangeSurface` or
 :class:`~lagsym.lagrange.LagrangeCurve` into the text ``lagsym equation`` and
-``lagsym curve`` print.
+``lagsym curve`` print.  With variables named by single letters (``x`` and
+``y``, always so on the command line) the text is written from the exact
+coefficients by :mod:`lagsym.polytext`, the characters SymPy would print, and
+SymPy is not imported; other variable names go through SymPy's printers.
 """
 
 from __future__ import annotations
@@ -12,11 +15,16 @@ from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, localcontext
 from fractions import Fraction
 
-import flint
-import sympy
+from typing import TYPE_CHECKING
 
+import flint
+
+from . import polytext
 from .errors import InputError
 from .lagrange import LagrangeCurve, LagrangeSurface, horner2
+
+if TYPE_CHECKING:
+    import sympy
 
 __all__ = ["FORMATS", "render", "nested_form", "decimal_text", "round_significant", "rounded_coefficients",
            "RoundingMiss", "rounding_miss", "MAX_TERMS"]
@@ -33,10 +41,37 @@ def _symbols(obj) -> tuple[sympy.Symbol, ...]:
     return obj.symbols if isinstance(obj, LagrangeSurface) else (obj.symbol,)
 
 
+def _names(obj) -> tuple:
+    """The variables as the value keeps them: names (str) of plain symbols, else the symbols."""
+    return obj.variables if isinstance(obj, LagrangeSurface) else (obj.variable,)
+
+
+def _fast(obj) -> bool:
+    return polytext.supported(_names(obj))
+
+
+def _expr_text(obj) -> str:
+    """``str(obj.expr)``, without SymPy where :mod:`lagsym.polytext` can write it."""
+    return polytext.plain_text(_coeff_dict(obj), _names(obj)) if _fast(obj) else str(obj.expr)
+
+
+def _nested_text(obj) -> str:
+    """``str(nested_form(obj))``, without SymPy where :mod:`lagsym.polytext` can write it."""
+    return polytext.nested_text(obj.coefficients, _names(obj)) if _fast(obj) else str(nested_form(obj))
+
+
 def _coeff_dict(obj) -> dict[tuple[int, ...], Fraction]:
     if isinstance(obj, LagrangeSurface):
         return {(a, b): c for a, row in enumerate(obj.coefficients) for b, c in enumerate(row) if c}
     return {(a,): c for a, c in enumerate(obj.coefficients) if c}
+
+
+def _latex_text(obj) -> str:
+    if _fast(obj):
+        return polytext.latex_text(_coeff_dict(obj), _names(obj))
+    import sympy
+
+    return sympy.latex(obj.expr)
 
 
 def nested_form(obj) -> sympy.Expr:
@@ -48,6 +83,8 @@ def nested_form(obj) -> sympy.Expr:
     >>> nested_form(lagrange_curve(curve_from_points([(1, 1), (2, 3), (3, 1)])))
     x*(8 - 2*x) - 5
     """
+    import sympy
+
     if isinstance(obj, LagrangeCurve):
         return sympy.horner(obj.expr, obj.symbol) if obj.expr.free_symbols else obj.expr
     sx, sy = obj.symbols
@@ -111,7 +148,7 @@ def decimal_text(obj, digits: int) -> str:
     '0.8333*x**3 - 6.5*x**2 + 15.67*x - 9'
     """
     coeffs = rounded_coefficients(obj, digits)
-    names = tuple(str(s) for s in _symbols(obj))
+    names = tuple(str(s) for s in _names(obj))
     # Graded order, highest total degree first, as SymPy prints.
     keys = sorted(coeffs, key=lambda k: (sum(k), k), reverse=True)
     parts: list[str] = []
@@ -132,16 +169,16 @@ def _json(obj) -> str:
     if isinstance(obj, LagrangeSurface):
         g = obj.grid
         doc = {
-            "equation": f"z = {obj.expr}",
-            "variables": [str(v) for v in obj.symbols],
+            "equation": f"z = {_expr_text(obj)}",
+            "variables": [str(v) for v in obj.variables],
             "degree": {"x": obj.degree[0], "y": obj.degree[1]},
             "coefficients": {f"{a},{b}": str(c) for (a, b), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in g.x], "y": [str(v) for v in g.y]},
         }
     else:
         doc = {
-            "equation": f"y = {obj.expr}",
-            "variables": [str(obj.symbol)],
+            "equation": f"y = {_expr_text(obj)}",
+            "variables": [str(obj.variable)],
             "degree": {"x": obj.degree},
             "coefficients": {str(a): str(c) for (a,), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in obj.points.x]},
@@ -150,7 +187,7 @@ def _json(obj) -> str:
 
 
 def _python(obj) -> str:
-    args = ", ".join(str(v) for v in _symbols(obj))
+    args = ", ".join(str(v) for v in _names(obj))
     what = (
         f"tensor-product Lagrange surface of degree {obj.degree[0]} x {obj.degree[1]}"
         if isinstance(obj, LagrangeSurface)
@@ -163,7 +200,7 @@ def _python(obj) -> str:
     return (
         f"def F({args}):\n"
         f"    {doc!r}\n"
-        f"    return {nested_form(obj)}\n"
+        f"    return {_nested_text(obj)}\n"
     )
 
 
@@ -188,16 +225,21 @@ def render(obj, fmt: str = "sympy", digits: int | None = None, max_terms: int | 
                          f"limit (--max-terms)")
     if digits is not None:
         rhs = decimal_text(obj, digits)
+        if fmt == "latex" and _fast(obj):
+            coeffs = {k: (d < 0, _decimal_str(abs(d))) for k, d in rounded_coefficients(obj, digits).items()}
+            return f"{lhs} = {polytext.latex_decimal_text(coeffs, _names(obj))}"
         if fmt == "latex":
+            import sympy
+
             names = {str(v): v for v in _symbols(obj)}
             return f"{lhs} = {sympy.latex(sympy.sympify(rhs, locals=names))}"
         raise InputError(f"--digits goes with --format sympy or latex, not {fmt}")
     if fmt == "sympy":
-        return f"{lhs} = {obj.expr}"
+        return f"{lhs} = {_expr_text(obj)}"
     if fmt == "latex":
-        return f"{lhs} = {sympy.latex(obj.expr)}"
+        return f"{lhs} = {_latex_text(obj)}"
     if fmt == "horner":
-        return f"{lhs} = {nested_form(obj)}"
+        return f"{lhs} = {_nested_text(obj)}"
     if fmt == "python":
         return _python(obj).rstrip("\n")
     return _json(obj)

@@ -13,11 +13,19 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from ._arrays import readonly as _readonly
 from .errors import GridError, InputError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+
+def _readonly(values):
+    # NumPy is imported with the first array asked for: the exact equation needs none of it.
+    from ._arrays import readonly
+
+    return readonly(values)
 
 __all__ = ["ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points",
            "SnapReport", "snap_points"]

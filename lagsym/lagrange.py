@@ -13,7 +13,10 @@ hundreds of times slower.
 The polynomials are built on plain SymPy symbols, ``x`` and ``y`` by default,
 the ones ``sympy.symbols('x y')`` gives, so that ``subs``, ``diff``,
 ``integrate``, ``solve`` and ``==`` work with the symbols a user types; pass
-``x=`` and ``y=`` to use others.
+``x=`` and ``y=`` to use others.  SymPy is imported only when a SymPy value
+(:attr:`~LagrangeSurface.expr`, ``poly``, ``symbols``, a basis) is first asked
+for: the exact coefficients and the printed equation (:mod:`lagsym.polytext`)
+need none of it, and the import alone takes most of a second.
 """
 
 from __future__ import annotations
@@ -22,8 +25,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
 
+from typing import TYPE_CHECKING
+
 import flint
-import sympy
 
 from .errors import InputError
 
@@ -41,18 +45,38 @@ __all__ = [
     "horner2",
 ]
 
-# Plain symbols: a symbol with assumptions (real=True) is a different symbol
-# from the x a user types, and every subs, diff or == with it silently fails.
-X, Y = sympy.symbols("x y")
+if TYPE_CHECKING:
+    import sympy
+
 LATEX_TERMS = 120  # a rich display longer than this shows a summary, not a page of LaTeX
 
 
-def _symbol(value, what: str) -> sympy.Symbol:
+def __getattr__(name: str):
+    # X and Y, the plain symbols x and y, made when first asked for, so that importing this module
+    # does not import SymPy.  Plain symbols: a symbol with assumptions (real=True) is a different
+    # symbol from the x a user types, and every subs, diff or == with it silently fails.
+    if name in ("X", "Y"):
+        import sympy
+
+        return sympy.Symbol(name.lower())
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _variable(value, what: str):
+    """A variable as the value keeps it: a plain symbol by its name (no SymPy needed), any other symbol itself."""
     if isinstance(value, str):
-        value = sympy.Symbol(value)
+        return value
+    import sympy
+
     if not isinstance(value, sympy.Symbol):
         raise InputError(f"{what} = {value!r} is not a SymPy symbol or a name")
-    return value
+    return value.name if type(value) is sympy.Symbol and value == sympy.Symbol(value.name) else value
+
+
+def _symbols_of(variables) -> tuple:
+    import sympy
+
+    return tuple(sympy.Symbol(v) if isinstance(v, str) else v for v in variables)
 
 
 def _fmpq(v: Fraction) -> flint.fmpq:
@@ -99,7 +123,7 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     return tuple(tuple(_frac(m[i, a]) for a in range(n)) for i in range(n))
 
 
-def lagrange_basis(nodes, symbol: sympy.Symbol = X) -> tuple[sympy.Poly, ...]:
+def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly, ...]:
     """The Lagrange basis polynomials ``L_i`` on ``nodes`` as exact ``sympy.Poly`` over QQ.
 
     Examples
@@ -107,10 +131,13 @@ def lagrange_basis(nodes, symbol: sympy.Symbol = X) -> tuple[sympy.Poly, ...]:
     >>> [p.as_expr() for p in lagrange_basis([1, 2, 3])][1]
     -x**2 + 4*x - 3
     """
+    (symbol,) = _symbols_of((symbol,))
     return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes))
 
 
 def _poly1(coeffs, symbol) -> sympy.Poly:
+    import sympy
+
     return sympy.Poly.from_dict({(a,): sympy.Rational(c.numerator, c.denominator) for a, c in enumerate(coeffs) if c},
                                 symbol, domain=sympy.QQ)
 
@@ -125,9 +152,12 @@ class LagrangeCurve:
         The nodes and values.
     coefficients : tuple of Fraction
         ``coefficients[a]`` multiplies ``x**a``.
+    variable : str or sympy.Symbol
+        The variable: the name of a plain symbol (``"x"`` by default), or the
+        symbol itself if it carries assumptions.
     symbol : sympy.Symbol
-        The variable of :attr:`poly`, :attr:`expr` and :attr:`basis`; plain
-        ``x`` by default.
+        The variable of :attr:`poly`, :attr:`expr` and :attr:`basis` (made on
+        first use).
 
     In Jupyter the curve shows as its equation in LaTeX and, once ``import lagsym`` has
     registered the display, a small line plot (:mod:`lagsym.plot.inline`).
@@ -135,7 +165,12 @@ class LagrangeCurve:
 
     points: CurvePoints
     coefficients: tuple[Fraction, ...]
-    symbol: sympy.Symbol = X
+    variable: str | sympy.Symbol = "x"
+
+    @cached_property
+    def symbol(self) -> sympy.Symbol:
+        """The variable as a SymPy symbol."""
+        return _symbols_of((self.variable,))[0]
 
     @property
     def degree(self) -> int:
@@ -158,7 +193,7 @@ class LagrangeCurve:
         return lagrange_basis(self.points.x, self.symbol)
 
     def __repr__(self) -> str:
-        sym = "" if self.symbol == X else f", x={self.symbol}"
+        sym = "" if self.variable == "x" else f", x={self.variable}"
         return f"LagrangeCurve({len(self.points.x)} points, degree {self.degree}{sym}, source={self.points.source!r})"
 
     def _repr_latex_(self) -> str:
@@ -184,9 +219,12 @@ class LagrangeSurface:
     coefficients : tuple of tuple of Fraction
         ``coefficients[a][b]`` multiplies ``x**a * y**b`` (numpy's ``polyval2d``
         order).
+    variables : tuple of str or sympy.Symbol
+        The variables ``(x, y)``: names of plain symbols (``("x", "y")`` by
+        default), or symbols that carry assumptions.
     symbols : tuple of sympy.Symbol
-        The variables ``(x, y)`` of :attr:`poly`, :attr:`expr` and the bases;
-        plain ``x`` and ``y`` by default.
+        The variables of :attr:`poly`, :attr:`expr` and the bases (made on
+        first use).
 
     In Jupyter the surface shows as its equation in LaTeX and, once ``import lagsym`` has
     registered the display, a small figure (:mod:`lagsym.plot.inline`).
@@ -194,7 +232,12 @@ class LagrangeSurface:
 
     grid: ControlGrid
     coefficients: tuple[tuple[Fraction, ...], ...]
-    symbols: tuple[sympy.Symbol, sympy.Symbol] = (X, Y)
+    variables: tuple[str | sympy.Symbol, str | sympy.Symbol] = ("x", "y")
+
+    @cached_property
+    def symbols(self) -> tuple[sympy.Symbol, sympy.Symbol]:
+        """The variables as SymPy symbols."""
+        return _symbols_of(self.variables)
 
     @property
     def degree(self) -> tuple[int, int]:
@@ -204,6 +247,8 @@ class LagrangeSurface:
     @cached_property
     def poly(self) -> sympy.Poly:
         """The surface as a ``sympy.Poly`` in :attr:`symbols` over QQ."""
+        import sympy
+
         terms = {
             (a, b): sympy.Rational(c.numerator, c.denominator)
             for a, row in enumerate(self.coefficients)
@@ -228,8 +273,8 @@ class LagrangeSurface:
         return lagrange_basis(self.grid.y, self.symbols[1])
 
     def __repr__(self) -> str:
-        (n, m), (sx, sy) = self.grid.shape, self.symbols
-        sym = "" if self.symbols == (X, Y) else f", x={sx}, y={sy}"
+        (n, m), (sx, sy) = self.grid.shape, self.variables
+        sym = "" if self.variables == ("x", "y") else f", x={sx}, y={sy}"
         return f"LagrangeSurface({n}x{m} nodes, degree {self.degree}{sym}, source={self.grid.source!r})"
 
     def _repr_latex_(self) -> str:
@@ -250,6 +295,8 @@ def _latex(lhs: str, expr: sympy.Expr, terms: int, degree: str) -> str:
     if terms > LATEX_TERMS:
         # MathJax takes seconds over a page of terms; the summary says how to get them all.
         return rf"${lhs} = F$ ({degree}, {terms} terms: ``.expr`` holds them all)"
+    import sympy
+
     return f"${lhs} = {sympy.latex(expr)}$"
 
 
@@ -270,7 +317,7 @@ def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
     return acc
 
 
-def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = X) -> LagrangeCurve:
+def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x") -> LagrangeCurve:
     """The exact Lagrange curve through ``points`` (paper eq. 1-3).
 
     Parameters
@@ -286,6 +333,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = X) -> LagrangeCu
     >>> pts = curve_from_points([(1, 1), (2, 3), (3, 1)])
     >>> lagrange_curve(pts).expr
     -2*x**2 + 8*x - 5
+    >>> import sympy
     >>> t = sympy.Symbol("t")
     >>> lagrange_curve(pts, x=t).expr.subs(t, 2)
     3
@@ -294,10 +342,10 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = X) -> LagrangeCu
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
     c = b.transpose() * yv
     return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())),
-                         symbol=_symbol(x, "x"))
+                         variable=_variable(x, "x"))
 
 
-def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = X, y: sympy.Symbol | str = Y) -> LagrangeSurface:
+def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Symbol | str = "y") -> LagrangeSurface:
     """The exact tensor-product Lagrange surface through ``grid`` (paper eqs. 6-7).
 
     Parameters
@@ -314,6 +362,7 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = X, y: sympy.Symb
     >>> pts = [(1, 2, 7), (1, 3, 10), (1, 4, 13), (3, 2, 15), (3, 3, 18), (3, 4, 21),
     ...        (5, 2, 31), (5, 3, 34), (5, 4, 37)]
     >>> s = lagrange_surface(grid_from_points(pts))
+    >>> import sympy
     >>> x, y = sympy.symbols("x y")
     >>> s.expr == x**2 + 3*y, s.expr.subs({x: 1, y: 2}), sympy.diff(s.expr, x)
     (True, 7, 2*x)
@@ -321,7 +370,7 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = X, y: sympy.Symb
     >>> lagrange_surface(grid_from_points(pts), x=u, y=v).expr
     u**2 + 3*v
     """
-    sx, sy = _symbol(x, "x"), _symbol(y, "y")
+    sx, sy = _variable(x, "x"), _variable(y, "y")
     if sx == sy:
         raise InputError(f"x and y are both the symbol {sx}: a surface needs two different variables")
     n, m = grid.shape
@@ -330,4 +379,4 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = X, y: sympy.Symb
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])
     c = bx.transpose() * z * by
     coeffs = tuple(tuple(_frac(c[a, b]) for b in range(m)) for a in range(n))
-    return LagrangeSurface(grid=grid, coefficients=coeffs, symbols=(sx, sy))
+    return LagrangeSurface(grid=grid, coefficients=coeffs, variables=(sx, sy))

@@ -25,6 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
+from .evaluate.surface import grid_product
 from .values import as_exact
 
 __all__ = [
@@ -321,4 +322,4 @@ def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS) -> 
     for start in range(0, grid.nx, rows):
         stop = min(start + rows, grid.nx)
         xs = grid.xs[start:stop]
-        yield Block(start, xs, grid.ys, ev.snap_grid(w[start:stop] @ ty, xs, grid.ys))
+        yield Block(start, xs, grid.ys, ev.snap_grid(grid_product(w[start:stop], ty), xs, grid.ys))

@@ -186,3 +186,17 @@ def test_the_macros_page_quotes_the_program_sizes():
                                Tool("flat", 0.0), precision=prec, form=form, tolerance_mm=1e9).size
                  for prec, form in ((8, "lagrange"), (15, "horner")) for d in ("fanuc", "linuxcnc", "heidenhain")]
         assert f"| {n}x{n} | " + " | ".join(map(str, sizes)) + " |" in text
+
+
+def test_sampling_page_float64_basis_bound_ratio(monkeypatch):
+    """The bound counted with the basis in float64 units, against the long-double bound, for Example 4."""
+    import lagsym.evaluate.bounds as bounds
+    from lagsym.evaluate import surface_evaluator
+
+    ev = surface_evaluator(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")))
+    kept = ev.error_bound()
+    # The same weights with float64's unit of rounding for the basis values.
+    monkeypatch.setattr(bounds, "EPS_BASIS", float(np.finfo(float).eps))
+    ratio = ev.error_bound() / kept
+    assert ratio > 1
+    assert f"the same bound counted in float64 units is {ratio:.1f} times larger" in page("sampling.md")

@@ -225,3 +225,17 @@ def test_fast_points_agree_with_exact_values():
     ev = surface_evaluator(example4).fast_points
     for x, y in [(1, 1), (Fraction(5, 2), Fraction(7, 3)), (5, 5), (Fraction(13, 10), 4)]:
         assert ev(float(x), float(y)) == pytest.approx(float(example4.exact_value(x, y)), abs=1e-12)
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 1), (37, 3, 5), (400, 5, 2000), (3, 20, 9000)])
+def test_the_blocked_grid_product_is_the_matrix_product(shape):
+    """Blocks of rows (and a given output array) give the product NumPy's one matmul gives, to rounding."""
+    from lagsym.evaluate.surface import grid_product
+
+    n, k, m = shape
+    rng = np.random.default_rng(n)
+    w, ty = rng.uniform(-1, 1, (n, k)), rng.uniform(-1, 1, (k, m))
+    out = np.full((n, m), np.nan)
+    got = grid_product(w, ty, out)
+    scale = np.abs(w) @ np.abs(ty)
+    assert got is out and np.all(np.abs(got - w @ ty) <= 2 * k * np.finfo(float).eps * scale)

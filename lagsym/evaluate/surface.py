@@ -34,8 +34,70 @@ from .chebyshev import (
 __all__ = ["CHUNK_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
            "evaluate_grid"]
 
-CHUNK_POINTS = 1 << 16  # scattered points are evaluated in blocks of this many (bounded memory, warm caches)
+CHUNK_POINTS = 1 << 13  # scattered points are evaluated in blocks of this many: their long-double basis stays in cache
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
+# Multiply-adds in one block of a grid product: its rows are computed in cache and written once, and
+# it stays below the size from which OpenBLAS splits a product between threads (65536 * 4 = 262144).
+PRODUCT_BLOCK = 200_000
+
+
+def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``out = w @ ty`` for a tall ``w`` and a wide ``ty`` with a short inner dimension, in blocks of rows.
+
+    One BLAS product over a whole large grid hands the work to BLAS's own
+    threads, which on a loaded machine fight over the cores (a 2000 x 2000
+    grid took 2-3 times as long as in blocks); each block here
+    (:data:`PRODUCT_BLOCK` multiply-adds, small enough for BLAS to run it in
+    one thread) is computed in cache and written to ``out`` once.  Every
+    element is the same dot product as in ``w @ ty``.  Two threads of blocks
+    were tried: on a loaded 2-core machine they were no faster.
+    """
+    n = w.shape[0]
+    out = np.empty((n, ty.shape[1])) if out is None else out
+    if w.shape[1] == 0:
+        out[...] = 0.0
+        return out
+    rows = max(1, PRODUCT_BLOCK // max(ty.shape[1] * w.shape[1], 1))
+    for r in range(0, n, rows):
+        np.matmul(w[r:r + rows], ty, out=out[r:r + rows])
+    return out
+
+
+class _BasisWork:
+    """Long-double scratch space for :meth:`SurfaceEvaluator.points`, reused from block to block."""
+
+    def __init__(self, size: int, degree: int):
+        self.s = np.empty(size, dtype=np.longdouble)
+        self.s2 = np.empty(size, dtype=np.longdouble)
+        self.v = np.empty((max(degree, 3), size), dtype=np.longdouble)
+
+    def basis(self, x: np.ndarray, offset: float, scale: float, n: int, out: np.ndarray) -> np.ndarray:
+        """``T_k((x - offset) / scale)`` for ``k < n`` into ``out[:, :len(x)]``: :func:`chebyshev_matrix`'s arithmetic.
+
+        Long-double operations are the cost here (NumPy does not vectorize them), so
+        ``T_0 = 1`` and ``T_1 = s`` are not copied and the recurrence starts from them.
+        """
+        k = x.size
+        s, v = self.s[:k], self.v[:, :k]
+        out = out[:, :k]
+        np.subtract(x, np.longdouble(offset), out=s)
+        np.divide(s, np.longdouble(scale), out=s)
+        out[0] = 1.0
+        if n > 1:
+            out[1] = s
+        if n > 2:
+            s2 = self.s2[:k]
+            np.multiply(2.0, s, out=s2)
+            np.multiply(s2, s, out=v[2])
+            v[2] -= 1.0
+            if n > 3:
+                np.multiply(s2, v[2], out=v[3])
+                v[3] -= s
+            for j in range(4, n):
+                np.multiply(s2, v[j - 1], out=v[j])
+                v[j] -= v[j - 2]
+            out[2:] = v[2:n]
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,7 +182,7 @@ class SurfaceEvaluator:
         """
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
-        return self.snap_grid(self.x_factor(xs) @ self.y_basis(ys), xs, ys)
+        return self.snap_grid(grid_product(self.x_factor(xs), self.y_basis(ys)), xs, ys)
 
     @staticmethod
     def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,26 +204,40 @@ class SurfaceEvaluator:
         """``F(x, y)`` at scattered points; ``x`` and ``y`` broadcast together.
 
         Works in blocks of ``chunk`` points, so memory stays a few megabytes
-        above the result whatever the number of points.
+        above the result whatever the number of points, and a block's basis
+        values stay in cache.  The arithmetic is that of :meth:`grid` (the
+        basis in long double, rounded once), so :meth:`error_bound` holds.
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
         xf, yf = x.ravel(), y.ravel()
         n, m = self.shape
         out = np.empty(xf.size)
-        c = self.coefficients.T  # (m, n)
-        vx = np.empty((n, min(chunk, xf.size)))
-        vy = np.empty((m, min(chunk, xf.size)))
+        c = np.ascontiguousarray(self.coefficients.T)  # (m, n)
+        size = min(chunk, xf.size)
+        work = _BasisWork(size, max(n, m))
+        tx, ty = np.empty((n, size)), np.empty((m, size))
         for lo in range(0, xf.size, chunk):
             hi = min(lo + chunk, xf.size)
-            tx = chebyshev_matrix(self._s(xf[lo:hi]), n, vx)
-            ty = chebyshev_matrix(self._t(yf[lo:hi]), m, vy)
-            out[lo:hi] = np.einsum("bp,bp->p", c @ tx, ty)
-        px, kx = self._hits(self.x_nodes, self.x_exact, xf)
-        if px.size:
-            py, ky = self._hits(self.y_nodes, self.y_exact, yf[px])
-            out[px[py]] = self.node_values[kx[py], ky]
+            bx = work.basis(xf[lo:hi], self.x_offset, self.x_scale, n, tx)
+            by = work.basis(yf[lo:hi], self.y_offset, self.y_scale, m, ty)
+            w = c @ bx
+            w *= by
+            w.sum(axis=0, out=out[lo:hi])
+            self._snap_points(out[lo:hi], xf[lo:hi], yf[lo:hi])
         return out.reshape(shape)
+
+    def _snap_points(self, out: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
+        """Set ``out`` to the control height where ``(x, y)`` is a control point exactly; in place."""
+        hit = np.zeros(x.size, dtype=bool)
+        for v in self.x_nodes[self.x_exact]:
+            hit |= x == v
+        if not hit.any():
+            return
+        px = np.flatnonzero(hit)
+        kx = np.searchsorted(self.x_nodes, x[px])
+        py, ky = self._hits(self.y_nodes, self.y_exact, y[px])
+        out[px[py]] = self.node_values[kx[py], ky]
 
     def partial(self, dx: int = 0, dy: int = 0) -> np.ndarray:
         """Chebyshev coefficients of ``d**(dx+dy) F / dx**dx dy**dy``, per surface unit, in the same basis.
