@@ -142,7 +142,8 @@ class SimControl:
     the machine found the buffer empty between the first and the last
     character (the program not yet all there); ``pending_at_xoff`` the most
     characters still in the pty, written but not yet carried by the line,
-    when a DC3 went out.
+    when a DC3 went out (less those a real line would have carried while the
+    simulation itself was descheduled).
 
     Parameters
     ----------
@@ -361,11 +362,13 @@ class _Control:
                 if crossed:
                     self.port.write(DC3)
                     self.pending_now, self.tail = self.port.in_waiting, self.after
-                    self.pending_at_xoff = max(self.pending_at_xoff, self.pending_now)
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
                     late_s = time.monotonic() - (last - gap) - 2 * _LOOP_S
                     self.excused = max(0.0, late_s) * self.cps
+                    # A real line would have carried the excused characters to the control by now: only the
+                    # rest was still on its way when the DC3 went out.
+                    self.pending_at_xoff = max(self.pending_at_xoff, self.pending_now - int(self.excused))
                     self.xoffs += 1
                     if self.drop_on_xoff is not None and self.xoffs == self.drop_on_xoff:
                         drop_at = time.monotonic() + self.drop_settle_s
