@@ -48,7 +48,7 @@ from .pattern import levels as spaced
 from .plan import MAX_PLAN_POINTS
 
 __all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
-           "MAX_ROUGH_SAMPLES"]
+           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points"]
 
 MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (about 1 ms each): minutes at most
 
@@ -191,17 +191,10 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     >>> bool((rp.points_mm[:, 2] >= rp.floor_mm).all()), round(float(rp.points_mm[:, 2].min()), 6)
     (True, 1.5)
     """
-    choice(tool.shape, TOOL_SHAPES, "tool shape")
-    if tool.diameter_mm <= 0:
-        raise ToolpathError("roughing needs a cutter with a diameter above 0")
-    if spec.stepover_mm > tool.diameter_mm:
-        raise ToolpathError(f"side step {spec.stepover_mm:g} mm is wider than the tool ({tool.diameter_mm:g} mm): "
-                            "ridges would stand between the rows")
     ev = evaluator or surface_evaluator(surface)
     place = settings.placement
     box = place.box_mm(ev.bounds)
-    _check_stock(stock, box, ev, place)
-    _check_points(stock, tool, spec, 1, max_samples, "--max-samples")
+    check_rough_request(tool, stock, spec, ev, place, max_samples, "--max-samples")
     rows = _rows(stock, box, tool.radius_mm, spec)
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
     rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev, place,
@@ -209,7 +202,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     reachable = np.concatenate([f for f in floors])
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
-    _check_points(stock, tool, spec, count, max_points, "--max-points")
+    check_points(stock, tool, spec, count, max_points, "--max-points")
     z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
     depth = stock.top_mm - float(z_levels[-1])
     if spec.reach_mm is not None and depth > spec.reach_mm:
@@ -219,7 +212,20 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
-def _check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
+def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place,
+                        max_points: int | None, option: str) -> None:
+    """What every roughing refuses before any work: the cutter, the side step, the block, one level's size."""
+    choice(tool.shape, TOOL_SHAPES, "tool shape")
+    if tool.diameter_mm <= 0:
+        raise ToolpathError("roughing needs a cutter with a diameter above 0")
+    if spec.stepover_mm > tool.diameter_mm:
+        raise ToolpathError(f"side step {spec.stepover_mm:g} mm is wider than the tool ({tool.diameter_mm:g} mm): "
+                            "ridges would stand between the rows")
+    _check_stock(stock, place.box_mm(ev.bounds), ev, place)
+    check_points(stock, tool, spec, 1, max_points, option)
+
+
+def check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
                   option: str) -> None:
     """Refuse a path of more than ``max_points`` (rows times samples per row, times ``levels``) before making it."""
     if max_points is None:
