@@ -159,10 +159,13 @@ def test_macro_clears_the_block(rs274):
     assert (h[ok] - np.maximum(reach[ok], f[ok] + 0.3)).max() <= 0.2  # the grid's own error, as in test_rough
 
 
-def test_program_size_does_not_grow_with_the_block():
-    small = plan(dialect="fanuc")[-1]
-    big = plan(dialect="fanuc", margin=400.0, step=0.5, stepdown=2.0)[-1]
-    assert len(big) <= len(small) + 20 and len(big.encode()) < 4096
+@pytest.mark.parametrize("dialect, precision", [("fanuc", 8), ("linuxcnc", 15), ("heidenhain", 8)])
+def test_program_size_does_not_grow_with_the_block(dialect, precision):
+    """A block 800 mm wider on every side, at a finer step and step-down: 100 times the moves, the same program."""
+    small = plan(dialect=dialect, precision=precision)
+    big = plan(dialect=dialect, precision=precision, margin=400.0, step=0.5, stepdown=2.0)
+    assert len(big[5].points_mm) > 100 * len(small[5].points_mm)
+    assert abs(len(big[-1]) - len(small[-1])) <= 20 and len(big[-1].encode()) < 9 * 1024
 
 
 @pytest.mark.parametrize("milling", ["climb", "conventional"])
@@ -171,3 +174,43 @@ def test_one_way_milling_is_refused_for_the_macro(milling):
     with pytest.raises(Exception, match="zig-zag only"):
         rough_macro(surface, Tool("flat", 10.0), stock_around(BOX, TOP), RoughSpec(milling=milling),
                     MachineSettings(dialect="fanuc", mm_per_unit=20.0), precision=8)
+
+
+def test_a_job_with_a_roughing_macro_runs_in_rs274(rs274, tmp_path, run_cli):
+    """The example job with its roughing as a macro: rs274 runs the loops, then the finish, as planned."""
+    from test_job import job_text
+
+    job = tmp_path / "macro.toml"
+    job.write_text(job_text(**{"stepover = 5": "stepover = 5\nstep = 2\nmacro = true", "stepdown = 2": "stepdown = 20",
+                               "stepover = 0.5": "stepover = 4", "step = 0.2": "step = 2"}))
+    out = tmp_path / "job.ngc"
+    status, _, err = run_cli("job", job, "-o", out)
+    assert status == 0, err
+    text = out.read_text()
+    assert "o100 while" in text and "(1 ROUGH MACRO T1" in text and "T2 M06" in text
+    feeds = np.array([m[1:] for m in moves(rs274, text, "T1 P1 Z0 D10 ;r\nT2 P2 Z0 D6 ;b\n") if m[0] == "F"])
+    from lagsym.job import plan_job, read_job
+
+    rough = plan_job(read_job(job)).operations[0]
+    assert np.abs(feeds[1:len(rough.points_mm) + 1] - rough.points_mm).max() <= 1e-3  # after the plunge
+
+
+@pytest.mark.parametrize("args, words", [
+    (("--dialect", "grbl", "--macro"), "a roughing macro is written for fanuc or linuxcnc, not grbl"),
+    (("--precision", "8",), "--precision 8 applies to a macro only"),
+    (("--macro", "--max-samples", "1000"), "--max-samples 1000: a roughing macro makes no drop-cutter samples"),
+    (("--macro", "--milling", "conventional"), "a roughing macro cuts zig-zag only"),
+    (("--macro", "--max-points", "1000"), "more than the limit of 1e+03"),
+])
+def test_options_that_do_not_apply_to_the_macro_are_refused(run_cli, args, words):
+    status, out, err = run_cli("rough", EX4, "--scale", "20", "--stock-above", "2", "--safe-z", "90", *args)
+    assert status == 2 and words in err and err.count("\n") == 1 and not out, err
+
+
+def test_rough_macro_from_the_command_line_reports_its_size_and_clearance(run_cli, tmp_path):
+    out = tmp_path / "O1000.nc"
+    status, _, err = run_cli("rough", EX4, "--scale", "20", "--stock-above", "2", "--tool-diameter", "10",
+                             "--stepdown", "2", "--safe-z", "90", "--dialect", "fanuc", "--macro", "-o", out)
+    assert status == 0, err
+    size = len(out.read_bytes())
+    assert f"macro: {size} bytes" in err and size < 6 * 1024 and "WHILE [" in out.read_text()

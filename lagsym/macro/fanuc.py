@@ -13,7 +13,7 @@ from __future__ import annotations
 from ..errors import ProgramError
 from ..gcode.limits import variable_ranges
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal, number_variables
-from .model import Assign, Choose, Clamp, Loop, Move
+from .model import Assign, Choose, Clamp, Loop, Move, SetItem
 
 __all__ = ["render", "body_lines", "DEFAULT_BASE"]
 
@@ -40,6 +40,8 @@ def body_lines(loops, precision: int = 8, variable_base: int | None = None, vari
             elif isinstance(s, Clamp):
                 lim = literal(s.limit.value, precision)
                 out.append(f"IF [{name(s.target)} GT {lim}] THEN {name(s.target)}={lim}")
+            elif isinstance(s, SetItem):
+                out.append(f"#{s.number}={literal(s.value.value, precision)}")
             elif isinstance(s, Choose):
                 out.append(f"IF [{name(s.test)} {s.op} {expr(s.limit)}] THEN {name(s.target)}={expr(s.value)}")
             elif isinstance(s, Loop):

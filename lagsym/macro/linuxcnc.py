@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..errors import ProgramError
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal
-from .model import Assign, Choose, Clamp, Loop, Move
+from .model import Assign, Choose, Clamp, Loop, Move, SetItem
 
 __all__ = ["render", "body_lines"]
 
@@ -34,6 +34,8 @@ def body_lines(loops, precision: int = 15) -> list[str]:
                 lim = literal(s.limit.value, precision)
                 out.extend([f"{pad}o{n} if [{name(s.target)} GT {lim}]",
                             f"{pad}  {name(s.target)} = {lim}", f"{pad}o{n} endif"])
+            elif isinstance(s, SetItem):
+                out.append(f"{pad}#{s.number} = {literal(s.value.value, precision)}")
             elif isinstance(s, Choose):
                 n = next(labels)
                 out.extend([f"{pad}o{n} if [{name(s.test)} {s.op} {expr(s.limit)}]",

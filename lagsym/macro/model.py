@@ -17,7 +17,8 @@ from typing import Union
 
 from ..errors import ProgramError
 
-__all__ = ["Var", "Const", "Op", "Sqrt", "Round", "div", "sqrt", "round_", "Assign", "Clamp", "Choose", "Loop", "Move",
+__all__ = ["Var", "Const", "Op", "Sqrt", "Round", "div", "sqrt", "round_", "Assign", "Clamp", "Choose", "Item", "SetItem",
+           "Loop", "Move",
            "Expr", "Statement",
            "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables", "written"]
 
@@ -59,7 +60,14 @@ class Round:
     a: "Expr"
 
 
-Expr = Union[Var, Const, Op, Sqrt, Round]
+@dataclass(frozen=True)
+class Item:
+    """The numbered variable whose number is the value of ``index`` (``#[#idx]``): a table's entry."""
+
+    index: Var
+
+
+Expr = Union[Var, Const, Op, Sqrt, Round, Item]
 
 
 @dataclass(frozen=True)
@@ -76,6 +84,14 @@ class Clamp:
 
     target: Var
     limit: Const
+
+
+@dataclass(frozen=True)
+class SetItem:
+    """``#number = value``: one entry of a table the program reads with :class:`Item`."""
+
+    number: int
+    value: Const
 
 
 @dataclass(frozen=True)
@@ -114,7 +130,7 @@ class Move:
     z: Var
 
 
-Statement = Union[Assign, Clamp, Choose, Loop, Move]
+Statement = Union[Assign, Clamp, Choose, SetItem, Loop, Move]
 
 
 def var(name: str) -> Var:

@@ -40,16 +40,18 @@ from ..evaluate import surface_evaluator
 from ..machine import MachineSettings, Tool
 from ..toolpath.rough import RoughSpec, Stock, check_points, check_rough_request
 from ..values import choice
-from .clearance import Clearance, clearance_terms
+from .clearance import Clearance, clearance_tables
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .loops import MacroLoops
-from .model import Assign, Choose, Clamp, Loop, Move, add, const, decimal_context, mul, run, sqrt, sub, var
+from .model import Assign, Choose, Clamp, Item, Loop, Move, SetItem, Var, add, const, decimal_context, mul, run, sqrt, sub, var
 from .raster import Axis, MacroRaster
 
-__all__ = ["RoughMacro", "rough_macro", "MACRO_MILLING"]
+__all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]
 
 MACRO_MILLING = ("zigzag",)
-_GRID = Fraction(1, 10_000)  # the loops' constants (positions, steps, levels) on a 0.0001 grid of program units
+_GRID = Fraction(1, 10_000)
+TILES = {"fanuc": 8, "linuxcnc": 8}  # tiles a side of the clearance tables; other dialects: one tile, no table
+TABLE_BASE = {"fanuc": 500, "linuxcnc": 1000}  # the tables' first variable number  # the loops' constants (positions, steps, levels) on a 0.0001 grid of program units
 
 
 @dataclass(frozen=True)
@@ -121,9 +123,17 @@ class _Layout:
     np_: int       # last point index (N + 2)
     dr: Fraction
     nr: int
+    p_edges: tuple = ()  # the tiles' inner edges along and across, half-way between two grid positions
+    r_edges: tuple = ()
 
 
-def _layout(rf: RowForm, stock: Stock, tool: Tool, spec: RoughSpec, per_mm: Fraction) -> _Layout:
+def _edges(lo: Fraction, hi: Fraction, tiles: int) -> tuple:
+    """``tiles - 1`` inner edges evenly between ``lo`` and ``hi``, each half-way between two grid positions
+    (so no sample is ever on one: every control's comparison with it is exact)."""
+    return tuple((math.floor((lo + i * (hi - lo) / tiles) / _GRID) + Fraction(1, 2)) * _GRID for i in range(1, tiles))
+
+
+def _layout(rf: RowForm, stock: Stock, tool: Tool, spec: RoughSpec, per_mm: Fraction, tiles: int) -> _Layout:
     def box(c, k):
         return c - 1 / k, c + 1 / k
 
@@ -136,20 +146,40 @@ def _layout(rf: RowForm, stock: Stock, tool: Tool, spec: RoughSpec, per_mm: Frac
     n, dp = _counted(a0, a1, mm(spec.step_mm))
     c0, c1 = _down(mm(across[0])), _up(mm(across[1]))
     nr, dr = _counted(c0, c1, mm(spec.stepover_mm))
-    return _Layout(a0, a1, b0, b1, _down(mm(along[0]) - out), _up(mm(along[1]) + out), c0, c1, dp, n + 2, dr, nr)
+    return _Layout(a0, a1, b0, b1, _down(mm(along[0]) - out), _up(mm(along[1]) + out), c0, c1, dp, n + 2, dr, nr,
+                   _edges(a0, a1, tiles), _edges(b0, b1, tiles))
 
 
-def _statements(rf: RowForm, lay: _Layout, radius: Fraction, k: Fraction, top: Fraction, sd: Fraction,
+def _tile(index: Var, position: Var, edges) -> tuple:
+    """``index`` = how many of the tile ``edges`` lie below ``position``."""
+    return (Assign(index, const(0)),) + tuple(Choose(index, position, "GT", const(e), const(k))
+                                               for k, e in enumerate(edges, 1))
+
+
+def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, top: Fraction, sd: Fraction,
                 low: Fraction, levels: int, direction: str) -> tuple[tuple, tuple, tuple]:
-    """The loops, and the row and point statements of ``b`` (for the arithmetic check)."""
+    """The loops, and the row and point statements of ``F + stock + R |grad F|`` (for the arithmetic check).
+
+    ``tables`` is ``(A, B)`` as constants (one tile) or ``(base, tiles)``: the
+    tables' first variable number and tiles a side.
+    """
     n, j, jj, i, kk, t = var("n"), var("j"), var("jj"), var("i"), var("kk"), var("t")
     w, d, lv, r, rc, p, pc, z, q = var("w"), var("d"), var("lv"), var("r"), var("rc"), var("p"), var("pc"), \
         var("z"), var("q")
-    zp, zr = var("zp"), var("zr")
+    zp, zr, ti, tj, ia, ib = var("zp"), var("zr"), var("ti"), var("tj"), var("ia"), var("ib")
     row_code = tuple(row_statements(rf, rc, slopes=True))
     point_code = tuple(point_statements(rf, pc, z, slopes=True)) + (
         Assign(q, sqrt(add(mul(zp, zp), mul(zr, zr)))),
-        Assign(z, add(add(z, mul(q, const(radius))), const(k))))
+        Assign(z, add(z, mul(q, const(radius)))))
+    if isinstance(tables[0], Fraction):
+        row_tile, cap = (), (Assign(z, add(z, const(tables[0]))), Choose(z, z, "GT", const(tables[1]),
+                                                                         const(tables[1])))
+    else:
+        base, tiles = tables  # A[ip, ir] is variable base + ir * tiles + ip, B[ip, ir] tiles**2 further on
+        row_tile = _tile(tj, rc, lay.r_edges) + (Assign(tj, add(mul(tj, const(tiles)), const(base))),)
+        cap = _tile(ti, pc, lay.p_edges) + (
+            Assign(ia, add(tj, ti)), Assign(ib, add(ia, const(tiles * tiles))),
+            Assign(z, add(z, Item(ia))), Choose(z, z, "GT", Item(ib), Item(ib)))
     point_body = (
         Assign(t, sub(const(lay.np_), mul(const(2), i))),
         Assign(kk, add(i, mul(d, t))),
@@ -161,6 +191,7 @@ def _statements(rf: RowForm, lay: _Layout, radius: Fraction, k: Fraction, top: F
         Choose(pc, pc, "LT", const(lay.a0), const(lay.a0)),
         Clamp(pc, const(lay.a1)),
         *point_code,
+        *cap,
         Choose(z, z, "LT", lv, lv),
         Move(p, r, z) if direction == "x" else Move(r, p, z),
     )
@@ -173,6 +204,7 @@ def _statements(rf: RowForm, lay: _Layout, radius: Fraction, k: Fraction, top: F
         Choose(rc, rc, "LT", const(lay.b0), const(lay.b0)),
         Clamp(rc, const(lay.b1)),
         *row_code,
+        *row_tile,
         Loop(i, lay.np_, point_body),
         Assign(d, sub(const(1), d)),
     )
@@ -202,10 +234,10 @@ def _xy(direction: str, p, r):
     return (p, r) if direction == "x" else (r, p)
 
 
-def _arithmetic_mm(rf, lay: _Layout, radius_mm: float, ev, place, settings: MachineSettings, per_mm: Fraction,
+def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: MachineSettings, per_mm: Fraction,
                    precision: int) -> float:
     """Twice the largest difference of the control's ``b`` from the PC's, over 9 x 41 box positions, plus 3 units."""
-    _, row_code, point_code = _statements(rf, lay, _near(radius_mm, per_mm), Fraction(0), Fraction(0),
+    _, row_code, point_code = _statements(rf, lay, radius, (Fraction(0), Fraction(0)), Fraction(0),
                                           Fraction(1), Fraction(0), 1, "x")
     ctx = decimal_context(precision)
     worst, size = 0.0, 0.0
@@ -217,7 +249,7 @@ def _arithmetic_mm(rf, lay: _Layout, radius_mm: float, ev, place, settings: Mach
             env["pc"] = ctx.create_decimal(repr(float(pv)))
             got.append(float(run(point_code, env, ctx)["z"]))
         x, y = _xy(rf.direction, ps / float(per_mm), np.full(len(ps), rv / float(per_mm)))
-        want = _b_mm(ev, place, float(_near(radius_mm, per_mm) / per_mm), settings.stock_to_leave_mm, 0.0, x, y)
+        want = _b_mm(ev, place, float(radius / per_mm), settings.stock_to_leave_mm, 0.0, x, y)
         worst = max(worst, float(np.abs(np.array(got) / float(per_mm) - want).max()))
         size = max(size, float(np.abs(want).max()))
     ulp = float(Decimal(1).scaleb(Decimal(repr(size * float(per_mm))).adjusted() + 1 - precision)) / float(per_mm)
@@ -256,45 +288,61 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     check_rough_request(tool, stock, spec, ev, place, max_points, "--max-points")
     per_mm = Fraction(1) if settings.units == "mm" else Fraction(5, 127)
     rf = row_form(surface, settings, spec.direction, form)
-    lay = _layout(rf, stock, tool, spec, per_mm)
-    unit_mm = 10.0 ** -settings.digits / float(per_mm)
-    arith = _arithmetic_mm(rf, lay, tool.radius_mm, ev, place, settings, per_mm, precision)
-    clear = clearance_terms(ev, place.mm_per_unit, tool, spec.direction, float(lay.dp / per_mm), unit_mm, arith)
-    k = _up(Fraction(repr(clear.total_mm)) * per_mm)
+    tiles = TILES[settings.dialect] if settings.dialect in TILES else 1
+    lay = _layout(rf, stock, tool, spec, per_mm, tiles)
     radius = _near(tool.radius_mm, per_mm)
-    rows, pts, b = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, float(k / per_mm),
-                          per_mm, spec.direction)
+    arith = _arithmetic_mm(rf, lay, radius, ev, place, settings, per_mm, precision)
+    edges = [np.array([float(v / per_mm) for v in (lo, *inner, hi)])
+             for lo, inner, hi in ((lay.a0, lay.p_edges, lay.a1), (lay.b0, lay.r_edges, lay.b1))]
+    ex, ey = edges if spec.direction == "x" else edges[::-1]
+    clear = clearance_tables(ev, place, tool, float(lay.dp / per_mm), settings.stock_to_leave_mm, ex, ey,
+                             10.0 ** -settings.digits / float(per_mm), arith, spec.direction)
+    a = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.a_mm]
+    b = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.b_mm]
+    rows, pts, tip = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a, b, per_mm,
+                            spec.direction)
     top, sd = _near(stock.top_mm, per_mm), _near(spec.stepdown_mm, per_mm)
-    low = _down(Fraction(repr(float(b.min()))) * per_mm)
+    low = _down(Fraction(repr(float(tip.min()))) * per_mm)
     count = max(math.ceil((top - low) / sd), 1)
     check_points(stock, tool, spec, count, max_points, "--max-points")
     levels = np.maximum(float(top) - float(sd) * np.arange(1, count + 1), float(low)) / float(per_mm)
     if spec.reach_mm is not None and stock.top_mm - levels[-1] > spec.reach_mm:
         raise ToolpathError(f"the tool cannot reach: the cut goes {stock.top_mm - levels[-1]:.3f} mm below the "
                             f"stock top, the tool reaches {spec.reach_mm:g} mm below its holder")
-    body, row_code, point_code = _statements(rf, lay, radius, k, top, sd, low, count, spec.direction)
-    path = _path(rows, pts, b, levels, spec.direction)
+    if tiles == 1:
+        tables, setup = (a[0][0], b[0][0]), ()
+    else:
+        base = TABLE_BASE[settings.dialect]
+        tables = (base, tiles)
+        setup = tuple(SetItem(base + k * tiles * tiles + ir * tiles + ip, const(t[ip][ir]))
+                      for k, t in enumerate((a, b)) for ir in range(tiles) for ip in range(tiles))
+    body, row_code, point_code = _statements(rf, lay, radius, tables, top, sd, low, count, spec.direction)
+    path = _path(rows, pts, tip, levels, spec.direction)
     start = tuple(Fraction(repr(float(v))) * per_mm for v in path[0])
     raster = MacroRaster(spec.direction, rows=Axis("Y" if spec.direction == "x" else "X", lay.c0, lay.c1, lay.dr,
                                                    lay.nr),
                          points=Axis("X" if spec.direction == "x" else "Y", lay.a0, lay.a1, lay.dp, lay.np_))
-    loops = MacroLoops(body=body, raster=raster, form=rf, start=start, row_code=row_code, point_code=point_code,
-                       title="LAGSYM ROUGHING MACRO")
+    loops = MacroLoops(body=setup + body, raster=raster, form=rf, start=start, row_code=row_code,
+                       point_code=point_code, title="LAGSYM ROUGHING MACRO")
     return RoughMacro(loops, clear, levels, path, precision, tool, stock, spec)
 
 
-def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, k_mm: float, per_mm: Fraction,
-           direction: str):
-    """The rows' and points' positions (mm) and ``b`` (mm) at each, rows by points, as the loops compute them."""
+def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, a, b, per_mm: Fraction, direction: str):
+    """The rows' and points' positions (mm) and the tip before the level (mm) at each, rows by points."""
     f = float(per_mm)
     kk = np.arange(lay.np_ + 1)
     p = np.minimum(float(lay.a0) + (kk - 1) * float(lay.dp), float(lay.a1))
     p[0], p[-1] = float(lay.e0), float(lay.e1)
     r = np.minimum(float(lay.c0) + np.arange(lay.nr + 1) * float(lay.dr), float(lay.c1))
     pc, rc = np.clip(p, float(lay.a0), float(lay.a1)), np.clip(r, float(lay.b0), float(lay.b1))
+    ti = np.searchsorted(np.array([float(e) for e in lay.p_edges]), pc)
+    tj = np.searchsorted(np.array([float(e) for e in lay.r_edges]), rc)
+    at = np.array([[float(v) for v in row] for row in a]) / f
+    bt = np.array([[float(v) for v in row] for row in b]) / f
     pp, rr = np.meshgrid(pc / f, rc / f)
     x, y = _xy(direction, pp, rr)
-    return r / f, p / f, _b_mm(ev, place, radius_mm, stock_mm, k_mm, x, y)
+    high = _b_mm(ev, place, radius_mm, stock_mm, 0.0, x, y) + at[ti[None, :], tj[:, None]]
+    return r / f, p / f, np.minimum(high, bt[ti[None, :], tj[:, None]])
 
 
 def _path(rows, pts, b, levels, direction: str) -> np.ndarray:
@@ -309,3 +357,35 @@ def _path(rows, pts, b, levels, direction: str) -> np.ndarray:
             out.append(np.column_stack([x, y, zz]))
             d = 1 - d
     return np.vstack(out)
+
+
+def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None) -> list[str]:
+    """The blocks from over the first point at safe Z: down to it, then the loops (Fanuc or LinuxCNC).
+
+    For a program that writes its own header, tool change and end (a job's);
+    :func:`rough_macro_program` writes a whole one, in any macro dialect.
+    """
+    from . import fanuc, linuxcnc
+    from ..gcode.numbers import fixed
+
+    dialect = choice(settings.dialect, ("fanuc", "linuxcnc"), "dialect of a roughing macro in a job")
+    uf, dp = settings.unit_factor, settings.digits
+    z0 = float(rm.loops.start[2])
+    out = []
+    if z0 + settings.feed_height_mm * uf < settings.safe_z_mm * uf:
+        out.append(f"G00 Z{fixed(z0 + settings.feed_height_mm * uf, dp)}")
+    out.append(f"G01 Z{fixed(z0, dp)} F{fixed(settings.plunge_feed_mm_min * uf, 1, trim=True)}")
+    out.append(f"F{fixed(settings.feed_mm_min * uf, 1, trim=True)}")
+    if dialect == "fanuc":
+        return out + fanuc.body_lines(rm.loops, rm.precision, variable_base)
+    return out + linuxcnc.body_lines(rm.loops, rm.precision)
+
+
+def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
+                        variables: str = "full") -> str:
+    """The whole program for ``rm``: header, tool, approach, the loops, the end (Fanuc, LinuxCNC or Heidenhain)."""
+    from .program import RENDERERS
+
+    dialect = choice(settings.dialect, tuple(RENDERERS), "macro dialect")
+    return RENDERERS[dialect](rm.loops, settings, precision=rm.precision, variable_base=variable_base,
+                              variables=variables)
