@@ -54,9 +54,13 @@ def add_arguments(p) -> None:
     r.add_argument("--stepover", type=_STEP_MM, metavar="MM", help="side step between rows (default half the tool)")
     r.add_argument("--step", type=_STEP_MM, default=0.5, metavar="MM", help="forward sampling step (default 0.5)")
     r.add_argument("--stock-to-leave", type=_DEPTH_MM, default=0.3, metavar="MM", help="material left above the surface (default 0.3)")
-    r.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
-    r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
-                   help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
+    r.add_argument("--pattern", choices=("raster", "offset"), default="raster",
+                   help="clearing at each level: raster rows (default) or offset, concentric rectangles from the "
+                        "block's outline inwards")
+    r.add_argument("--direction", choices=DIRECTIONS, help="raster rows along x (default) or y")
+    r.add_argument("--milling", choices=("zigzag", "climb", "conventional"),
+                   help="raster: zigzag (default, stays down), or one-way climb or conventional (retracts above "
+                        "the block); offset: climb (default) or conventional")
     t = p.add_argument_group("cutter")
     t.add_argument("--tool-shape", default="flat", help="flat (default), ball or bull (bull nose: give --corner-radius)")
     t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
@@ -93,7 +97,10 @@ def job_data(args) -> dict:
             tool[key] = getattr(args, key)
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
           "plunge_feed": args.plunge_feed, "coolant": args.coolant, "stepdown": args.stepdown, "step": args.step,
-          "stock_to_leave": args.stock_to_leave, "direction": args.direction, "milling": args.milling}
+          "stock_to_leave": args.stock_to_leave}
+    for key in ("pattern", "direction", "milling"):
+        if getattr(args, key) is not None:
+            op[key] = getattr(args, key)
     if args.stepover is not None:
         op["stepover"] = args.stepover
     if args.macro:
@@ -125,6 +132,14 @@ def _refuse(args) -> None:
         raise InputError(f"--precision {args.precision} applies to a macro only: add --macro or leave it out")
     if args.macro and args.dialect == "grbl":
         raise InputError("--macro: a roughing macro is written for fanuc or linuxcnc, not grbl (no macro language)")
+    if args.pattern == "offset" and args.direction is not None:
+        raise InputError(f"--direction {args.direction} does not apply with --pattern offset (rectangles, no rows)")
+    if args.pattern == "offset" and args.milling == "zigzag":
+        raise InputError("--milling zigzag: --pattern offset cuts every rectangle one way, climb (default) or "
+                         "conventional")
+    if args.macro and args.pattern != "raster":
+        raise InputError(f"--pattern {args.pattern}: a roughing macro runs raster rows; leave out --macro "
+                         "for offset clearing")
     if args.macro and args.max_samples is not None:
         raise InputError(f"--max-samples {args.max_samples}: a roughing macro makes no drop-cutter samples; "
                          "leave it out (--max-points limits the moves the control runs)")

@@ -116,7 +116,8 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
                        step_mm=o.get("step", 0.5), stock_to_leave_mm=o.get("stock_to_leave", 0.3),
-                       direction=o.get("direction", "x"), milling=o.get("milling", "zigzag"),
+                       direction=o.get("direction", "x"), pattern=o.get("pattern", "raster"),
+                       milling=o.get("milling", "climb" if o.get("pattern") == "offset" else "zigzag"),
                        flute_length_mm=tool.flute_length_mm, reach_mm=tool.reach_mm)
         if o.get("macro"):
             precision = o.get("precision", DEFAULT_PRECISION[spec.dialect])

@@ -277,6 +277,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     """
     import dataclasses
 
+    if spec.pattern != "raster":
+        raise ToolpathError(f"pattern {spec.pattern!r}: a roughing macro runs raster rows")
     if spec.milling not in MACRO_MILLING:
         raise ToolpathError(f"milling {spec.milling!r}: a roughing macro cuts zig-zag only (a one-way raster "
                             "retracts over the block between rows); leave out the macro for climb or conventional")
