@@ -193,6 +193,10 @@ def test_a_job_with_a_roughing_macro_runs_in_rs274(rs274, tmp_path, run_cli):
 
     rough = plan_job(read_job(job)).operations[0]
     assert np.abs(feeds[1:len(rough.points_mm) + 1] - rough.points_mm).max() <= 1e-3  # after the plunge
+    # verify --job runs the macro through the simulator: every move of both tools, no gouge, no crash
+    status, report, err = run_cli("verify", "--job", job, out, "--cell", "2")
+    assert status == 0, report + err
+    assert f"T1 FLAT END D10 MM from line 9: {len(rough.points_mm) + 3} moves" in report
 
 
 @pytest.mark.parametrize("args, words", [
@@ -214,3 +218,21 @@ def test_rough_macro_from_the_command_line_reports_its_size_and_clearance(run_cl
     assert status == 0, err
     size = len(out.read_bytes())
     assert f"macro: {size} bytes" in err and size < 6 * 1024 and "WHILE [" in out.read_text()
+
+
+@pytest.mark.parametrize("dialect, precision", [("fanuc", 8), ("linuxcnc", 15)])
+def test_inch_rows_along_y_with_an_origin_run_as_planned(dialect, precision):
+    """Program units, row direction and work offset change the loops' constants, not where the tool goes."""
+    from lagsym.macro.roughing import rough_macro_program
+
+    surface = lagrange_surface(read_points(EX4))
+    settings = MachineSettings(dialect=dialect, mm_per_unit=20.0, safe_z_mm=120.0, units="inch",
+                               origin_mm=(5.0, -3.0, 1.0))
+    rm = rough_macro(surface, Tool("ball", 6.0), stock_around((25.0, 105.0, 17.0, 97.0), 74.6, 3.0),
+                     RoughSpec(12.0, 3.0, 1.5, 0.3, "y"), settings, precision=precision)
+    text = rough_macro_program(rm, settings)
+    assert "G20" in text
+    pts = simulate(text, dialect, precision).feed_points() * 25.4
+    assert np.abs(pts[1:] - rm.points_mm).max() <= 1e-4
+    rows = rm.points_mm[:, 0]
+    assert len(np.unique(rows)) < len(np.unique(rm.points_mm[:, 1]))  # rows along y: few X, many Y
