@@ -183,14 +183,15 @@ def machine_job(spec, text: str, source: str = "<program>", **options) -> Machin
     """
     surface = lagrange_surface(read_points(spec.points))
     stock = job_stock(spec, surface)
-    plain = _MACRO_BLOCK.sub("", text)  # the macro statements blanked, the lines kept: tool changes are words
+    # in a macro program the macro statements are blanked (the lines kept): its tool changes are plain words
+    plain = _MACRO_BLOCK.sub("", text) if _MACRO_LINE.search(text) else text
     return machine_part(surface, job_moves(spec, text, source), tool_changes(plain, source=source),
                         {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
                         Placement(spec.mm_per_unit, spec.origin_mm), **options)
 
 
-_MACRO_LINE = re.compile(r"^\s*(#|WHILE\b|o\d+\s)", re.I | re.M)
-_MACRO_BLOCK = re.compile(r"^[^\n]*(#|\[|^\s*o\d+\s|^\s*END\d)[^\n]*$", re.I | re.M)
+_MACRO_LINE = re.compile(r"^[ \t]*(#|WHILE\b|o\d+[ \t])", re.I | re.M)
+_MACRO_BLOCK = re.compile(r"^[^\n]*(#|\[|^[ \t]*o\d+[ \t]|^[ \t]*END\d)[^\n]*$", re.I | re.M)
 
 
 def job_moves(spec, text: str, source: str = "<program>") -> Moves:

@@ -7,12 +7,13 @@
         lv = TOP - (n + 1) * SD; if lv < LOW: lv = LOW
         j = 0 .. NR                      rows, counted; every other level in reverse
             jj = j + w * (NR - 2 j);  r = R0 + jj * DR, clamped to the block
-            rc = r clamped to the box;  the row's statements of F from rc
+            rc = r clamped to the box;  the row's statements of F from rc;  tj = its tile row
             i = 0 .. NP                  points: outside, the box edge, ..., the box edge, outside
                 kk = i + d * (NP - 2 i);  p = A0 + (kk - 1) * DP, clamped to A1
                 p = E0 at kk = 0, E1 at kk = NP (beside the block);  pc = p clamped to the box
-                z = F(pc, rc) + stock, zp, zr = the slopes there
-                z = z + R * SQRT[zp**2 + zr**2] + K;  if z < lv: z = lv
+                z = F(pc, rc) + stock, zp, zr = the slopes there;  ti = its tile
+                z = z + R * SQRT[zp**2 + zr**2] + A[ti, tj];  if z > B[ti, tj]: z = B[ti, tj]
+                if z < lv: z = lv
                 G1 to (p, r, z)
             d = 1 - d
         w = 1 - w
@@ -20,13 +21,16 @@
 so the tool runs the point-list roughing's zig-zag (:mod:`lagsym.toolpath.rough`):
 every row starts and ends beside the block by the tool radius plus the
 clearance, so every level is entered from the air, and the links between
-rows and levels run there.  ``K`` and its proof are in :mod:`.clearance`:
+rows and levels run there.  The tables ``A`` and ``B`` (set at the start,
+read with ``#[..]``; one tile and no table for a dialect without them) and
+the proof are in :mod:`.clearance`:
 no position and no move goes below the exact drop-cutter height plus the
 stock.  The program's size depends on the surface's degree, not on the block.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from decimal import Decimal
@@ -63,7 +67,7 @@ class RoughMacro:
     loops : MacroLoops
         What a dialect renders (:data:`~lagsym.macro.program.RENDERERS`).
     clearance : Clearance
-        ``K`` and its terms (mm).
+        The tables ``A`` and ``B`` and their terms (mm).
     levels_mm : ndarray
         The Z levels, from the top down (machine mm).
     points_mm : ndarray, shape (N, 3)
@@ -224,7 +228,7 @@ def _near(v_mm: float, per_mm: Fraction) -> Fraction:
 
 
 def _b_mm(ev, place, radius_mm: float, stock_mm: float, k_mm: float, x_mm, y_mm) -> np.ndarray:
-    """``F + stock + R |grad F| + K`` (mm) at box positions ``x_mm, y_mm`` (machine mm), in floats."""
+    """``F + stock + R |grad F| + k_mm`` (mm) at box positions ``x_mm, y_mm`` (machine mm), in floats."""
     u, v = place.to_surface(np.asarray(x_mm, float), np.asarray(y_mm, float))
     g = np.hypot(ev.fast_points(u, v, dx=1), ev.fast_points(u, v, dy=1))
     return place.height_mm(ev.fast_points(u, v)) + stock_mm + radius_mm * g + k_mm
@@ -273,10 +277,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     >>> rm = rough_macro(s, Tool("flat", 2.0), Stock(0, 4, 0, 4, 4.0), RoughSpec(1.5, 1.5, 1.0, 0.5),
     ...                  MachineSettings(dialect="linuxcnc"), precision=15)
     >>> [round(float(z), 4) for z in rm.levels_mm], bool(rm.points_mm[:, 2].min() >= 1.5)
-    ([2.5, 1.5], True)
+    ([2.5, 1.5006], True)
     """
-    import dataclasses
-
     if spec.pattern != "raster":
         raise ToolpathError(f"pattern {spec.pattern!r}: a roughing macro runs raster rows")
     if spec.milling not in MACRO_MILLING:
