@@ -45,7 +45,8 @@ _EXPORTS = {
     "gcode": ("Moves", "parse_moves", "move_points"),
     "verify": ("CutReport", "simulate_cut"),
     "post.program": ("PointProgram", "point_program", "write_program"),
-    "macro": ("MacroProgram", "macro_program", "planned_points", "predicted_error", "program_stats"),
+    "macro": ("MacroProgram", "macro_program", "planned_points", "predicted_error", "program_stats", "RoughMacro",
+              "rough_macro", "rough_macro_program"),
     "simulate": ("ControlAlarm", "Simulation", "simulate"),
     "dnc": ("Program", "parse_program", "resume_setup", "PROFILES", "LineSettings", "profile", "LineFault",
             "TransferProgress", "TransferResult", "transfer_segments", "send_program", "receive_program"),
@@ -120,7 +121,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
     from .io import read_any_points, read_curve_points, read_points
     from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
-    from .macro import MacroProgram, macro_program, planned_points, predicted_error, program_stats
+    from .macro import (MacroProgram, RoughMacro, macro_program, planned_points, predicted_error, program_stats,
+                        rough_macro, rough_macro_program)
     from .post.program import PointProgram, point_program, write_program
     from .sampling import Sample, SampleGrid, sample, sample_grid
     from .simulate import ControlAlarm, Simulation, simulate

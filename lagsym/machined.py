@@ -17,6 +17,7 @@ exact surface inside the box of the control points (beyond it lies no part):
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -182,9 +183,38 @@ def machine_job(spec, text: str, source: str = "<program>", **options) -> Machin
     """
     surface = lagrange_surface(read_points(spec.points))
     stock = job_stock(spec, surface)
-    return machine_part(surface, parse_moves(text, source=source), tool_changes(text, source=source),
+    # in a macro program the macro statements are blanked (the lines kept): its tool changes are plain words
+    plain = _MACRO_BLOCK.sub("", text) if _MACRO_LINE.search(text) else text
+    return machine_part(surface, job_moves(spec, text, source), tool_changes(plain, source=source),
                         {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
                         Placement(spec.mm_per_unit, spec.origin_mm), **options)
+
+
+_MACRO_LINE = re.compile(r"^[ \t]*(#|WHILE\b|o\d+[ \t])", re.I | re.M)
+_MACRO_BLOCK = re.compile(r"^[^\n]*(#|\[|^[ \t]*o\d+[ \t]|^[ \t]*END\d)[^\n]*$", re.I | re.M)
+
+
+def job_moves(spec, text: str, source: str = "<program>") -> Moves:
+    """The moves of a job's program: read as a point list or, where it holds macro loops (a roughing macro,
+    ``macro = true``), as lagsym's simulator runs it at the precision of the job's macros."""
+    if not _MACRO_LINE.search(text):
+        return parse_moves(text, source=source)
+    from .macro import DEFAULT_PRECISION
+    from .simulate import simulate
+
+    precision = max(op.options.get("precision", DEFAULT_PRECISION[spec.dialect]) for op in spec.operations
+                    if op.options.get("macro")) if any(op.options.get("macro") for op in spec.operations) \
+        else DEFAULT_PRECISION.get(spec.dialect, 15)
+    sim = simulate(text, spec.dialect, precision).moves
+    n = len(sim)
+    scale = 25.4 if spec.units == "inch" else 1.0
+    pts = np.column_stack([np.frombuffer(c, dtype=float) if n else np.zeros(0) for c in (sim._x, sim._y, sim._z)])
+    line = np.frombuffer(sim._line, dtype=np.int32).astype(int) if n else np.zeros(0, int)
+    z_lines = [k for k, t in enumerate(text.splitlines(), 1) if re.search(r"Z[-+.\d#\[]", re.sub(r"\(.*?\)", "", t))]
+    return Moves(points_mm=pts.reshape(-1, 3) * scale, start_mm=np.zeros(3),
+                 rapid=np.frombuffer(sim._rapid, dtype=np.int8).astype(bool) if n else np.zeros(0, bool),
+                 feed_mm_min=np.frombuffer(sim._feed, dtype=float) * scale if n else np.zeros(0),
+                 line=line, z_known=line >= (z_lines[0] if z_lines else math.inf))
 
 
 def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:

@@ -200,3 +200,46 @@ def test_sampling_page_float64_basis_bound_ratio(monkeypatch):
     ratio = ev.error_bound() / kept
     assert ratio > 1
     assert f"the same bound counted in float64 units is {ratio:.1f} times larger" in page("sampling.md")
+
+
+def test_the_roughing_page_quotes_the_roughing_macro(tmp_path, run_cli):
+    """Sizes, the clearance tables' range and the extra height over the point-list roughing, recomputed."""
+    import re
+
+    from test_rough_macro import BOX, drop, plan
+
+    text = page("roughing.md")
+    common = ("rough", EXAMPLES / "paper-example-4.json", "--scale", "20", "--stock-above", "2", "--tool-diameter",
+              "10", "--stepdown", "2", "--stepover", "5", "--stock-to-leave", "0.3", "--safe-z", "90")
+    sizes = {}
+    for name, extra in (("fanuc", ("--macro",)), ("linuxcnc", ("--macro",)), ("points", ())):
+        out = tmp_path / f"{name}.nc"
+        status, _, err = run_cli(*common, "--dialect", "linuxcnc" if name == "linuxcnc" else "fanuc", *extra,
+                                 "-o", out)
+        assert status == 0, err
+        sizes[name] = len(out.read_bytes())
+        if name == "fanuc":
+            a = re.search(r"A (\S+) to (\S+) mm \(curvature up to (\S+)/mm\)", err).groups()
+    assert (f"the Fanuc program is {sizes['fanuc']} bytes and the LinuxCNC one {sizes['linuxcnc']}, where the "
+            f"Fanuc point-list program is {sizes['points']} bytes") in text
+    assert f"`A` runs from {a[0]} to {a[1]} mm" in text and f"at most {a[2]} per mm" in text
+    surface, settings, tool, spec, stock, rm, _ = plan(stepdown=2.0, step=0.5)
+    per = len(rm.points_mm) // len(rm.levels_mm)
+    last = rm.points_mm[-per:]
+    q = last[(last[:, 0] >= BOX[0]) & (last[:, 0] <= BOX[1])]
+    cl = drop(q[:, 0], q[:, 1]) + 0.3
+    extra = q[:, 2] - np.maximum(cl, rm.levels_mm[-1])
+    assert f"on average {extra.mean():.1f} mm and at most {extra.max():.1f} mm above" in page("roughing.md")
+    from lagsym.evaluate import surface_evaluator
+
+    ev = surface_evaluator(surface)
+    u, v = settings.placement.to_surface(q[:, 0], np.clip(q[:, 1], 20, 100))
+    f = settings.placement.height_mm(ev.fast_points(np.clip(u, 1, 5), np.clip(v, 1, 5)))
+    c = float((cl - 0.3 - f).max())
+    constant = np.maximum(f + c + 0.3, rm.levels_mm[-1]) - np.maximum(cl, rm.levels_mm[-1])
+    assert f"above `F` over the box ({c:.1f} mm), would leave {constant.mean():.1f} mm on average" in text
+    fanuc = (tmp_path / "fanuc.nc").read_text()
+    assert "\n#500=" in fanuc and "\n#627=" in fanuc and "\n#628=" not in fanuc and "\n#499=" not in fanuc
+    linuxcnc = (tmp_path / "linuxcnc.nc").read_text()
+    assert "\n#1000 = " in linuxcnc and "\n#1127 = " in linuxcnc and "\n#1128 = " not in linuxcnc
+    assert "8 x 8 tiling" in text and "(128 numbers, `#500`-`#627` on a Fanuc, `#1000`-`#1127` on LinuxCNC)" in text

@@ -47,6 +47,12 @@ BAD = [
     ({"safe_z = 90": "safe_z = 60"}, "is not above the stock top"),
     ({"[stock]": "[stock]\nheight = 3"}, "unknown key stock.'height'"),
     ({"scale = 20": "scale = 20 20"}, "not a valid TOML job file"),
+    ({"stepover = 5": "stepover = 5\nprecision = 8"}, "operations[0].precision applies to a roughing macro only"),
+    ({"stepover = 5": "stepover = 5\nmacro = 1"}, "operations[0].macro = 1 must be true or false"),
+    ({"stepover = 5": "stepover = 5\nmacro = true", 'dialect = "linuxcnc"': 'dialect = "grbl"'},
+     "operations[0].macro: a roughing macro is written for fanuc or linuxcnc, not 'grbl'"),
+    ({"stepover = 5": "stepover = 5\nmacro = true\nmilling = 'climb'"}, "a roughing macro cuts zig-zag only"),
+    ({"stepover = 5": "stepover = 5\nmacro = true\nprecision = 12"}, "precision = 12 is not one of 8, 15"),
 ]
 
 

@@ -134,6 +134,7 @@ def test_roughing_example_4_is_gouge_free_and_clears_the_block(rs274, program):
     cl_rows = np.where(on_row[None, :], cl, np.inf)
     padc = np.pad(cl_rows, k, constant_values=np.inf)
     reach = np.min([padc[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    assert np.isfinite(reach[inbox]).all(), "a cell of the box no row comes within the radius of"
     slope = max(np.abs(np.diff(f[inbox].reshape(161, 161), axis=0)).max(), 0) / cell
     tol = slope * cell + 0.2  # the grid's own error of the maximum, plus the sag allowance
     excess = np.where(inbox, h - (np.maximum(reach, f) + STOCK), -np.inf)
@@ -187,7 +188,71 @@ def test_climb_rows_keep_the_material_on_the_right(rs274, run_cli, tmp_path):
     (("--stock-above", "2", "--stepover", "12"), "wider than the tool"),
     (("--stock-above", "2", "--block", "30,90,20,100"), "does not cover"),
     (("--stock-above", "2", "--tool-shape", "drill"), "shape = 'drill' is not one of ball, flat"),
+    (("--stock-above", "2", "--pattern", "offset", "--direction", "y"), "--direction y does not apply"),
+    (("--stock-above", "2", "--pattern", "offset", "--milling", "zigzag"), "cuts every rectangle one way"),
+    (("--stock-above", "2", "--pattern", "offset", "--macro"), "a roughing macro runs raster rows"),
 ])
 def test_bad_roughing_requests_get_one_line_and_exit_2(run_cli, args, words):
     status, out, err = run_cli("rough", EX4, "--scale", "20", "--safe-z", "90", *args)
     assert status == 2 and words in err and err.count("\n") == 1 and not out, err
+
+
+def test_offset_clearing_is_gouge_free_and_clears_the_block(rs274, run_cli, tmp_path):
+    """Concentric rectangles at every level: the same checks as the raster's, with what the tool can reach
+    taken over the centres the program's feed moves pass (every 0.5 mm along them)."""
+    out = tmp_path / "offset.ngc"
+    status, _, err = run_cli("rough", EX4, "--scale", "20", "--stock-above", "2", "--tool-diameter", "10",
+                             "--stepdown", "2", "--stepover", "5", "--stock-to-leave", "0.3", "--safe-z", "90",
+                             "--pattern", "offset", "--dialect", "linuxcnc", "-o", out)
+    assert status == 0, err
+    mv = moves(rs274, out.read_text())
+    cell = 0.5
+    gx = gy = np.arange(10.0, 110.0 + cell / 2, cell)
+    fx, fy = np.meshgrid(gx, gy, indexing="ij")
+    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    f = np.where(inbox, exact_heights(EX4, np.clip(fx, 20, 100), np.clip(fy, 20, 100)), -np.inf)
+    top = float(exact_heights(EX4, *np.meshgrid(np.linspace(20, 100, 401), np.linspace(20, 100, 401))).max()) + 2
+    h = np.where(inbox, top, -np.inf)
+    pos, centres, entries = None, [], []
+    for kind, x, y, z in mv:
+        if pos is not None:
+            removed = sweep_flat(h, gx, gy, pos, (x, y, z), R)
+            if kind == "T" or (x, y) == pos[:2]:
+                assert removed <= 1e-6, f"a rapid or a plunge at {pos} -> {(x, y, z)} cut {removed} mm of stock"
+                if kind != "T":
+                    entries.append((x, y))
+            else:
+                n = int(np.ceil(np.hypot(x - pos[0], y - pos[1]) / cell)) + 1
+                centres += list(zip(np.linspace(pos[0], x, n), np.linspace(pos[1], y, n)))
+        pos = (x, y, z)
+    # every level comes down beside the block, clear of it by more than the tool radius
+    assert entries and all(min(x - 20, 100 - x, y - 20, 100 - y) < -R for x, y in entries)
+    assert (np.where(inbox, h, 0.0) - np.where(inbox, f, 0.0))[inbox].min() >= STOCK - 0.002
+    k = int(round(R / cell))
+    off = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1) if (i * i + j * j) * cell * cell <= R * R]
+    pad = np.pad(f, k, constant_values=-np.inf)
+    cl = np.max([pad[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    on_path = np.zeros(cl.shape, dtype=bool)
+    c = np.array(centres)
+    ix, iy = np.rint((c[:, 0] - gx[0]) / cell).astype(int), np.rint((c[:, 1] - gy[0]) / cell).astype(int)
+    keep = (ix >= 0) & (ix < len(gx)) & (iy >= 0) & (iy < len(gy))
+    on_path[ix[keep], iy[keep]] = True
+    padc = np.pad(np.where(on_path, cl, np.inf), k, constant_values=np.inf)
+    reach = np.min([padc[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    assert np.isfinite(reach[inbox]).all(), "a cell of the box no centre of the path comes within the radius of"
+    slope = max(np.abs(np.diff(f[inbox].reshape(161, 161), axis=0)).max(), 0) / cell
+    excess = np.where(inbox, h - (np.maximum(reach, f) + STOCK), -np.inf)
+    assert excess.max() <= STEPDOWN + slope * cell + 0.2, excess.max()
+
+
+def test_offset_rectangles_run_clockwise_for_climb(rs274, run_cli, tmp_path):
+    """Climb milling with the middle uncut: the first side after the lead-in runs up the block's left edge (+y)."""
+    out = tmp_path / "o.ngc"
+    status, _, err = run_cli("rough", EX4, "--scale", "20", "--stock-above", "2", "--stepdown", "80",
+                             "--safe-z", "90", "--pattern", "offset", "--dialect", "linuxcnc", "-o", out)
+    assert status == 0, err
+    feeds = [m for m in moves(rs274, out.read_text()) if m[0] == "F"]
+    lead = [m for m in feeds if m[2] == 20.0 and m[1] <= 20.0]
+    assert lead and min(m[1] for m in lead) < 15.0  # fed in from beside the block along its edge
+    left = [m for m in feeds if m[1] == 20.0 and m[2] > 20.0]
+    assert left and left[0][2] < left[-1][2]

@@ -21,15 +21,28 @@ raster whose height is never below the cutter's exact drop-cutter height
 plus the stock to leave.  Every level is entered from beside the block, so
 no cutter plunges into solid stock.
 
+With --macro the program is a parametric macro instead: the control loops
+over the levels, rows and points and computes each tip height from the
+surface equation, never below the drop-cutter height plus the stock (see
+docs/roughing.md for the proof of its clearance).
+
 examples:
   lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-shape flat \\
-      --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc"""
+      --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc
+  lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-diameter 10 --stepdown 2 \\
+      --safe-z 90 --dialect fanuc --macro -o O1000.nc"""
 
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=("fanuc", "linuxcnc", "grbl"), default="fanuc", help="fanuc (default), linuxcnc or grbl")
+    p.add_argument("--macro", action="store_true",
+                   help="write a parametric macro (fanuc or linuxcnc): the control computes every height from the "
+                        "surface equation plus a proved clearance; a few kilobytes whatever the block")
+    p.add_argument("--precision", type=int, choices=(8, 15), metavar="N",
+                   help="with --macro: significant digits of the control's arithmetic, 8 or 15 "
+                        "(default 8 for fanuc, 15 for linuxcnc)")
     s = p.add_argument_group("stock")
     top = s.add_mutually_exclusive_group(required=True)
     top.add_argument("--stock-top", type=HEIGHT_MM, metavar="MM", help="machine Z of the block's top")
@@ -41,9 +54,13 @@ def add_arguments(p) -> None:
     r.add_argument("--stepover", type=_STEP_MM, metavar="MM", help="side step between rows (default half the tool)")
     r.add_argument("--step", type=_STEP_MM, default=0.5, metavar="MM", help="forward sampling step (default 0.5)")
     r.add_argument("--stock-to-leave", type=_DEPTH_MM, default=0.3, metavar="MM", help="material left above the surface (default 0.3)")
-    r.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
-    r.add_argument("--milling", choices=("zigzag", "climb", "conventional"), default="zigzag",
-                   help="zigzag (default, stays down), or one-way climb or conventional (retracts above the block)")
+    r.add_argument("--pattern", choices=("raster", "offset"), default="raster",
+                   help="clearing at each level: raster rows (default) or offset, concentric rectangles from the "
+                        "block's outline inwards")
+    r.add_argument("--direction", choices=DIRECTIONS, help="raster rows along x (default) or y")
+    r.add_argument("--milling", choices=("zigzag", "climb", "conventional"),
+                   help="raster: zigzag (default, stays down), or one-way climb or conventional (retracts above "
+                        "the block); offset: climb (default) or conventional")
     t = p.add_argument_group("cutter")
     t.add_argument("--tool-shape", default="flat", help="flat (default), ball or bull (bull nose: give --corner-radius)")
     t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
@@ -64,6 +81,7 @@ def add_arguments(p) -> None:
     m.add_argument("--safe-z", type=HEIGHT_MM, default=50.0, metavar="MM", help="retract height (default 50)")
     m.add_argument("--program", type=PROGRAM_NUMBER, default=1000, metavar="N", help="program number O N (default 1000)")
     add_max_points(p)
+    p.set_defaults(max_samples=None)  # None: the default limit, and --max-samples not given (refused with --macro)
 
 
 def job_data(args) -> dict:
@@ -79,9 +97,16 @@ def job_data(args) -> dict:
             tool[key] = getattr(args, key)
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
           "plunge_feed": args.plunge_feed, "coolant": args.coolant, "stepdown": args.stepdown, "step": args.step,
-          "stock_to_leave": args.stock_to_leave, "direction": args.direction, "milling": args.milling}
+          "stock_to_leave": args.stock_to_leave}
+    for key in ("pattern", "direction", "milling"):
+        if getattr(args, key) is not None:
+            op[key] = getattr(args, key)
     if args.stepover is not None:
         op["stepover"] = args.stepover
+    if args.macro:
+        op["macro"] = True
+    if args.precision is not None:
+        op["precision"] = args.precision
     return {"points": str(Path(args.file).resolve()), "dialect": args.dialect, "units": args.units,
             "scale": args.scale, "origin": list(origin(args.origin)), "safe_z": args.safe_z, "rapid": args.rapid,
             "program_number": args.program, "title": Path(args.file).name, "stock": stock,
@@ -99,12 +124,36 @@ def origin_list(text: str):
     return [in_range(v, f"--block {name}", -LENGTH_MM, LENGTH_MM, unit="mm") for name, v in zip(names, parts)]
 
 
+def _refuse(args) -> None:
+    """Options that do not apply with or without --macro, refused rather than ignored."""
+    from ..errors import InputError
+
+    if args.precision is not None and not args.macro:
+        raise InputError(f"--precision {args.precision} applies to a macro only: add --macro or leave it out")
+    if args.macro and args.dialect == "grbl":
+        raise InputError("--macro: a roughing macro is written for fanuc or linuxcnc, not grbl (no macro language)")
+    if args.pattern == "offset" and args.direction is not None:
+        raise InputError(f"--direction {args.direction} does not apply with --pattern offset (rectangles, no rows)")
+    if args.pattern == "offset" and args.milling == "zigzag":
+        raise InputError("--milling zigzag: --pattern offset cuts every rectangle one way, climb (default) or "
+                         "conventional")
+    if args.macro and args.pattern != "raster":
+        raise InputError(f"--pattern {args.pattern}: a roughing macro runs raster rows; leave out --macro "
+                         "for offset clearing")
+    if args.macro and args.max_samples is not None:
+        raise InputError(f"--max-samples {args.max_samples}: a roughing macro makes no drop-cutter samples; "
+                         "leave it out (--max-points limits the moves the control runs)")
+
+
 def run(args, out, err) -> int:
     from ..job import job_program, plan_job
     from ..job.spec import parse_job
+    from ..toolpath.rough import MAX_ROUGH_SAMPLES
     from .job import report
 
-    planned = plan_job(parse_job(job_data(args), "lagsym rough"), args.max_points, args.max_samples)
+    _refuse(args)
+    samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
+    planned = plan_job(parse_job(job_data(args), "lagsym rough"), args.max_points, samples)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")
@@ -112,5 +161,11 @@ def run(args, out, err) -> int:
         out.write(prog.text)
     rp = planned.operations[0].path
     err.write(f"{len(rp.levels_mm)} levels from Z{rp.levels_mm[0]:.3f} to Z{rp.levels_mm[-1]:.3f} mm\n")
+    if args.macro:
+        c = rp.clearance
+        err.write(f"macro: {len(prog.text.encode('ascii'))} bytes; tip at min(F + stock + {rp.tool.radius_mm:g} "
+                  f"|grad F| + A, B) over {c.tiles}x{c.tiles} tiles: A {c.a_mm.min():.3f} to {c.a_mm.max():.3f} mm "
+                  f"(curvature up to {c.curvature_per_mm.max():.4f}/mm), B the surface's bound plus "
+                  f"{c.chord_mm.min() + c.extra_mm:.3f} to {c.chord_mm.max() + c.extra_mm:.3f} mm\n")
     report(planned, prog, err)
     return 0

@@ -19,6 +19,8 @@ from ..evaluate import surface_evaluator
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec
+from ..macro import DEFAULT_PRECISION
+from ..macro.roughing import rough_macro
 from ..toolpath import plan_toolpath
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
@@ -114,8 +116,16 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
                        step_mm=o.get("step", 0.5), stock_to_leave_mm=o.get("stock_to_leave", 0.3),
-                       direction=o.get("direction", "x"), milling=o.get("milling", "zigzag"),
+                       direction=o.get("direction", "x"), pattern=o.get("pattern", "raster"),
+                       milling=o.get("milling", "climb" if o.get("pattern") == "offset" else "zigzag"),
                        flute_length_mm=tool.flute_length_mm, reach_mm=tool.reach_mm)
+        if o.get("macro"):
+            precision = o.get("precision", DEFAULT_PRECISION[spec.dialect])
+            rm = rough_macro(surface, tool.tool, stock, rs, _settings(spec, op), precision=precision, evaluator=ev,
+                             max_points=limits[0])
+            kinds = np.full(len(rm.points_mm), FEED, dtype=np.int8)
+            kinds[0] = PLUNGE
+            return Operation(op, tool, rm.points_mm, kinds, rm)
         rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev, *limits)
         return Operation(op, tool, rp.points_mm, rp.kinds, rp)
     default_dir = "y" if op.kind == "cross-finish" else "x"

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..machine import MachineSettings
+from ..macro.roughing import RoughMacro, rough_macro_blocks
 from ..post.model import iso_comment, units_word
 from ..post.moves import format_moves
 from ..gcode.numbers import fixed
@@ -87,7 +88,8 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
     out.append(_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM", spec.dialect))
     for i, (op, m) in enumerate(zip(job.operations, minutes), 1):
         t = op.tool
-        out.append(_comment(f"{i} {op.spec.kind} T{t.number} {t.tool.label} {m:.1f} MIN", spec.dialect))
+        kind = op.spec.kind + (" MACRO" if isinstance(op.path, RoughMacro) else "")
+        out.append(_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN", spec.dialect))
     out.append(_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN",
                         spec.dialect))
     out.append(f"{units_word(s)} G17 G90 G94" if spec.dialect == "grbl" else f"{units_word(s)} G17 G40 G49 G80 G90 G94")
@@ -112,7 +114,10 @@ def _operation(op, s: MachineSettings, spec, changed: bool) -> list[str]:
         out.append(coolant)
     out.append(f"G00 X{num(p[0, 0])} Y{num(p[0, 1])}")
     out.append(f"G00 Z{num(spec.safe_z_mm)}" if spec.dialect == "grbl" else f"G43 H{t.number} Z{num(spec.safe_z_mm)}")
-    out += _moves(op, s, (p[0, 0], p[0, 1], spec.safe_z_mm))
+    if isinstance(op.path, RoughMacro):
+        out += rough_macro_blocks(op.path, s)
+    else:
+        out += _moves(op, s, (p[0, 0], p[0, 1], spec.safe_z_mm))
     out.append(f"G00 Z{num(spec.safe_z_mm)}")
     if coolant:
         out.append("M09")

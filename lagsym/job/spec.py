@@ -32,7 +32,7 @@ from pathlib import Path
 from ..errors import InputError, LagsymError
 from ..io.files import read_bytes
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
-from ..toolpath.rough import MILLING
+from ..toolpath.rough import MILLING, PATTERNS
 from ..values import in_range
 
 __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KINDS", "COOLANTS"]
@@ -50,7 +50,8 @@ _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float,
          "reach": float}
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
-       "stock_to_leave": float, "direction": str, "milling": str}
+       "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
+       "pattern": str}
 _REQUIRED_OP = ("kind", "tool")
 
 
@@ -123,12 +124,15 @@ def _keys(table: dict, allowed: dict, where: str, source: str) -> dict:
     return table
 
 
-_NAMES = {float: "a number", int: "a whole number", str: "a string", list: "a list", dict: "a table"}
+_NAMES = {float: "a number", int: "a whole number", str: "a string", list: "a list", dict: "a table",
+          bool: "true or false"}
+MACRO_DIALECTS = ("fanuc", "linuxcnc")  # of the job's dialects, those with a macro language
+PRECISIONS = (8, 15)
 
 
 def _choice(value, options, key: str, source: str):
     if value not in options:
-        raise InputError(f"{source}: {key} = {value!r} is not one of {', '.join(options)}")
+        raise InputError(f"{source}: {key} = {value!r} is not one of {', '.join(str(o) for o in options)}")
     return value
 
 
@@ -180,6 +184,11 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         if ranks[i] < ranks[i - 1]:
             raise InputError(f"{source}: operations[{i}] ({ops[i].kind}) comes after {ops[i - 1].kind}; "
                              f"run them in the order {', '.join(KINDS)}")
+    dialect = data.get("dialect", "fanuc")
+    for i, op in enumerate(ops):
+        if op.options.get("macro") and dialect not in MACRO_DIALECTS:
+            raise InputError(f"{source}: operations[{i}].macro: a roughing macro is written for "
+                             f"{' or '.join(MACRO_DIALECTS)}, not {dialect!r}")
     program_number = data.get("program_number", 1000)
     if not 1 <= program_number <= 9999:
         raise InputError(f"{source}: program_number = {program_number} must be 1 to 9999")
@@ -245,7 +254,8 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
             raise InputError(f"{source}: missing key {where}{key}")
     kind = _choice(table["kind"], KINDS, where + "kind", source)
     _choice(table["tool"], tuple(tools), where + "tool", source)
-    allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling"} if kind == "rough" else \
+    allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling", "macro",
+               "precision", "pattern"} if kind == "rough" else \
         {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction"}
     opts = {}
     for key, value in table.items():
@@ -258,8 +268,24 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
             opts[key] = _choice(value, DIRECTIONS, where + key, source)
         elif key == "milling":
             opts[key] = _choice(value, MILLING, where + key, source)
+        elif key == "macro":
+            opts[key] = value
+        elif key == "pattern":
+            opts[key] = _choice(value, PATTERNS, where + key, source)
+        elif key == "precision":
+            opts[key] = _choice(value, PRECISIONS, where + key, source)
         else:
             opts[key] = _positive(value, where + key, source, allow_zero=key == "stock_to_leave")
+    if opts.get("pattern") == "offset":
+        for key, why in (("direction", "offset clearing has no row direction"),
+                         ("macro", "a roughing macro runs raster rows")):
+            if key in opts and (key != "macro" or opts[key]):
+                raise InputError(f"{source}: {where}{key} does not apply with pattern = 'offset': {why}")
+        if opts.get("milling") == "zigzag":
+            raise InputError(f"{source}: {where}milling = 'zigzag': offset clearing cuts every rectangle one way, "
+                             "climb or conventional")
+    if "precision" in opts and not opts.get("macro"):
+        raise InputError(f"{source}: {where}precision applies to a roughing macro only (macro = true)")
     return OperationSpec(
         kind=kind, tool=table["tool"],
         spindle_rpm=_positive(table.get("spindle", 3000.0), where + "spindle", source),

@@ -14,7 +14,8 @@ does not depend on the step.  The modules, in the order data flows through them:
 - :mod:`.accuracy`: the control's arithmetic error, predicted;
 - :mod:`.fanuc`, :mod:`.linuxcnc`, :mod:`.heidenhain`: one renderer a dialect;
 - :mod:`.program`: :func:`macro_program`, the one entry point;
-- :mod:`.stats`: the size comparison with a point list.
+- :mod:`.stats`: the size comparison with a point list;
+- :mod:`.roughing`, :mod:`.clearance`: the roughing macro (:func:`rough_macro`) and the proof of its clearance.
 
 :mod:`lagsym.simulate` dry-runs the result.
 """
@@ -25,10 +26,16 @@ from .form import FORMS, RowForm, row_form
 from .loops import MacroLoops, macro_loops
 from .points import planned_points, points_at
 from .program import DEFAULT_PRECISION, MACRO_DIALECTS, PRECISIONS, MacroProgram, macro_program
+from .clearance import Clearance
+from .roughing import RoughMacro, rough_macro, rough_macro_program
 from .raster import MacroRaster, macro_raster, raster_positions, sample_positions
 from .stats import ProgramStats, point_list_size, program_stats, transfer_seconds
 
 __all__ = [
+    "Clearance",
+    "RoughMacro",
+    "rough_macro",
+    "rough_macro_program",
     "DEFAULT_PRECISION",
     "FORMS",
     "MACRO_DIALECTS",

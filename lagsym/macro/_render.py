@@ -9,7 +9,7 @@ from ..gcode.limits import check_axis, check_blocks, check_settings
 from ..gcode.numbers import fixed
 from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
-from .model import Const, Op, Round, Sqrt, Var, variables, written
+from .model import Const, Item, Op, Round, Sqrt, Var, variables, written
 
 __all__ = ["number_variables", "expression", "literal", "iso_start", "iso_end", "header_comments", "check_text"]
 
@@ -104,6 +104,8 @@ def expression(e, name, precision: int) -> str:
         return f"SQRT[{_inner(e.a, name, precision)}]"
     if isinstance(e, Round):
         return f"ROUND[{_inner(e.a, name, precision)}]"
+    if isinstance(e, Item):
+        return f"#[{name(e.index)}]"
     return f"[{_chain(e, name, precision)}]"
 
 

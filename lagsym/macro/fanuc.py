@@ -13,15 +13,15 @@ from __future__ import annotations
 from ..errors import ProgramError
 from ..gcode.limits import variable_ranges
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal, number_variables
-from .model import Assign, Clamp, Loop, Move
+from .model import Assign, Choose, Clamp, Loop, Move, SetItem
 
-__all__ = ["render", "DEFAULT_BASE"]
+__all__ = ["render", "body_lines", "DEFAULT_BASE"]
 
 DEFAULT_BASE = 100
 
 
-def render(loops, settings, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> str:
-    """The Fanuc macro program for ``loops`` (a :class:`~lagsym.macro.loops.MacroLoops`) as text with the settings' line endings."""
+def body_lines(loops, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> list[str]:
+    """The blocks of the loops alone (no header, approach or end), for a program that frames them itself."""
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
     number = number_variables(loops.body, base, variable_ranges("fanuc", variables))
 
@@ -31,10 +31,7 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
     def expr(e):
         return expression(e, name, precision)
 
-    out = ["%", f"O{settings.program_number:04d} (LAGSYM SURFACE MACRO)"]
-    out += [f"({c})" for c in header_comments(loops, settings, precision)]
-    out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90")
-    out += iso_start(loops, settings, ("M6", "M3"))
+    out: list[str] = []
 
     def emit(stmts, depth):
         for s in stmts:
@@ -43,6 +40,10 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
             elif isinstance(s, Clamp):
                 lim = literal(s.limit.value, precision)
                 out.append(f"IF [{name(s.target)} GT {lim}] THEN {name(s.target)}={lim}")
+            elif isinstance(s, SetItem):
+                out.append(f"#{s.number}={literal(s.value.value, precision)}")
+            elif isinstance(s, Choose):
+                out.append(f"IF [{name(s.test)} {s.op} {expr(s.limit)}] THEN {name(s.target)}={expr(s.value)}")
             elif isinstance(s, Loop):
                 if depth >= 3:
                     raise ProgramError("a Fanuc macro nests at most 3 WHILE loops")
@@ -56,6 +57,16 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
                 out.append(f"G1 X{name(s.x)} Y{name(s.y)} Z{name(s.z)}")
 
     emit(loops.body, 0)
+    return out
+
+
+def render(loops, settings, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> str:
+    """The Fanuc macro program for ``loops`` (a :class:`~lagsym.macro.loops.MacroLoops`) as text with the settings' line endings."""
+    out = ["%", f"O{settings.program_number:04d} ({loops.title})"]
+    out += [f"({c})" for c in header_comments(loops, settings, precision)]
+    out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90")
+    out += iso_start(loops, settings, ("M6", "M3"))
+    out += body_lines(loops, precision, variable_base, variables)
     out += iso_end(settings, "M30") + ["%"]
     check_text(out, settings)
     return settings.eol.join(out) + settings.eol

@@ -13,7 +13,7 @@ from ..errors import ProgramError
 from ..gcode.limits import check_axis, check_blocks, check_settings, variable_ranges
 from ..gcode.numbers import fixed
 from ._render import header_comments, literal, number_variables
-from .model import Assign, Clamp, Const, Loop, Move, Op, Sqrt, Var
+from .model import Assign, Choose, Clamp, Const, Loop, Move, Op, Sqrt, Var
 from .model import variables as variables_of
 
 __all__ = ["render", "DEFAULT_BASE", "MAX_LABEL"]
@@ -93,6 +93,14 @@ class _Blocks:
                 lim = self.operand(s.limit)
                 out.extend([f"FN 12: IF +{q(s.target)} LT {lim} GOTO LBL {n}",
                             f"FN 0: {q(s.target)} = {lim}", f"LBL {n}"])
+            elif isinstance(s, Choose):
+                # Skip the assignment unless test OP limit: jump on the opposite relation and on equality.
+                n = self.label()
+                t, lim = "+" + q(s.test), self.operand(s.limit)
+                other = "FN 12: IF {} LT {}" if s.op == "GT" else "FN 11: IF {} GT {}"
+                out.extend([other.format(t, lim) + f" GOTO LBL {n}", f"FN 9: IF {t} EQU {lim} GOTO LBL {n}"])
+                self.assign(s.target, s.value)
+                out.append(f"LBL {n}")
             elif isinstance(s, Loop):
                 n = self.label()
                 c = q(s.counter)
@@ -121,7 +129,7 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
         return _signed(fixed(v, dp))
 
     safe = pos(settings.safe_z_mm * uf)
-    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}", "; LAGSYM SURFACE MACRO"]
+    out: list[str] = [f"BEGIN PGM {settings.program_number} {unit}", f"; {loops.title}"]
     out += [f"; {c}" for c in header_comments(loops, settings, precision)]
     out += [f"TOOL CALL {settings.tool_number} Z S{int(round(settings.spindle_rpm))}",
             f"L Z{safe} R0 FMAX M3"]

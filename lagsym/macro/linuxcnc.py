@@ -8,25 +8,20 @@ from __future__ import annotations
 
 from ..errors import ProgramError
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal
-from .model import Assign, Clamp, Loop, Move
+from .model import Assign, Choose, Clamp, Loop, Move, SetItem
 
-__all__ = ["render"]
+__all__ = ["render", "body_lines"]
 
 
-def render(loops, settings, precision: int = 15, variable_base: int | None = None, variables: str = "full") -> str:
-    """The LinuxCNC program for ``loops``: named parameters, so neither a variable base nor a profile applies."""
-    if variable_base is not None or variables != "full":
-        raise ProgramError("a LinuxCNC macro uses named parameters: leave out the variable base and profile")
+def body_lines(loops, precision: int = 15) -> list[str]:
+    """The blocks of the loops alone (no header, approach or end), for a program that frames them itself."""
     def name(v):
         return f"#<{v.name}>"
 
     def expr(e):
         return expression(e, name, precision)
 
-    out = ["%", f"(LAGSYM SURFACE MACRO PROGRAM {settings.program_number})"]
-    out += [f"({c})" for c in header_comments(loops, settings, precision)]
-    out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90 G64 P0.001")
-    out += iso_start(loops, settings, ("M6", "M3"))
+    out: list[str] = []
     labels = iter(range(100, 10000))
 
     def emit(stmts, indent):
@@ -39,6 +34,12 @@ def render(loops, settings, precision: int = 15, variable_base: int | None = Non
                 lim = literal(s.limit.value, precision)
                 out.extend([f"{pad}o{n} if [{name(s.target)} GT {lim}]",
                             f"{pad}  {name(s.target)} = {lim}", f"{pad}o{n} endif"])
+            elif isinstance(s, SetItem):
+                out.append(f"{pad}#{s.number} = {literal(s.value.value, precision)}")
+            elif isinstance(s, Choose):
+                n = next(labels)
+                out.extend([f"{pad}o{n} if [{name(s.test)} {s.op} {expr(s.limit)}]",
+                            f"{pad}  {name(s.target)} = {expr(s.value)}", f"{pad}o{n} endif"])
             elif isinstance(s, Loop):
                 n = next(labels)
                 c = name(s.counter)
@@ -51,6 +52,18 @@ def render(loops, settings, precision: int = 15, variable_base: int | None = Non
                 out.append(f"{pad}G1 X{name(s.x)} Y{name(s.y)} Z{name(s.z)}")
 
     emit(loops.body, 0)
+    return out
+
+
+def render(loops, settings, precision: int = 15, variable_base: int | None = None, variables: str = "full") -> str:
+    """The LinuxCNC program for ``loops``: named parameters, so neither a variable base nor a profile applies."""
+    if variable_base is not None or variables != "full":
+        raise ProgramError("a LinuxCNC macro uses named parameters: leave out the variable base and profile")
+    out = ["%", f"({loops.title} PROGRAM {settings.program_number})"]
+    out += [f"({c})" for c in header_comments(loops, settings, precision)]
+    out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90 G64 P0.001")
+    out += iso_start(loops, settings, ("M6", "M3"))
+    out += body_lines(loops, precision)
     out += iso_end(settings, "M2") + ["%"]
     check_text(out, settings)
     return settings.eol.join(out) + settings.eol

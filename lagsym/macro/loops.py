@@ -71,6 +71,8 @@ class MacroLoops:
     resolution, tip_lift : Fraction
         The unit positions are rounded to on the control (0: not rounded), and
         what a rounded tip's height is raised by.
+    title : str
+        The program's name in its first comment.
     """
 
     body: tuple
@@ -85,6 +87,7 @@ class MacroLoops:
     ball_offset: float = 0.0
     resolution: Fraction = Fraction(0)
     tip_lift: Fraction = Fraction(0)
+    title: str = "LAGSYM SURFACE MACRO"
 
     def reference(self, p: Fraction, r: Fraction) -> tuple:
         """The point (P, R, Z) the program should reach at raster position (p, r), computed on the PC.

@@ -17,7 +17,9 @@ from typing import Union
 
 from ..errors import ProgramError
 
-__all__ = ["Var", "Const", "Op", "Sqrt", "Round", "div", "sqrt", "round_", "Assign", "Clamp", "Loop", "Move", "Expr", "Statement",
+__all__ = ["Var", "Const", "Op", "Sqrt", "Round", "div", "sqrt", "round_", "Assign", "Clamp", "Choose", "Item", "SetItem",
+           "Loop", "Move",
+           "Expr", "Statement",
            "var", "const", "add", "sub", "mul", "decimal_context", "run", "variables", "written"]
 
 
@@ -58,7 +60,14 @@ class Round:
     a: "Expr"
 
 
-Expr = Union[Var, Const, Op, Sqrt, Round]
+@dataclass(frozen=True)
+class Item:
+    """The numbered variable whose number is the value of ``index`` (``#[#idx]``): a table's entry."""
+
+    index: Var
+
+
+Expr = Union[Var, Const, Op, Sqrt, Round, Item]
 
 
 @dataclass(frozen=True)
@@ -75,6 +84,32 @@ class Clamp:
 
     target: Var
     limit: Const
+
+
+@dataclass(frozen=True)
+class SetItem:
+    """``#number = value``: one entry of a table the program reads with :class:`Item`."""
+
+    number: int
+    value: Const
+
+
+@dataclass(frozen=True)
+class Choose:
+    """``if test OP limit: target = value``, ``OP`` ``LT`` or ``GT``: a lower clamp, a maximum, a row's ends.
+
+    ``test`` is a variable; ``limit`` and ``value`` a variable or a constant.
+    """
+
+    target: Var
+    test: Var
+    op: str
+    limit: "Expr"
+    value: "Expr"
+
+    def __post_init__(self):
+        if self.op not in ("LT", "GT"):
+            raise ValueError(f"Choose compares with LT or GT, not {self.op!r}")
 
 
 @dataclass(frozen=True)
@@ -95,7 +130,7 @@ class Move:
     z: Var
 
 
-Statement = Union[Assign, Clamp, Loop, Move]
+Statement = Union[Assign, Clamp, Choose, SetItem, Loop, Move]
 
 
 def var(name: str) -> Var:
@@ -200,6 +235,10 @@ def run(statements, env: dict, ctx: Context) -> dict:
             limit = _constant(s.limit.value, ctx)
             if env[s.target.name] > limit:
                 env[s.target.name] = limit
+        elif isinstance(s, Choose):
+            t, lim = env[s.test.name], _eval(s.limit, env, ctx)
+            if (t < lim) if s.op == "LT" else (t > lim):
+                env[s.target.name] = _eval(s.value, env, ctx)
         else:
             raise TypeError(f"run() executes straight-line code only, not {type(s).__name__}")
     return env
@@ -215,7 +254,7 @@ def variables(statements) -> list[str]:
 
     def walk(stmts):
         for s in stmts:
-            if isinstance(s, (Assign, Clamp)):
+            if isinstance(s, (Assign, Clamp, Choose)):
                 see(s.target)
             elif isinstance(s, Loop):
                 see(s.counter)

@@ -46,16 +46,15 @@ from .chordal import check_moves, crosses_box_edge, lift
 from .dropcutter import drop_cutter
 from .pattern import levels as spaced
 from .plan import MAX_PLAN_POINTS
+from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
 
-__all__ = ["Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
-           "MAX_ROUGH_SAMPLES"]
+__all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
+           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points"]
 
 MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (about 1 ms each): minutes at most
 
 MILLING = ("zigzag", "climb", "conventional")
 _SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
-FEED, RAPID, PLUNGE = 0, 1, 2
-"""How the tool moves into a point: at the cutting feed, at rapid, or at the plunge feed."""
 
 
 @dataclass(frozen=True)
@@ -93,7 +92,9 @@ class RoughSpec:
 
     ``milling`` is ``zigzag`` (both directions, the tool stays down),
     ``climb`` or ``conventional`` (one way, for a spindle turning clockwise,
-    M03).  ``flute_length_mm`` and ``reach_mm`` (length below the holder),
+    M03).  ``pattern`` is ``raster`` (rows along ``direction``) or ``offset``
+    (concentric rectangles from the block's outline inwards, one way:
+    climb or conventional; ``direction`` does not apply).  ``flute_length_mm`` and ``reach_mm`` (length below the holder),
     when given, are checked against the step-down and the depth of the cut.
     """
 
@@ -106,6 +107,7 @@ class RoughSpec:
     clearance_mm: float = 2.0
     flute_length_mm: float | None = None
     reach_mm: float | None = None
+    pattern: str = "raster"
 
     def __post_init__(self):
         for name in ("stepdown_mm", "stepover_mm", "step_mm", "clearance_mm"):
@@ -113,6 +115,10 @@ class RoughSpec:
         positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
         choice(self.direction, DIRECTIONS, "raster direction")
         choice(self.milling, MILLING, "milling")
+        choice(self.pattern, PATTERNS, "clearing pattern")
+        if self.pattern == "offset" and self.milling == "zigzag":
+            raise ToolpathError("offset clearing cuts every rectangle one way: milling climb or conventional, "
+                                "not zigzag")
         for name in ("flute_length_mm", "reach_mm"):
             if getattr(self, name) is not None:
                 positive(getattr(self, name), name[:-3].replace("_", " "))
@@ -191,35 +197,55 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     >>> bool((rp.points_mm[:, 2] >= rp.floor_mm).all()), round(float(rp.points_mm[:, 2].min()), 6)
     (True, 1.5)
     """
+    ev = evaluator or surface_evaluator(surface)
+    place = settings.placement
+    box = place.box_mm(ev.bounds)
+    check_rough_request(tool, stock, spec, ev, place, max_samples, "--max-samples")
+    sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
+    if spec.pattern == "offset":
+        x, y = offset_line(stock, box, tool.radius_mm, spec)
+        floors = floor_at(surface, ev, place, tool, box, [x], [y], spec.stock_to_leave_mm)
+
+        def cl(px, py, **search):
+            return floor_at(surface, ev, place, tool, box, [np.asarray(px, float)], [np.asarray(py, float)],
+                            spec.stock_to_leave_mm, **search)[0]
+
+        x, y, floor, up = checked_line(cl, x, y, floors[0], box, tool.radius_mm, sigma)
+        floors, lifts = [floor], [up]
+    else:
+        rows = _rows(stock, box, tool.radius_mm, spec)
+        rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev,
+                                       place, tool, box, spec, sigma)
+    reachable = np.concatenate([f for f in floors])
+    low = float(reachable[np.isfinite(reachable)].min()) + sigma
+    count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
+    check_points(stock, tool, spec, count, max_points, "--max-points")
+    z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
+    depth = stock.top_mm - float(z_levels[-1])
+    if spec.reach_mm is not None and depth > spec.reach_mm:
+        raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
+                            f"the tool reaches {spec.reach_mm:g} mm below its holder")
+    if spec.pattern == "offset":
+        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock, spec)
+    else:
+        pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec)
+    return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place,
+                        max_points: int | None, option: str) -> None:
+    """What every roughing refuses before any work: the cutter, the side step, the block, one level's size."""
     choice(tool.shape, TOOL_SHAPES, "tool shape")
     if tool.diameter_mm <= 0:
         raise ToolpathError("roughing needs a cutter with a diameter above 0")
     if spec.stepover_mm > tool.diameter_mm:
         raise ToolpathError(f"side step {spec.stepover_mm:g} mm is wider than the tool ({tool.diameter_mm:g} mm): "
                             "ridges would stand between the rows")
-    ev = evaluator or surface_evaluator(surface)
-    place = settings.placement
-    box = place.box_mm(ev.bounds)
-    _check_stock(stock, box, ev, place)
-    _check_points(stock, tool, spec, 1, max_samples, "--max-samples")
-    rows = _rows(stock, box, tool.radius_mm, spec)
-    sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
-    rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev, place,
-                                   tool, box, spec, sigma)
-    reachable = np.concatenate([f for f in floors])
-    low = float(reachable[np.isfinite(reachable)].min()) + sigma
-    count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
-    _check_points(stock, tool, spec, count, max_points, "--max-points")
-    z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
-    depth = stock.top_mm - float(z_levels[-1])
-    if spec.reach_mm is not None and depth > spec.reach_mm:
-        raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
-                            f"the tool reaches {spec.reach_mm:g} mm below its holder")
-    pts, kinds, floor = _assemble(rows, floors, lifts, z_levels, stock, spec)
-    return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+    _check_stock(stock, place.box_mm(ev.bounds), ev, place)
+    check_points(stock, tool, spec, 1, max_points, option)
 
 
-def _check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
+def check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
                   option: str) -> None:
     """Refuse a path of more than ``max_points`` (rows times samples per row, times ``levels``) before making it."""
     if max_points is None:
@@ -269,23 +295,10 @@ def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
     along_x = spec.direction == "x"
     c0, c1 = (stock.y0, stock.y1) if along_x else (stock.x0, stock.x1)
     a0, a1 = (stock.x0, stock.x1) if along_x else (stock.y0, stock.y1)
-    b_a0, b_a1, b_c0, b_c1 = (box[0], box[1], box[2], box[3]) if along_x else (box[2], box[3], box[0], box[1])
+    b_along, b_cross = (box[:2], box[2:]) if along_x else (box[2:], box[:2])
     out = spec.clearance_mm + radius
-    base = spaced(a0 - out, a1 + out, spec.step_mm)
-    rows = []
-    for c in spaced(c0, c1, spec.stepover_mm):
-        gap = max(b_c0 - c, c - b_c1, 0.0)
-        # Where the disc under the tool starts to meet a box edge or corner, the height may bend down sharply.
-        extra = [b_a0, b_a1, b_a0 + radius, b_a1 - radius]
-        for edge_gap in (abs(c - b_c0), abs(c - b_c1)):
-            if edge_gap <= radius:
-                w = math.sqrt(radius * radius - edge_gap * edge_gap)
-                extra += [b_a0 + w, b_a1 - w]
-        if gap <= radius:
-            w = math.sqrt(radius * radius - gap * gap)
-            extra += [b_a0 - w, b_a1 + w]
-        rows.append(_Row(float(c), np.unique(np.concatenate([base, extra]))))
-    return rows
+    return [_Row(float(c), along_samples(a0 - out, a1 + out, float(c), b_along, b_cross, radius, spec.step_mm))
+            for c in spaced(c0, c1, spec.stepover_mm)]
 
 
 def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec) -> list[np.ndarray]:
@@ -319,6 +332,26 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **sea
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 
 
+def checked_line(cl, vx, vy, f, box, radius: float, sigma: float):
+    """One polyline's samples checked where the tool meets a box edge (see :func:`_checked`).
+
+    Returns the points (the check's own added), their floors and their lifts.
+    """
+    live = np.isfinite(f)
+    dense = crosses_box_edge(vx, vy, box, radius) & live[:-1] & live[1:]
+    vz = np.where(live, f, 0.0) + sigma
+    zeros = np.zeros(len(f) - 1)
+    nx, ny, nz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, zeros.copy(), dense, _SPLIT_TOL_MM,
+                                     radius)
+    floor = nz.copy()  # a point the check added has its floor there, without sigma
+    k = 0
+    for i in range(len(nx)):  # the first points are a subsequence of the checked ones
+        if k < len(vx) and nx[i] == vx[k] and ny[i] == vy[k]:
+            floor[i] = f[k]
+            k += 1
+    return nx, ny, floor, sigma + lift(sag)
+
+
 def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float):
     """Rows whose moves are checked against the true floor where the tool meets a box edge, and each sample's lift.
 
@@ -344,81 +377,8 @@ def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec,
     for r, f in zip(rows, floors):
         cross = np.full(len(r.along), r.cross)
         vx, vy = (r.along, cross) if along_x else (cross, r.along)
-        live = np.isfinite(f)
-        dense = crosses_box_edge(vx, vy, box, tool.radius_mm) & live[:-1] & live[1:]
-        vz = np.where(live, f, 0.0) + sigma
-        zeros = np.zeros(len(f) - 1)
-        vx, vy, vz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, zeros.copy(), dense,
-                                         _SPLIT_TOL_MM, tool.radius_mm)
-        along = vx if along_x else vy
-        floor = vz.copy()  # a point the check added has its floor there, without sigma
-        floor[np.isin(along, r.along)] = f
-        out_rows.append(_Row(r.cross, along))
+        vx, vy, floor, up = checked_line(cl, vx, vy, f, box, tool.radius_mm, sigma)
+        out_rows.append(_Row(r.cross, vx if along_x else vy))
         out_floors.append(floor)
-        lifts.append(sigma + lift(sag))
+        lifts.append(up)
     return out_rows, out_floors, lifts
-
-
-def _climb_forward(direction: str, progress: int) -> bool:
-    """Whether a row cut forwards (along increasing coordinates) is climb milling, rows advancing by ``progress``.
-
-    With the spindle turning clockwise, climb milling keeps the uncut
-    material on the right of the direction of travel.
-    """
-    return progress < 0 if direction == "x" else progress > 0
-
-
-def _kept(z: np.ndarray) -> np.ndarray:
-    """Indices of a row's samples to emit: the middle of three samples at one height is on a straight move."""
-    flat = np.zeros(len(z), dtype=bool)
-    flat[1:-1] = (z[1:-1] == z[:-2]) & (z[1:-1] == z[2:])
-    return np.flatnonzero(~flat)
-
-
-def _assemble(rows, floors, lifts, z_levels, stock: Stock, spec: RoughSpec):
-    """The moves level by level: rows, links outside the block, and retracts above it for a one-way raster.
-
-    Long because the three kinds of link (along a row end, down between
-    levels, back above the block) are decided here together with the row
-    directions they depend on.
-    """
-    along_x = spec.direction == "x"
-    top = stock.top_mm + spec.clearance_mm
-    pts, kinds, floor = [], [], []
-
-    def add(a, c, z, kind, f=-np.inf):
-        pts.append((a, c, z) if along_x else (c, a, z))
-        kinds.append(kind)
-        floor.append(f)
-
-    toggle = 0
-    for k, zl in enumerate(z_levels):
-        order = range(len(rows)) if k % 2 == 0 else range(len(rows) - 1, -1, -1)
-        progress = 1 if k % 2 == 0 else -1
-        for i in order:
-            r, f, up = rows[i], floors[i], lifts[i]
-            if spec.milling == "zigzag":
-                fwd = toggle % 2 == 0
-                toggle += 1
-            else:
-                fwd = _climb_forward(spec.direction, progress) == (spec.milling == "climb")
-            a, ff, uu = (r.along, f, up) if fwd else (r.along[::-1], f[::-1], up[::-1])
-            z = np.maximum(zl, ff + uu)
-            if not pts:
-                add(a[0], r.cross, top, RAPID)
-                add(a[0], r.cross, float(z[0]), PLUNGE)
-            elif spec.milling == "zigzag":
-                # The row ends lie outside the block by the tool radius and the clearance: clear at any height.
-                add(a[0], r.cross, float(z[0]), PLUNGE if pts[-1][2] > z[0] else FEED)
-            else:
-                last = pts[-1]
-                add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
-                add(a[0], r.cross, top, RAPID)
-                if zl + spec.clearance_mm < top:
-                    add(a[0], r.cross, zl + spec.clearance_mm, RAPID)
-                add(a[0], r.cross, float(z[0]), PLUNGE)
-            for j in _kept(z)[1:]:
-                add(float(a[j]), r.cross, float(z[j]), FEED, float(ff[j]))
-    last = pts[-1]
-    add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
-    return pts, kinds, floor
