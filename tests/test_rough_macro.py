@@ -8,11 +8,14 @@ exact height, so a tip found below it plus the stock is a real gouge.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from test_rough import EX4, exact_heights, moves, sweep_flat
 
+from lagsym.errors import ToolpathError
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
 from lagsym.machine import MachineSettings, Tool
@@ -236,3 +239,20 @@ def test_inch_rows_along_y_with_an_origin_run_as_planned(dialect, precision):
     assert np.abs(pts[1:] - rm.points_mm).max() <= 1e-4
     rows = rm.points_mm[:, 0]
     assert len(np.unique(rows)) < len(np.unique(rm.points_mm[:, 1]))  # rows along y: few X, many Y
+
+
+def test_a_safe_z_below_the_highest_tip_the_control_moves_to_is_refused():
+    # The clearance lifts the tip above the block on steep flanks; the highest feed move the simulated
+    # control makes, plus the feed height, is the lowest safe Z the macro may retract to and approach from.
+    surface, settings, tool, spec, stock, rm, text = plan(stepdown=30.0, step=2.0, stepover=10.0)
+    highest = float(simulate(text, "fanuc", 8).feed_points()[:, 2].max())
+    assert highest > stock.top_mm  # above the block (74.78 against 73.6 mm here)
+    need = highest + settings.feed_height_mm
+    for safe, ok in ((need - 0.01, False), (need + 0.01, True)):
+        low = dataclasses.replace(settings, safe_z_mm=safe)
+        if ok:
+            rough_macro(surface, tool, stock, spec, low, precision=8)
+            continue
+        with pytest.raises(ToolpathError, match=r"safe Z .* less than the feed height 2 mm above the highest tip "
+                                                r"of the roughing macro .*: raise --safe-z to at least"):
+            rough_macro(surface, tool, stock, spec, low, precision=8)

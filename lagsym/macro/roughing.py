@@ -322,6 +322,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
                       for k, t in enumerate((a, b)) for ir in range(tiles) for ip in range(tiles))
     body, row_code, point_code = _statements(rf, lay, radius, tables, top, sd, low, count, spec.direction)
     path = _path(rows, pts, tip, levels, spec.direction)
+    _check_safe_z(float(path[:, 2].max()), settings)
     start = tuple(Fraction(repr(float(v))) * per_mm for v in path[0])
     raster = MacroRaster(spec.direction, rows=Axis("Y" if spec.direction == "x" else "X", lay.c0, lay.c1, lay.dr,
                                                    lay.nr),
@@ -329,6 +330,20 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     loops = MacroLoops(body=setup + body, raster=raster, form=rf, start=start, row_code=row_code,
                        point_code=point_code, title="LAGSYM ROUGHING MACRO")
     return RoughMacro(loops, clear, levels, path, precision, tool, stock, spec)
+
+
+def _check_safe_z(highest_mm: float, settings: MachineSettings) -> None:
+    """Refuse a safe Z below the feed height over the highest tip the loops move to.
+
+    The clearance can lift the tip above the block on a steep flank; the
+    retract at the end and every approach go straight down or up there.
+    """
+    need = highest_mm + settings.feed_height_mm
+    if settings.safe_z_mm < need - 1e-9:
+        raise ToolpathError(f"safe Z {settings.safe_z_mm:g} mm is less than the feed height "
+                            f"{settings.feed_height_mm:g} mm above the highest tip of the roughing macro "
+                            f"{highest_mm:.3f} mm (its clearance lifts the tool above the surface on steep flanks): "
+                            f"raise --safe-z to at least {need:.3f} mm")
 
 
 def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, a, b, per_mm: Fraction, direction: str):
