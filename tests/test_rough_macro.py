@@ -246,7 +246,9 @@ def test_a_safe_z_below_the_highest_tip_the_control_moves_to_is_refused():
     # control makes, plus the feed height, is the lowest safe Z the macro may retract to and approach from.
     surface, settings, tool, spec, stock, rm, text = plan(stepdown=30.0, step=2.0, stepover=10.0)
     highest = float(simulate(text, "fanuc", 8).feed_points()[:, 2].max())
-    assert highest > stock.top_mm  # above the block (74.78 against 73.6 mm here)
+    assert highest > stock.top_mm  # above the block, as docs/roughing.md says
+    doc = " ".join((EX4.parent.parent / "docs" / "roughing.md").read_text().split())
+    assert f"(to {highest:.2f} mm over a {stock.top_mm:.1f} mm block top at a 30 mm step-down" in doc
     need = highest + settings.feed_height_mm
     for safe, ok in ((need - 0.01, False), (need + 0.01, True)):
         low = dataclasses.replace(settings, safe_z_mm=safe)
