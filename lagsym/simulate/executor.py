@@ -8,7 +8,7 @@ from decimal import localcontext
 from ..errors import ProgramError
 from ..gcode.limits import VARIABLE_RANGES
 from ..values import choice
-from .alarms import BlockAlarm, ControlAlarm
+from .alarms import BlockAlarm, ControlAlarm, alarm_at
 from .blocks import Block, End, Label, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, While
 from .compiler import alarm_block, compile_program
 from .control import Control
@@ -91,10 +91,7 @@ def _run(table, where, blocks, m: Control, runaway: Runaway) -> int:
         k = alarm_block(e, where)
         if k is None:
             raise
-        b = blocks[k]
-        if isinstance(e, BlockAlarm):
-            raise ControlAlarm(e.alarm, e.message, b.line, b.text) from None
-        raise ControlAlarm("111", f"calculated data out of range ({type(e).__name__})", b.line, b.text) from None
+        raise alarm_at(e, blocks[k]) from None
     return executed
 
 

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from decimal import Decimal
 
 from ..gcode.words import FUNCTIONS, WordError, words
@@ -240,7 +241,11 @@ class Expr:
     """
 
     node: tuple
-    run: Callable = field(compare=False, repr=False)
+
+    @cached_property
+    def run(self) -> Callable:
+        """The closure of the tree, built on the first call (most expressions are only compiled)."""
+        return closure(self.node)
 
     def __call__(self, m):
         return self.run(m)
@@ -248,7 +253,7 @@ class Expr:
 
 def expr_of(node: Node) -> Expr:
     """The :class:`Expr` of a tree."""
-    return Expr(node, closure(node))
+    return Expr(node)
 
 
 def expression(text: str):
