@@ -148,3 +148,21 @@ def test_a_negative_zero_keeps_its_sign_where_the_control_keeps_it():
 def test_conditional_and_computed_assignments(text):
     assert compiled(text, "fanuc", 8) == interpreted(text, "fanuc", 8)
     assert compiled(text, "fanuc", 8)[0] == interpreted(text, "fanuc", 8)[0] != {}
+
+
+def test_a_point_list_runs_as_one_call_with_the_modes_of_each_block():
+    """Blocks of constant words: G90/G91, G0/G1, F, M30 stopping, counted block by block."""
+    lines = ["G90 G0 X0. Y0. Z5.", "G1 Z0. F100."] + [f"X{k}. Y{2 * k}." for k in range(1, 250)]
+    lines += ["G91 X1. Y-1.", "G0 Z10.", "M30", "G1 X99. Y99. Z99."]
+    sim = simulate("\n".join(lines) + "\n", "fanuc", 8)
+    assert sim.blocks == 254 and len(sim.moves) == 253  # the block after M30 never runs
+    assert (sim.moves[251].x, sim.moves[251].y, sim.moves[251].z) == (250.0, 497.0, 0.0)  # G91: 249+1, 498-1
+    assert sim.moves[-1].motion == "G0" and sim.moves[-1].z == 10.0 and sim.moves[-2].feed == 100.0
+    assert [m.line for m in sim.moves[:3]] == [1, 2, 3]
+
+
+def test_an_alarm_in_a_point_list_names_its_block():
+    lines = [f"G1 X{k}. Y0. Z0. F100." for k in range(150)] + ["G2 X1. Y1."]
+    with pytest.raises(ControlAlarm, match="alarm arc") as e:
+        simulate("\n".join(lines) + "\n", "fanuc", 8)
+    assert e.value.line == 151
