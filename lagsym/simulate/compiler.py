@@ -46,13 +46,13 @@ def _leaders(blocks, labels) -> list[int]:
     n = len(blocks)
     starts = {0, *labels.values()}
     for i, b in enumerate(blocks):
-        if isinstance(b, _CONTROL) or (isinstance(b, Words) and any(k == "M" for k, _ in b.words)):
+        if isinstance(b, _CONTROL):
             starts.add(i + 1)
-        for name in ("end", "next", "endif"):
-            if getattr(b, name, -1) >= 0:
-                starts.add(getattr(b, name) + 1)
-        if getattr(b, "start", -1) >= 0:
-            starts.add(b.start)
+            starts.update(getattr(b, name) + 1 for name in ("end", "next", "endif") if getattr(b, name, -1) >= 0)
+            if getattr(b, "start", -1) >= 0:
+                starts.add(b.start)
+        elif isinstance(b, Words) and any(k == "M" for k, _ in b.words):
+            starts.add(i + 1)
     starts = sorted(s for s in starts if s < n)
     cut = []  # long straight runs (a point list) in pieces: the compiler's time and memory stay linear
     for a, b in zip(starts, starts[1:] + [n]):
@@ -143,7 +143,7 @@ class _Program:
         kind = node[0]
         if kind == "dec":
             return Decimal(node[1])
-        if kind in ("var", "named", "lit", "idx", "ind") or _reads_variables(node):
+        if kind in ("var", "named", "lit", "idx", "ind") or (kind != "num" and _reads_variables(node)):
             return None
         try:
             return self.m.const(node[1]) if kind == "num" else closure(node)(self.m)
