@@ -370,3 +370,7 @@ def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
     assert status == 0, err
     assert err.endswith(": fanuc, 8 digits: 2525622 blocks executed, 64566 moves (64562 feed), no alarm\n"), err
     assert 2525622 < MAX_BLOCKS and len(out.splitlines()) == 64566 + 1
+    from conftest import ROOT
+
+    macros = " ".join((ROOT / "docs" / "macros.md").read_text().split())
+    assert "ball macro at 8 digits (2,525,622 blocks executed, 64,566 moves)" in macros

@@ -26,8 +26,11 @@ The steps, one module each: :mod:`~lagsym.simulate.reader` turns the text
 into typed :mod:`~lagsym.simulate.blocks` with one parser per dialect
 (:mod:`~lagsym.simulate.fanuc`, :mod:`~lagsym.simulate.linuxcnc`,
 :mod:`~lagsym.simulate.heidenhain`) and the expressions of
-:mod:`~lagsym.simulate.expressions`; :mod:`~lagsym.simulate.executor` runs
-them on the arithmetic and variables of :mod:`~lagsym.simulate.control`;
+:mod:`~lagsym.simulate.expressions` (trees, and closures over the control);
+:mod:`~lagsym.simulate.compiler` turns each straight run of blocks into one
+Python function, read once; :mod:`~lagsym.simulate.executor` links the loops
+and runs those functions on the arithmetic and variables of
+:mod:`~lagsym.simulate.control`;
 :mod:`~lagsym.simulate.runaway` stops a program that would never end;
 :mod:`~lagsym.simulate.result` holds what comes back.
 """

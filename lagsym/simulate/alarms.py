@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..errors import ProgramError
 
-__all__ = ["ControlAlarm", "BlockAlarm"]
+__all__ = ["ControlAlarm", "BlockAlarm", "alarm_at"]
 
 
 class ControlAlarm(ProgramError):
@@ -26,3 +26,10 @@ class BlockAlarm(Exception):
     def __init__(self, alarm: str, message: str):
         super().__init__(alarm, message)
         self.alarm, self.message = alarm, message
+
+
+def alarm_at(error: Exception, block) -> ControlAlarm:
+    """The :class:`ControlAlarm` for a :class:`BlockAlarm` or an arithmetic error raised by ``block``."""
+    if isinstance(error, BlockAlarm):
+        return ControlAlarm(error.alarm, error.message, block.line, block.text)
+    return ControlAlarm("111", f"calculated data out of range ({type(error).__name__})", block.line, block.text)

@@ -1,8 +1,8 @@
 """The blocks a dialect's parser turns program text into, one frozen dataclass per kind of statement.
 
-Expressions inside a block are closures ``f(control) -> Decimal`` (see
-:mod:`lagsym.simulate.expressions`); a variable target is a closure
-``f(control) -> int``.  Indices of partner blocks (a loop's end, an if's
+Expressions inside a block are :class:`~lagsym.simulate.expressions.Expr`
+values: a tree the compiler turns into code, callable as ``f(control) ->
+Decimal``; a variable target is one of a reference tree, ``f(control) -> int``.  Indices of partner blocks (a loop's end, an if's
 next branch) are filled in by the executor when it links the program; until
 then they are ``-1``.
 """

@@ -1,16 +1,16 @@
-"""The executor: links loops and branches, then runs the blocks one by one on a :class:`Control`."""
+"""The executor: links loops and branches, compiles the blocks and runs them on a :class:`Control`."""
 
 from __future__ import annotations
 
 from dataclasses import replace
-from decimal import Decimal, InvalidOperation
+from decimal import localcontext
 
 from ..errors import ProgramError
 from ..gcode.limits import VARIABLE_RANGES
 from ..values import choice
-from .alarms import BlockAlarm, ControlAlarm
-from .blocks import (Assign, AssignNamed, Block, End, Goto, IfGoto, IfGotoLabel, IfThen, Label, Nop, OElse, OElseIf,
-                     OEndIf, OEndWhile, OIf, OWhile, Stop, While, Words)
+from .alarms import BlockAlarm, ControlAlarm, alarm_at
+from .blocks import Block, End, Label, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, While
+from .compiler import alarm_block, compile_program
 from .control import Control
 from .reader import SIM_DIALECTS, detect_dialect, read_blocks
 from .result import Simulation
@@ -65,24 +65,34 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     blocks = _match_loops(read_blocks(text, dialect))
     labels = _labels(blocks)
     m = Control(dialect, int(precision), variable_ranges or VARIABLE_RANGES[dialect])
-    handlers = [_RUN[type(b)] for b in blocks]
     runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, dialect, int(precision)), blocks)
-    pc, executed = 0, 0
-    while pc < len(blocks):
-        b = blocks[pc]
-        executed += 1
-        try:
-            nxt = handlers[pc](m, blocks, pc, b, labels)
-        except BlockAlarm as e:
-            raise ControlAlarm(e.alarm, e.message, b.line, b.text) from None
-        except (InvalidOperation, OverflowError, ArithmeticError) as e:
-            raise ControlAlarm("111", f"calculated data out of range ({type(e).__name__})", b.line, b.text) from None
-        if nxt is None:
-            break
-        if nxt <= pc:  # a run that never ends jumps back again and again: the guard looks only here
-            runaway.check(m, executed, nxt, b)
-        pc = nxt
+    table, where = compile_program(m, blocks, labels)
+    executed = _run(table, where, blocks, m, runaway)
     return Simulation(dialect=dialect, precision=int(precision), moves=m.moves, blocks=executed)
+
+
+def _run(table, where, blocks, m: Control, runaway: Runaway) -> int:
+    """Run the compiled segments from the first block; the number of blocks executed."""
+    pc, executed, n = 0, 0, len(blocks)
+    try:
+        with localcontext(m.ctx):  # the operators of the compiled code round as the control does
+            while pc < n:
+                run, count, last = table[pc]
+                nxt = run()
+                executed += count
+                if nxt is None:
+                    break
+                if nxt <= last:  # a run that never ends jumps back again and again: the guard looks only here
+                    runaway.check(m, executed, nxt, blocks[last])
+                pc = nxt
+    except ControlAlarm:
+        raise
+    except (BlockAlarm, ArithmeticError) as e:
+        k = alarm_block(e, where)
+        if k is None:
+            raise
+        raise alarm_at(e, blocks[k]) from None
+    return executed
 
 
 # --------------------------------------------------------------------------- linking
@@ -151,114 +161,3 @@ def _labels(blocks: list[Block]) -> dict[int, int]:
         elif b.sequence is not None:
             labels.setdefault(b.sequence, i)
     return labels
-
-
-# --------------------------------------------------------------------------- running
-# Each handler runs block ``b`` at index ``pc`` and returns the index of the next block, or None to stop.
-
-
-def _jump(labels, n: int) -> int:
-    if n not in labels:
-        raise BlockAlarm("128", f"sequence number or label {n} not found")
-    return labels[n]
-
-
-def _assign(m: Control, blocks, pc: int, b: Assign, labels) -> int:
-    m.set(b.target(m), b.value(m))
-    return pc + 1
-
-
-def _assign_named(m: Control, blocks, pc: int, b: AssignNamed, labels) -> int:
-    m.names[b.name] = m.ctx.plus(b.value(m))
-    return pc + 1
-
-
-def _while(m: Control, blocks, pc: int, b: While | OWhile, labels) -> int:
-    if b.cond is not None and not b.cond(m):
-        return b.end + 1
-    return pc + 1
-
-
-def _end(m: Control, blocks, pc: int, b: End | OEndWhile, labels) -> int:
-    return b.start
-
-
-def _if(m: Control, blocks, pc: int, b: OIf, labels) -> int:
-    j, branch = pc, b
-    while not branch.cond(m):  # try the if, then each elseif, in turn
-        j = branch.next
-        branch = blocks[j]
-        if not isinstance(branch, OElseIf):
-            break  # the else (its body runs) or the endif
-    return j + 1
-
-
-def _skip_to_endif(m: Control, blocks, pc: int, b: OElseIf | OElse, labels) -> int:
-    return b.endif + 1  # reached from a branch that ran: skip the rest
-
-
-def _next(m: Control, blocks, pc: int, b: Block, labels) -> int:
-    return pc + 1
-
-
-def _stop(m: Control, blocks, pc: int, b: Stop, labels) -> None:
-    return None
-
-
-def _if_then(m: Control, blocks, pc: int, b: IfThen, labels) -> int | None:
-    if b.cond(m):
-        return _RUN[type(b.then)](m, blocks, pc, b.then, labels)
-    return pc + 1
-
-
-def _goto(m: Control, blocks, pc: int, b: Goto, labels) -> int:
-    return _jump(labels, m.index(b.number(m)))
-
-
-def _if_goto(m: Control, blocks, pc: int, b: IfGoto, labels) -> int:
-    if b.cond(m):
-        return _jump(labels, m.index(b.number(m)))
-    return pc + 1
-
-
-def _if_goto_label(m: Control, blocks, pc: int, b: IfGotoLabel, labels) -> int:
-    if b.cond(m):
-        return _jump(labels, b.label)
-    return pc + 1
-
-
-def _words(m: Control, blocks, pc: int, b: Words, labels) -> int | None:
-    values: dict[str, Decimal] = {}
-    gs: list[Decimal] = []
-    ms: list[Decimal] = []
-    for letter, f in b.words:
-        v = f(m)
-        if letter == "G":
-            gs.append(v)
-        elif letter == "M":
-            ms.append(v)
-        else:
-            values[letter] = v
-    for g in gs:
-        if g in (0, 1, 2, 3):
-            m.motion = f"G{int(g)}"
-        elif g == 90:
-            m.absolute = True
-        elif g == 91:
-            m.absolute = False
-    if "F" in values:
-        m.feed = values["F"]
-    if m.motion in ("G2", "G3") and any(a in values for a in "XYZ"):
-        raise BlockAlarm("arc", "arcs are outside what the simulator runs")
-    m.move(b.line, values)
-    if any(v in (2, 30, 99) for v in ms):
-        return None  # end of program
-    return pc + 1
-
-
-_RUN = {
-    Assign: _assign, AssignNamed: _assign_named, Words: _words,
-    While: _while, End: _end, IfThen: _if_then, Goto: _goto, IfGoto: _if_goto,
-    Label: _next, IfGotoLabel: _if_goto_label, Stop: _stop, Nop: _next,
-    OWhile: _while, OEndWhile: _end, OIf: _if, OElseIf: _skip_to_endif, OElse: _skip_to_endif, OEndIf: _next,
-}

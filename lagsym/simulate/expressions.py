@@ -1,21 +1,26 @@
-"""Tokens and expressions of the macro languages, compiled once into closures ``f(control) -> Decimal``.
+"""Tokens and expressions of the macro languages, read once into trees and closures ``f(control) -> Decimal``.
 
 An expression (``[#1+2.]*SQRT[#3]``, ``#[#2+1]``, ``#<x> LT 5``) is read
-into a closure that the executor calls each time the block runs, with the
-:class:`~lagsym.simulate.control.Control` that holds the variables and does
-the arithmetic.  Reading checks what a Fanuc checks when it reads a block:
+into an :class:`Expr`: its tree (:data:`Node`), which
+:mod:`~lagsym.simulate.compiler` turns into the Python code the executor
+runs, and a closure over the methods of
+:class:`~lagsym.simulate.control.Control` (the variables and the
+arithmetic), which the runaway guard's analysis calls on probe controls.  Reading checks what a Fanuc checks when it reads a block:
 brackets nested at most 5 deep (alarm 118) and well formed (alarm 114).
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
 from decimal import Decimal
 
 from ..gcode.words import FUNCTIONS, WordError, words
 from .alarms import BlockAlarm
 
-__all__ = ["expression", "reference", "word_values", "MAX_BRACKETS"]
+__all__ = ["Expr", "Node", "expression", "reference", "word_values", "closure", "expr_of", "MAX_BRACKETS"]
 
 MAX_BRACKETS = 5  # Fanuc alarm 118
 
@@ -24,6 +29,12 @@ _TOKEN = re.compile(r"\s*(?:(?P<num>\d+\.?\d*|\.\d+)|(?P<name>#<[^>]*>)|(?P<word
 _FUNCS = frozenset(FUNCTIONS)
 _CMP = {"EQ", "NE", "GT", "GE", "LT", "LE"}
 _LOGIC = {"AND", "OR", "XOR"}
+
+Node = tuple
+"""An expression tree: ``("num", text)`` a constant as written, ``("dec", text)`` an exact one, ``("var", ref)``,
+``("named", name)``, ``("neg", a)``, ``("add"|"sub"|"mul"|"div"|"mod"|"pow"|"atan2", a, b)``,
+``("func", NAME, a)``, ``("cmp"|"logic", OP, a, b)``; a reference is ``("lit", n)``, ``("idx", expr)``
+(``#[expr]``) or ``("ind", ref)`` (``##n``)."""
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -53,7 +64,7 @@ def _tokens(text: str) -> list[tuple[str, str]]:
 
 
 class _Parser:
-    """Recursive descent over tokens; builds closures ``f(control) -> Decimal``."""
+    """Recursive descent over tokens; builds expression trees (:data:`Node`)."""
 
     def __init__(self, toks):
         self.toks, self.i = toks, 0
@@ -72,48 +83,41 @@ class _Parser:
         f = self.compare()
         while self.peek()[1] in _LOGIC:
             op = self.take()[1]
-            g = self.compare()
-            f = _logic(op, f, g)
+            f = ("logic", op, f, self.compare())
         return f
 
     def compare(self):
         f = self.additive()
         while self.peek()[1] in _CMP:
             op = self.take()[1]
-            g = self.additive()
-            f = _cmp(op, f, g)
+            f = ("cmp", op, f, self.additive())
         return f
 
     def additive(self):
         f = self.term()
         while self.peek()[1] in ("+", "-"):
             op = self.take()[1]
-            g = self.term()
-            f = (lambda a, b: lambda m: m.ctx.add(a(m), b(m)))(f, g) if op == "+" else \
-                (lambda a, b: lambda m: m.ctx.subtract(a(m), b(m)))(f, g)
+            f = ("add" if op == "+" else "sub", f, self.term())
         return f
 
     def term(self):
         f = self.power()
         while self.peek()[1] in ("*", "/", "MOD"):
             op = self.take()[1]
-            g = self.power()
-            f = _mul(op, f, g)
+            f = ({"*": "mul", "/": "div"}.get(op, "mod"), f, self.power())
         return f
 
     def power(self):
         f = self.unary()
         if self.peek()[1] == "**":
             self.take()
-            g = self.unary()
-            return lambda m, a=f, b=g: m.ctx.power(a(m), b(m))
+            return ("pow", f, self.unary())
         return f
 
     def unary(self):
         if self.peek()[1] == "-":
             self.take()
-            f = self.unary()
-            return lambda m: m.ctx.minus(f(m))
+            return ("neg", self.unary())
         if self.peek()[1] == "+":
             self.take()
             return self.unary()
@@ -122,16 +126,15 @@ class _Parser:
     def primary(self):
         kind, val = self.take()
         if kind == "num":
-            return lambda m, t=val: m.const(t)
+            return ("num", val)
         if val == "[":
             f = self.expr()
             self.take("]")
             return f
         if kind == "name":
-            return lambda m, n=val[2:-1].strip().lower(): m.named(n)
+            return ("named", val[2:-1].strip().lower())
         if val == "#":
-            ref = self.reference()
-            return lambda m: m.get(ref(m))
+            return ("var", self.reference())
         if kind == "word" and val in _FUNCS:
             self.take("[")
             a = self.expr()
@@ -141,28 +144,62 @@ class _Parser:
                 self.take("[")
                 b = self.expr()
                 self.take("]")
-                return lambda m: m.atan2(a(m), b(m))
-            return lambda m, fn=val: m.func(fn, a(m))
+                return ("atan2", a, b)
+            return ("func", val, a)
         raise BlockAlarm("114", f"unexpected {val!r}")
 
     def reference(self):
-        """After ``#``: a number, ``[expr]`` or another ``#``; returns ``f(control) -> int``."""
+        """After ``#``: a number, ``[expr]`` or another ``#``; returns a reference node."""
         kind, val = self.peek()
         if kind == "num":
             self.take()
             if "." in val:
                 raise BlockAlarm("114", f"variable number #{val} is not an integer")
-            return lambda m, n=int(val): n
+            return ("lit", int(val))
         if val == "[":
             self.take()
             f = self.expr()
             self.take("]")
-            return lambda m: m.index(f(m))
+            return ("idx", f)
         if val == "#":
             self.take()
-            inner = self.reference()
-            return lambda m: m.index(m.get(inner(m)))
+            return ("ind", self.reference())
         raise BlockAlarm("114", "'#' without a variable number")
+
+
+_TESTS = {"EQ": lambda a, b: a == b, "NE": lambda a, b: a != b, "GT": lambda a, b: a > b,
+          "GE": lambda a, b: a >= b, "LT": lambda a, b: a < b, "LE": lambda a, b: a <= b}
+
+
+def closure(node: Node):
+    """The closure ``f(control) -> Decimal`` (``-> int`` for a reference node) that evaluates ``node``.
+
+    Every operation goes through the control's methods, so a control that
+    overrides them (the runaway guard's probes) sees every read; the
+    executor runs the compiled form of :mod:`~lagsym.simulate.compiler`.
+    """
+    kind = node[0]
+    if kind == "num":
+        return lambda m, t=node[1]: m.const(t)
+    if kind == "dec":
+        return lambda m, v=Decimal(node[1]): v
+    if kind == "named":
+        return lambda m, n=node[1]: m.named(n)
+    if kind == "lit":
+        return lambda m, n=node[1]: n
+    if kind == "neg":
+        f = closure(node[1])
+        return lambda m: m.ctx.minus(f(m))
+    if kind == "func":
+        f, name = closure(node[2]), node[1]
+        return lambda m: m.func(name, f(m))
+    if kind in ("var", "idx", "ind"):
+        f = closure(node[1])
+        if kind == "var":
+            return lambda m: m.get(f(m))
+        return (lambda m: m.index(f(m))) if kind == "idx" else (lambda m: m.index(m.get(f(m))))
+    f, g = closure(node[-2]), closure(node[-1])
+    return _BINARY[kind](node[1], f, g)
 
 
 def _logic(op, f, g):
@@ -174,18 +211,49 @@ def _logic(op, f, g):
 
 
 def _cmp(op, f, g):
-    tests = {"EQ": lambda a, b: a == b, "NE": lambda a, b: a != b, "GT": lambda a, b: a > b,
-             "GE": lambda a, b: a >= b, "LT": lambda a, b: a < b, "LE": lambda a, b: a <= b}
-    t = tests[op]
+    t = _TESTS[op]
     return lambda m: Decimal(int(t(f(m), g(m))))
 
 
-def _mul(op, f, g):
-    if op == "*":
-        return lambda m: m.ctx.multiply(f(m), g(m))
-    if op == "/":
-        return lambda m: m.divide(f(m), g(m))
+def _mod(f, g):
     return lambda m: m.ctx.remainder(f(m), g(m)) if g(m) else m.divide(f(m), g(m))
+
+
+_BINARY = {
+    "add": lambda op, f, g: lambda m: m.ctx.add(f(m), g(m)),
+    "sub": lambda op, f, g: lambda m: m.ctx.subtract(f(m), g(m)),
+    "mul": lambda op, f, g: lambda m: m.ctx.multiply(f(m), g(m)),
+    "div": lambda op, f, g: lambda m: m.divide(f(m), g(m)),
+    "mod": lambda op, f, g: _mod(f, g),
+    "pow": lambda op, f, g: lambda m: m.ctx.power(f(m), g(m)),
+    "atan2": lambda op, f, g: lambda m: m.atan2(f(m), g(m)),
+    "cmp": _cmp, "logic": _logic,
+}
+
+
+@dataclass(frozen=True)
+class Expr:
+    """An expression read once: its tree ``node`` and, called with a control, its value.
+
+    The tree is what :mod:`~lagsym.simulate.compiler` turns into Python code;
+    calling the expression runs :func:`closure` (the runaway guard's analysis
+    does, on probe controls).
+    """
+
+    node: tuple
+
+    @cached_property
+    def run(self) -> Callable:
+        """The closure of the tree, built on the first call (most expressions are only compiled)."""
+        return closure(self.node)
+
+    def __call__(self, m):
+        return self.run(m)
+
+
+def expr_of(node: Node) -> Expr:
+    """The :class:`Expr` of a tree."""
+    return Expr(node)
 
 
 def expression(text: str):
@@ -194,7 +262,7 @@ def expression(text: str):
     f = p.expr()
     if p.i != len(p.toks):
         raise BlockAlarm("114", f"unexpected {p.toks[p.i][1]!r}")
-    return f
+    return expr_of(f)
 
 
 def reference(text: str):
@@ -204,7 +272,7 @@ def reference(text: str):
     r = p.reference()
     if p.i != len(p.toks):
         raise BlockAlarm("114", f"unexpected {p.toks[p.i][1]!r}")
-    return r
+    return expr_of(r)
 
 
 _AXIS_DECIMAL = set("XYZABCIJKRUVW")
@@ -224,7 +292,7 @@ def _word_value(letter: str, text: str, dialect: str):
         if letter in _AXIS_DECIMAL and "." not in t and dialect == "fanuc":
             raise BlockAlarm("decimal-point",
                              f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
-        return lambda m, v=t: m.const(v)
+        return expr_of(("num", t))
     return expression(t)
 
 

@@ -10,10 +10,9 @@ a comment.
 from __future__ import annotations
 
 import re
-from decimal import Decimal
-
 from .alarms import BlockAlarm
 from .blocks import Assign, Block, IfGotoLabel, Label, Nop, Stop, Words
+from .expressions import expr_of
 
 __all__ = ["parse_block"]
 
@@ -24,7 +23,7 @@ _JUMP = re.compile(r"FN\s*(9|10|11|12)\s*:\s*IF\s+" + _OPERAND + r"\s+(EQU|NE|GT
 _SET_UP = ("BEGIN PGM", "BLK FORM", "TOOL CALL", "TOOL DEF", "CYCL")
 _OPERATORS = {1: "+", 2: "-", 3: "*", 4: "/"}
 _RELATIONS = {9: "EQU", 10: "NE", 11: "GT", 12: "LT"}
-_TESTS = {"EQU": lambda x, y: x == y, "NE": lambda x, y: x != y, "GT": lambda x, y: x > y, "LT": lambda x, y: x < y}
+_TESTS = {"EQU": "EQ", "NE": "NE", "GT": "GT", "LT": "LT"}  # the relation as the expression trees name it
 
 
 def parse_block(line: int, raw: str, text: str) -> Block:
@@ -43,27 +42,28 @@ def parse_block(line: int, raw: str, text: str) -> Block:
     t = re.sub(r"^(FN\s*5\s*:\s*Q\d+\s*=\s*)SQRT\s*", r"\1", t, flags=re.I)
     m = _ASSIGN.fullmatch(t)
     if m:
-        return Assign(line, raw, lambda c, n=int(m.group(2)): n, _arithmetic(*m.group(1, 3, 4, 5)))
+        return Assign(line, raw, expr_of(("lit", int(m.group(2)))), expr_of(_arithmetic(*m.group(1, 3, 4, 5))))
     m = _JUMP.fullmatch(t)
     if m:
-        return IfGotoLabel(line, raw, _comparison(*m.group(1, 2, 3, 4)), int(m.group(5)))
+        return IfGotoLabel(line, raw, expr_of(_comparison(*m.group(1, 2, 3, 4))), int(m.group(5)))
     m = re.fullmatch(r"L\s+(.*)", t, re.I)
     if m:
         return Words(line, raw, _straight(m.group(1)))
     m = re.fullmatch(r"M\s*(\d+)", t, re.I)
     if m:
-        return Words(line, raw, (("M", lambda c, v=m.group(1): Decimal(v)),))
+        return Words(line, raw, (("M", expr_of(("dec", m.group(1)))),))
     raise BlockAlarm("114", f"cannot read {t[:30]!r}")
 
 
 def _operand(text: str):
+    """The tree of ``Qn``, ``-Qn`` or a signed constant."""
     t = text.replace(" ", "")
     neg = t.startswith("-")
     t = t.lstrip("+-")
     if t.upper().startswith("Q"):
-        n = int(t[1:])
-        return (lambda c: c.ctx.minus(c.get(n))) if neg else (lambda c: c.get(n))
-    return lambda c, v=("-" if neg else "") + t: c.const(v)
+        q = ("var", ("lit", int(t[1:])))
+        return ("neg", q) if neg else q
+    return ("num", ("-" if neg else "") + t)
 
 
 def _arithmetic(fn: str, a: str, op: str | None, b: str | None):
@@ -72,11 +72,9 @@ def _arithmetic(fn: str, a: str, op: str | None, b: str | None):
     if fn == 0 and op is None:
         return fa
     if fn in _OPERATORS and op == _OPERATORS[fn]:
-        fb = _operand(b)
-        return {1: lambda c: c.ctx.add(fa(c), fb(c)), 2: lambda c: c.ctx.subtract(fa(c), fb(c)),
-                3: lambda c: c.ctx.multiply(fa(c), fb(c)), 4: lambda c: c.divide(fa(c), fb(c))}[fn]
+        return ({1: "add", 2: "sub", 3: "mul", 4: "div"}[fn], fa, _operand(b))
     if fn == 5 and op is None:
-        return lambda c: c.func("SQRT", fa(c))
+        return ("func", "SQRT", fa)
     raise BlockAlarm("114", f"FN {fn} does not take this form")
 
 
@@ -86,16 +84,15 @@ def _comparison(fn: str, a: str, relation: str, b: str):
     want = _RELATIONS[fn]
     if relation != want:
         raise BlockAlarm("114", f"FN {fn} compares with {want}, not {relation}")
-    fa, fb, test = _operand(a), _operand(b), _TESTS[relation]
-    return lambda c: test(fa(c), fb(c))
+    return ("cmp", _TESTS[relation], _operand(a), _operand(b))
 
 
 def _straight(rest: str):
     """The words of ``L X.. Y.. Z.. F..``: ``FMAX`` is a rapid (``G0``), any other feed a ``G1``."""
-    axes = [(w[0].upper(), _operand(w[1])) for w in re.findall(r"([XYZ])\s*" + _OPERAND, rest, re.I)]
+    axes = [(w[0].upper(), expr_of(_operand(w[1]))) for w in re.findall(r"([XYZ])\s*" + _OPERAND, rest, re.I)]
     feed = re.search(r"\bF\s*(\d+\.?\d*|MAX)\b", rest, re.I)
     rapid = feed is not None and feed.group(1).upper() == "MAX"
-    out = [("G", lambda c, v="0" if rapid else "1": Decimal(v))]
+    out = [("G", expr_of(("dec", "0" if rapid else "1")))]
     if feed and not rapid:
-        out.append(("F", lambda c, v=feed.group(1): c.const(v)))
+        out.append(("F", expr_of(("num", feed.group(1)))))
     return tuple(out + axes)

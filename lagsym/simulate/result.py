@@ -51,6 +51,11 @@ class SimMoves(Sequence):
         self._z.append(z)
         self._feed.append(feed)
 
+    def appenders(self) -> tuple:
+        """The ``append`` of each column, in the order of :meth:`append` (the executor's use only)."""
+        return (self._line.append, self._rapid.append, self._x.append, self._y.append, self._z.append,
+                self._feed.append)
+
     def __len__(self) -> int:
         return len(self._line)
 
@@ -107,7 +112,10 @@ class Simulation:
 
 def moves_csv(sim: Simulation, decimals: int = 6) -> str:
     """The moves as CSV: ``line,motion,x,y,z,feed``."""
+    mv = sim.moves
+    row = f"{{}},{{}},{{:.{int(decimals)}f}},{{:.{int(decimals)}f}},{{:.{int(decimals)}f}},{{:g}}".format
+    motion = ("G1", "G0")
     rows = ["line,motion,x,y,z,feed"]
-    for mv in sim.moves:
-        rows.append(f"{mv.line},{mv.motion},{mv.x:.{decimals}f},{mv.y:.{decimals}f},{mv.z:.{decimals}f},{mv.feed:g}")
+    rows += [row(line, motion[rapid], x, y, z, feed)
+             for line, rapid, x, y, z, feed in zip(mv._line, mv._rapid, mv._x, mv._y, mv._z, mv._feed)]
     return "\n".join(rows) + "\n"
