@@ -10,7 +10,7 @@ the machine.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
 from . import chordal
+from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
 from .filter import filter_rows
 from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
@@ -63,6 +64,9 @@ class Toolpath:
         measured normal to the surface (mm); None for a fixed side step.
     cusp_at_mm : tuple of float or None
         Where that cusp is, ``(x, y)`` on the machine.
+    arcs : Arcs or None
+        With ``raster.arcs``, the circular moves that replace runs of the
+        points (:mod:`lagsym.toolpath.arcs`); None without.
     """
 
     points_mm: np.ndarray
@@ -76,6 +80,7 @@ class Toolpath:
     fine_points: int = 0
     cusp_mm: float | None = None
     cusp_at_mm: tuple[float, float] | None = None
+    arcs: Arcs | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -151,7 +156,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
-    return Toolpath(
+    tp = Toolpath(
         **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
                           _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
         tool=tool,
@@ -162,6 +167,14 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         fine_points=len(path.x),
         **_cusp(scallop, raster.direction, settings),
     )
+    if not raster.arcs:
+        return tp
+    fine = np.stack(_place(settings, path.x, path.y, path.z), axis=1)
+    along = bx if raster.direction == "x" else by
+    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa, tol,
+                                     settings.unit_factor, settings.digits, settings.units,
+                                     (float(along[0]), float(along[1])), cl.radius * mm_per_unit,
+                                     CHORD_MM.get(settings.dialect, 0.0)))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
