@@ -191,3 +191,13 @@ def test_the_reader_reads_arcs_in_every_plane():
         assert np.all(p.min(axis=0) >= -1e-9)  # the short way round: a positive turn, first axis to second
         cw = parse_moves(f"G21 G90\nG00 {start}\n{plane} G02 {end} {centre_off} F100.\n").points_mm[1:]
         assert np.any(cw.min(axis=0) < -0.5)  # the long way round
+
+
+def test_plot_reads_the_arcs_as_feed_pieces():
+    """``lagsym plot --show toolpath`` draws a program through ``move_points``: an arc's pieces are feed moves."""
+    from lagsym.gcode import move_points
+
+    pts, rapid = move_points("G21 G90\nG00 X0. Y0. Z1.\nG01 Z0. F100.\nG18 G03 X2. Z0. I1. K0.\nG17\nG00 Z5.\n")
+    arc = pts[2:-1]
+    assert len(arc) > 100 and not rapid[1:-1].any() and rapid[-1]
+    assert np.allclose(np.hypot(arc[:, 0] - 1.0, arc[:, 2]), 1.0) and arc[:, 2].max() > 0.99  # G03 seen from +Y: over the top seen from the front

@@ -167,14 +167,18 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         fine_points=len(path.x),
         **_cusp(scallop, raster.direction, settings),
     )
-    if not raster.arcs:
-        return tp
+    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+
+
+def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSettings, kappa: float) -> Toolpath:
+    """The toolpath with the arcs fitted along its rows from the fine samples (:func:`.arcs.fit_arcs`)."""
     fine = np.stack(_place(settings, path.x, path.y, path.z), axis=1)
-    along = bx if raster.direction == "x" else by
-    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa, tol,
-                                     settings.unit_factor, settings.digits, settings.units,
-                                     (float(along[0]), float(along[1])), cl.radius * mm_per_unit,
-                                     CHORD_MM.get(settings.dialect, 0.0)))
+    x0, x1, y0, y1 = tp.bounds_mm
+    raster = tp.raster
+    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa,
+                                     raster.chordal_tolerance_mm, settings.unit_factor, settings.digits,
+                                     settings.units, (x0, x1) if raster.direction == "x" else (y0, y1),
+                                     cl.radius * cl.mm_per_unit, CHORD_MM.get(settings.dialect, 0.0)))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
