@@ -205,7 +205,7 @@ def test_readme_finishing_example(run_cli, tmp_path):
 
     ex4 = EXAMPLES / "paper-example-4.json"
     prog = tmp_path / "O1000.nc"
-    status, _, err = run_cli("toolpath", ex4, "--scale", "20", "--tool-diameter", "6", "--stepover", "0.5",
+    status, _, err = run_cli("toolpath", ex4, "--scale", "20", "--tool-diameter", "6", "--stepover", "0.4",
                              "--step", "0.2", "--feed", "600", "--safe-z", "80", "--dialect", "fanuc", "-o", prog)
     assert status == 0, err
     status, out, _ = run_cli("verify", ex4, prog, "--scale", "20", "--tool-diameter", "6")

@@ -20,7 +20,7 @@ tool tip; the tool stays down between rows.
 
 examples:
   lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
-      --stepover 0.5 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
+      --stepover 0.4 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
   lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 --safe-z 400 \\
       --dialect linuxcnc -o part.ngc"""
 
