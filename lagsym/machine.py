@@ -346,6 +346,10 @@ class RasterSpec:
     times the sine of the surface's steepest slope angle; for a flat end, the
     tool radius), so that the tool reaches the box edges also where the surface
     is steep there.
+
+    With ``arcs``, runs of moves along a row are replaced by circular moves
+    in the row's plane where one fits within the tolerance, never below the
+    cutter path (:mod:`lagsym.toolpath.arcs`).
     """
 
     direction: str = "x"
@@ -354,6 +358,7 @@ class RasterSpec:
     scallop_mm: float | None = None
     tolerance_mm: float | None = None
     boundary: str = "past"
+    arcs: bool = False
 
     def __post_init__(self):
         choice(self.direction, DIRECTIONS, "raster direction")

@@ -243,3 +243,37 @@ def test_the_roughing_page_quotes_the_roughing_macro(tmp_path, run_cli):
     linuxcnc = (tmp_path / "linuxcnc.nc").read_text()
     assert "\n#1000 = " in linuxcnc and "\n#1127 = " in linuxcnc and "\n#1128 = " not in linuxcnc
     assert "8 x 8 tiling" in text and "(128 numbers, `#500`-`#627` on a Fanuc, `#1000`-`#1127` on LinuxCNC)" in text
+
+
+def arc_figures(name: str, rs274, tmp_path):
+    """The README's finishing settings with --arcs on one example: feed moves before and after, and how far the
+    arcs rs274 moves lie above a brute-force ball drop-cutter on the exact polynomial (um, least and most)."""
+    from cutters import brute_ball
+    from gcheck import arc_feeds, tessellate
+    from lagsym.machine import MachineSettings, RasterSpec, Tool
+    from lagsym.post.program import point_program, write_program
+    from lagsym.toolpath import plan_toolpath
+    from test_arcs import example2, example4
+
+    f, box = {"paper-example-2": (example2, (1.0, 4.0, 1.0, 4.0)), "paper-example-4": (example4, (1.0, 5.0, 1.0, 5.0))}[name]
+    settings = MachineSettings(mm_per_unit=20.0, dialect="fanuc", safe_z_mm=80.0)
+    s = lagrange_surface(read_points(ROOT / "examples" / f"{name}.json"))
+    tp = plan_toolpath(s, Tool("ball", 6.0), RasterSpec("x", 0.4, 0.2, arcs=True), settings)
+    path = tmp_path / f"{name}.nc"
+    path.write_text(write_program(point_program(tp, settings)))
+    r = rs274.run(path)
+    assert r.returncode == 0, r.stderr[-400:]
+    arcs, _ = arc_feeds(r.stdout)
+    assert len(arcs) == len(tp.arcs)
+    pts = np.concatenate([tessellate(*a, n=50)[1:-1] for a in arcs])
+    pick = pts[np.random.default_rng(11).choice(len(pts), 4000, replace=False)]
+    dev = pick[:, 2] - brute_ball(f, box, pick[:, 0] / 20.0, pick[:, 1] / 20.0, 3.0 / 20.0) * 20.0
+    return len(tp) - 1, len(tp) - 1 - tp.arcs.blocks_saved(), len(tp.arcs), dev.min() * 1000, dev.max() * 1000
+
+
+@pytest.mark.parametrize("name, label", [("paper-example-2", "Example 2"), ("paper-example-4", "Example 4")])
+def test_the_toolpaths_page_quotes_the_arc_figures(rs274, tmp_path, name, label):
+    before, after, arcs, low, high = arc_figures(name, rs274, tmp_path)
+    assert low >= -0.1 and high <= 6.1  # never below; the tolerance and a unit of rounding above
+    assert (f"{label}: {before:,} feed moves, {after:,} with {arcs:,} arcs, which lie {low:.1f} to {high:.1f} um "
+            f"above the cutter path") in page("toolpaths.md")

@@ -54,7 +54,8 @@ def test_reads_every_dialect_lagsym_writes(rs274, dialect):
 
 
 @pytest.mark.parametrize("text, match", [
-    ("G0 X1\nG2 X2 Y2 I1 J0\n", "G2 is not a straight move"),
+    ("G0 X1\nG2 X2 Y2 R1\n", "by its radius"),
+    ("G0 X1\nG28\n", "G28 is not a straight or circular move"),
     ("G0 X1 (open comment\n", "unclosed comment"),
     ("X1 Y2\n", "before any G00"),
     ("G0 X1 X2\n", "X given twice"),

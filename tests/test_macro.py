@@ -709,3 +709,69 @@ def test_a_ball_end_macro_never_goes_below_the_cutter_location_where_the_control
     below = brute_ball(f, (20.0, 100.0, 20.0, 100.0), at[:, 0], at[:, 1], 2.0, n=25, rounds=10) - got[:, 2]
     assert below.max() <= 2e-5, f"{below.max() * 1000:.2f} um below at {at[np.argmax(below)]}"
     assert np.abs(got[:, :2] * 1000 - np.rint(got[:, :2] * 1000)).max() < 1e-6  # nothing left to round
+
+
+def _within_a_unit(at, unit=1e-3):
+    """The four positions within a unit of each ``(x, y)`` a control that rounds or truncates may go to."""
+    lo_x, lo_y = np.floor(at[:, 0] / unit + 1e-9) * unit, np.floor(at[:, 1] / unit + 1e-9) * unit
+    return [(lo_x + i * unit, lo_y + k * unit) for i in (0, 1) for k in (0, 1)]
+
+
+def test_a_heidenhain_surface_macro_stays_above_the_surface_where_the_tnc_goes():
+    """FN arithmetic cannot round: Z is raised by the slope bound, so at any position within a unit it is above F.
+
+    Checked with the TNC's arithmetic (the simulator) against the exact
+    polynomial at the positions the control may go to (X and Y rounded or
+    truncated to the last decimal) and Z truncated there; without the raise
+    the 7x7 thirds grid of the Fanuc test goes 0.82 mm into its steep surface (and the ball of the next
+    test 4.5 um into Example 4).
+    """
+    from lagsym.macro.rounding import slope_lift
+
+    rng = random.Random(7)
+    nodes = [Fraction(1, 3) + Fraction(i, 3) for i in range(7)]
+    z = [[Fraction(rng.randint(0, 5000), 100) for _ in range(7)] for _ in range(7)]
+    s = lagrange_surface(grid_from_table(nodes, nodes, z, source="thirds"))
+    settings = machine(dialect="heidenhain", safe_z_mm=9e4)
+    program = macro_program(s, settings, RasterSpec("x", 0.2, 0.1), FLAT, precision=15, tolerance_mm=1e-3)
+    got = simulate(program.text, "heidenhain", 15).feed_points()
+    inside = (got[:, 0] >= 1 / 3 + 1e-3) & (got[:, 0] <= 7 / 3 - 1e-3) & (got[:, 1] >= 1 / 3 + 1e-3) \
+        & (got[:, 1] <= 7 / 3 - 1e-3)
+    got = got[inside]
+    z_tnc = np.floor(got[:, 2] * 1000 + 1e-9) / 1000
+    worst = np.full(len(got), -np.inf)
+    for x, y in _within_a_unit(got):
+        exact = np.array([float(_lagrange_at(s.grid, Fraction(str(round(a, 3))), Fraction(str(round(b, 3)))))
+                          for a, b in zip(x, y)])
+        worst = np.maximum(worst, exact - z_tnc)
+    lift = float(slope_lift(s, settings))
+    assert worst.max() <= 1e-6, f"{worst.max() * 1000:.2f} um below the surface"
+    assert worst.min() >= -(lift + 2e-3)  # the raise is the bound, no more
+    plain = np.array([float(_lagrange_at(s.grid, Fraction(str(a)), Fraction(str(b)))) for a, b, _ in got[:200]])
+    assert np.all(got[:200, 2] - plain >= lift - 2e-6)  # every Z raised by the bound
+
+
+def test_a_heidenhain_ball_macro_stays_above_the_cutter_location_where_the_tnc_goes():
+    """The README's 4 mm ball on Example 4 (scale 20) as a Heidenhain macro: above a brute-force drop-cutter
+    at every position within a unit of the one computed, Z truncated to the last decimal."""
+    from cutters import brute_ball
+    from test_rough import exact_heights
+
+    s = surface("paper-example-4")
+    settings = machine(dialect="heidenhain", mm_per_unit=20.0, safe_z_mm=100.0)
+    program = macro_program(s, settings, RasterSpec("x", 4.0, 1.0), BALL)
+    got = simulate(program.text, "heidenhain", 8).feed_points()
+    from lagsym.macro.rounding import slope_lift
+
+    lift = float(slope_lift(s, settings))
+    z_tnc = np.floor(got[:, 2] * 1000 + 1e-9) / 1000
+    f = lambda x, y: exact_heights(EXAMPLES / "paper-example-4.json", x, y)  # noqa: E731
+    cl = np.full(len(got), -np.inf)
+    for x, y in _within_a_unit(got):
+        cl = np.maximum(cl, brute_ball(f, (20.0, 100.0, 20.0, 100.0), x, y, 2.0, n=25, rounds=10))
+    below = cl - z_tnc
+    assert below.max() <= 2e-5, f"{below.max() * 1000:.2f} um below at {got[np.argmax(below)]}"
+    unraised = (cl - np.floor((got[:, 2] - lift) * 1000 + 1e-9) / 1000).max()  # the same program without the raise
+    doc = " ".join((EXAMPLES.parent / "docs" / "macros.md").read_text().split())
+    assert f"{lift:.6f} mm for Example 4 at scale 20" in doc
+    assert f"without the raise, the 4 mm ball on Example 4 went {unraised * 1000:.1f} um into the part" in doc

@@ -105,9 +105,9 @@ def test_verify_command_exit_statuses(run_cli, tmp_path, ex2_program):
     status, out, _ = run_cli("verify", EX2, good, "--scale", "10", "--tool-diameter", "8", "--cell", "0.3")
     assert status == 1 and "GOUGE" in out  # the program was made for a smaller ball
     arcs = tmp_path / "arcs.ngc"
-    arcs.write_text("G0 X0 Y0 Z5\nG2 X1 Y1 I1 J0\n")
+    arcs.write_text("G0 X0 Y0 Z5\nG2 X1 Y1 R1\n")  # an arc by its radius: not read
     status, _, err = run_cli("verify", EX2, arcs, "--scale", "10")
-    assert status == 2 and "arcs.ngc, line 2" in err
+    assert status == 2 and "arcs.ngc, line 2" in err and "I, J, K" in err
     status, _, err = run_cli("verify", EX2, tmp_path / "missing.nc")
     assert status == 2 and "missing.nc" in err
 
@@ -235,3 +235,23 @@ def test_readme_finishing_example(run_cli, tmp_path):
         edge = above[:, 0 if b[0] == 20.0 else 1] if len(b) == 2 and len(a) > 2 else above[0 if a[0] == 20.0 else 1]
         assert edge.min() >= -0.002  # no gouge (the swept ball's sampling errs by about 1 um)
         assert edge.max() <= height + 0.01
+
+
+def test_verify_simulates_a_program_with_arcs(run_cli, tmp_path):
+    """An arc program (G18 arcs) is simulated: no gouge, and its cut within the tolerance of the same plan's lines."""
+    surf = lagrange_surface(read_points(EX2))
+    s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, None, None, 0.005, arcs=True), s)
+    text = write_program(point_program(tp, s))
+    assert "G18 G0" in text and len(tp.arcs) > 50
+    f = tmp_path / "arcs.ngc"
+    f.write_text(text)
+    status, out, err = run_cli("verify", EX2, f, "--scale", "10", "--tool-diameter", "6", "--cell", "0.25",
+                               "--max-left", "1")
+    assert status == 0, out + err
+    arcs = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.25)
+    lines = simulate_cut(surf, parse_moves(write_program(PointProgram(tp.points_mm, s))), tp.tool, Placement(10.0),
+                         cell_mm=0.25)
+    assert arcs.gouge_mm <= 0.0005 and not arcs.gouges
+    both = np.isfinite(arcs.cut_mm) & np.isfinite(lines.cut_mm)
+    assert np.abs(arcs.cut_mm - lines.cut_mm)[both].max() <= 0.005 + 0.001

@@ -48,6 +48,10 @@ def add_arguments(p) -> None:
                    help="past (default: the tool axis goes beyond the box as far as the tool still touches "
                         "the part, so the whole part is finished), centre (the axis stays in the box) or "
                         "inside (the whole tool stays in the box)")
+    g.add_argument("--arcs", action="store_true",
+                   help="replace runs of moves along a row by G02/G03 arcs in the row's plane (G18 for rows "
+                        "along x, G19 along y) where one stays within --tolerance above the cutter path and "
+                        "never below it; the report gives the blocks before and after")
     t = p.add_argument_group("cutter")
     t.add_argument("--tool-shape", choices=TOOL_SHAPES, default="ball", help="ball (default), flat or bull (bull nose: give --corner-radius)")
     t.add_argument("--corner-radius", type=CORNER_MM, metavar="MM",
@@ -83,7 +87,7 @@ def run(args, out, err) -> int:
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
-    raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary)
+    raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary, args.arcs)
     tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
@@ -92,7 +96,7 @@ def run(args, out, err) -> int:
         err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
                   f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
                   f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"
-                  + _cusp_note(tp) + "\n")
+                  + _cusp_note(tp) + _arc_note(tp) + "\n")
     else:
         out.write(text)
     return 0
@@ -104,3 +108,12 @@ def _cusp_note(tp) -> str:
         return ""
     x, y = tp.cusp_at_mm
     return f", worst predicted cusp {tp.cusp_mm:.4f} mm normal to the surface at X{x:.3f} Y{y:.3f}"
+
+
+def _arc_note(tp) -> str:
+    """With arcs: how many, and the feed moves before and after."""
+    if tp.arcs is None:
+        return ""
+    moves = len(tp) - 1
+    return (f"; {len(tp.arcs)} arcs ({tp.arcs.plane}): {moves} feed moves before, "
+            f"{moves - tp.arcs.blocks_saved()} after")

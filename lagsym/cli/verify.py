@@ -19,12 +19,13 @@ result with the exact surface: the worst gouge (the cut below the surface),
 the deepest rapid (G00) into the part, the most material left anywhere on the
 part (its edges included) and where, the scallop between passes (normal to
 the surface, a tool radius or more from the edges) and the area the tool never
-reached.  Any point-list program can be checked this way, lagsym's or not.
+reached.  Any point-list program can be checked this way, lagsym's or not,
+with G02/G03 arcs (I J K centres, G17/G18/G19) too.
 
 exit status: 0 the program passes; 1 it gouges or a rapid goes into the part
 (deeper than the gouge limit), or it leaves more material than --max-left
 (or a scallop above --max-scallop); 2 bad input (an unreadable file, a
-program with arcs or canned cycles).
+program with canned cycles or arcs given by a radius R).
 
 With --job the first file is a job file (TOML, as for lagsym job): the
 program is simulated from the job's block, each part of it (from one M06 to
@@ -48,7 +49,7 @@ _SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": Non
 
 def add_arguments(p) -> None:
     p.add_argument("surface", metavar="SURFACE", help="points file: JSON or CSV with x,y,z (with --job: the job file)")
-    p.add_argument("program", help="G-code program (point list: G00/G01 moves)")
+    p.add_argument("program", help="G-code program (point list: G00/G01 moves, G02/G03 arcs with I J K)")
     p.add_argument("--job", action="store_true",
                    help="SURFACE is a job file (TOML): simulate the whole job from its block, tool by tool")
     p.add_argument("--tool-shape", choices=TOOL_SHAPES, help="ball (default), flat or bull (bull nose: give --corner-radius)")

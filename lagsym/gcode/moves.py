@@ -3,11 +3,16 @@
 It understands what point-list programs use, as LinuxCNC's interpreter reads
 it: modal ``G00``/``G01`` with ``X Y Z F`` words, ``G20``/``G21`` units,
 ``G90``/``G91`` absolute and incremental positions, ``(...)`` and ``;``
-comments, ``%`` framing lines, ``O`` program numbers and ``N`` block numbers.
-Set-up words that do not move the tool (``G17 G40 G43 G49 G54..G59 G80 G94``,
+comments, ``%`` framing lines, ``O`` program numbers and ``N`` block numbers,
+and arcs: ``G02``/``G03`` with ``I J K`` centre offsets in the ``G17``,
+``G18`` or ``G19`` plane, each read as fine straight moves
+(:func:`lagsym.gcode.arcs.arc_points`, within a hundredth of a micrometre of
+the arc), all with the arc's line.
+Set-up words that do not move the tool (``G40 G43 G49 G54..G59 G80 G94``,
 ``S T M H D``) are passed over.  Anything that would move the tool in another
-way (arcs, canned cycles, ``G28``, ``G92``) is refused with the line it is on,
-so a reader of the result never silently sees a different path.
+way (``R``-format arcs, absolute arc centres ``G90.1``, canned cycles,
+``G28``, ``G92``) is refused with the line it is on, so a reader of the
+result never silently sees a different path.
 
 The tool starts at ``(0, 0, 0)``, as in LinuxCNC's interpreter; a number
 without a decimal point is read as a whole number of units (LinuxCNC's
@@ -22,11 +27,12 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ProgramError
+from .arcs import arc_points
 from .words import WordError, numeric_words
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
 
-_IGNORED_G = {17, 40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 94, 97}
+_IGNORED_G = {40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 91.1, 94, 97}
 _IGNORED_LETTERS = set("NSTMHDP")
 
 
@@ -94,25 +100,29 @@ def _blocks(text: str):
 
 
 class _Modal:
-    """The modal state a point list sets: units, absolute or incremental, motion, feed."""
+    """The modal state a point list sets: units, absolute or incremental, motion, plane, feed."""
 
     def __init__(self):
         self.factor = 1.0  # mm per program unit
         self.absolute = True
         self.motion = None
+        self.plane = 17
         self.feed = float("nan")
 
     def read(self, words, where: str) -> dict[str, float]:
-        """Apply a block's modal words; its X, Y, Z targets (program units)."""
+        """Apply a block's modal words; its X, Y, Z targets and I, J, K arc offsets (program units)."""
         target = {}
         for letter, value in words:
             v = float(value)
             if letter == "G":
                 self._g(round(v, 1), value, where)
-            elif letter in "XYZ":
+            elif letter in "XYZIJK":
                 if letter in target:
                     raise ProgramError(f"{where}: {letter} given twice")
                 target[letter] = v
+            elif letter == "R":
+                raise ProgramError(f"{where}: an arc by its radius (R{value}) is not read; "
+                                   "give its centre with I, J, K")
             elif letter == "F":
                 self.feed = v
             elif letter != "O" and letter not in _IGNORED_LETTERS:
@@ -120,15 +130,17 @@ class _Modal:
         return target
 
     def _g(self, g: float, value: str, where: str) -> None:
-        if g in (0, 1):
+        if g in (0, 1, 2, 3):
             self.motion = int(g)
+        elif g in (17, 18, 19):
+            self.plane = int(g)
         elif g in (20, 21):
             self.factor = 25.4 if g == 20 else 1.0
         elif g in (90, 91):
             self.absolute = g == 90
         elif g not in _IGNORED_G:
-            raise ProgramError(f"{where}: G{value} is not a straight move; "
-                               "only point-list programs (G00/G01) can be read")
+            raise ProgramError(f"{where}: G{value} is not a straight or circular move; "
+                               "only point-list programs (G00/G01, G02/G03 with I J K) can be read")
 
 
 def parse_moves(text: str, source: str = "<program>") -> Moves:
@@ -157,21 +169,29 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
             words = numeric_words(block)
         except WordError as e:
             raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
-        target = modal.read(words, f"{source}, line {no}")
+        where = f"{source}, line {no}"
+        target = modal.read(words, where)
         if not target:
             continue
         if modal.motion is None:
-            raise ProgramError(f"{source}, line {no}: a coordinate before any G00 or G01")
+            raise ProgramError(f"{where}: a coordinate before any G00, G01, G02 or G03")
+        offset = [target.pop(letter, 0.0) * modal.factor for letter in "IJK"]
+        arc = modal.motion in (2, 3)
+        if not arc and any(offset):
+            raise ProgramError(f"{where}: I, J or K without an arc (G02 or G03)")
         z_seen = z_seen or "Z" in target
+        before = tuple(pos)
         for k, letter in enumerate("XYZ"):
             if letter in target:
                 v = target[letter] * modal.factor
                 pos[k] = v if modal.absolute else pos[k] + v
-        pts.append(tuple(pos))
-        rapid.append(modal.motion == 0)
-        feeds.append(modal.feed * modal.factor)
-        lines.append(no)
-        zk.append(z_seen)
+        ends = arc_points(before, pos, offset, modal.plane, modal.motion == 3, where) if arc else [tuple(pos)]
+        for end in ends:
+            pts.append(tuple(end))
+            rapid.append(modal.motion == 0)
+            feeds.append(modal.feed * modal.factor)
+            lines.append(no)
+            zk.append(z_seen)
     return Moves(
         points_mm=np.array(pts, dtype=float).reshape(-1, 3),
         start_mm=np.array(start, dtype=float),

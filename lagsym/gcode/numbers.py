@@ -11,9 +11,11 @@ import math
 from decimal import ROUND_HALF_EVEN, Decimal
 from fractions import Fraction
 
+import numpy as np
+
 from ..errors import ProgramError
 
-__all__ = ["fixed"]
+__all__ = ["fixed", "program_ints"]
 
 
 def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = False) -> str:
@@ -42,3 +44,22 @@ def fixed(value: float | Fraction | Decimal, decimals: int = 3, trim: bool = Fal
         text = text.rstrip("0")
     return text
 
+
+
+def program_ints(points_mm, unit_factor: float, digits: int) -> np.ndarray:
+    """Points (mm) in units of the program's last decimal: X and Y to the nearest, Z rounded up.
+
+    Rounding Z up means a written point never lies below its cutter location,
+    so the rounding cannot gouge; it raises a point by less than one unit of
+    the last decimal.  ``unit_factor`` is program units per mm.
+
+    Examples
+    --------
+    >>> program_ints(np.array([[1.0004, 2.0, -0.0008]]), 1.0, 3).tolist()
+    [[1000, 2000, 0]]
+    """
+    v = np.asarray(points_mm, dtype=float) * (unit_factor * 10 ** digits)
+    out = np.empty(v.shape, dtype=np.int64)
+    out[:, :2] = np.rint(v[:, :2])
+    out[:, 2] = np.ceil(v[:, 2] - 1e-6)  # 1e-6 of a unit: a value that is a whole unit up to float error stays
+    return out

@@ -38,7 +38,7 @@ from .ballend import TIP_OUTPUTS, ball_offsets, ball_tips, checked_tip_lift, con
 from .form import RowForm, point_statements, row_form, row_statements
 from .model import Assign, Clamp, Loop, Move, add, const, mul, sub, var
 from .raster import MacroRaster, macro_raster
-from .rounding import resolution, round_statement, tip_statements
+from .rounding import resolution, round_statement, slope_lift, tip_statements
 
 __all__ = ["MacroLoops", "macro_loops", "zigzag_loops", "exact_height"]
 
@@ -73,6 +73,9 @@ class MacroLoops:
         what a rounded tip's height is raised by.
     title : str
         The program's name in its first comment.
+    slope_lift : Fraction
+        Where the control cannot round (Heidenhain), what every height is
+        raised by instead (:func:`~lagsym.macro.rounding.slope_lift`); 0 elsewhere.
     """
 
     body: tuple
@@ -88,6 +91,7 @@ class MacroLoops:
     resolution: Fraction = Fraction(0)
     tip_lift: Fraction = Fraction(0)
     title: str = "LAGSYM SURFACE MACRO"
+    slope_lift: Fraction = Fraction(0)
 
     def reference(self, p: Fraction, r: Fraction) -> tuple:
         """The point (P, R, Z) the program should reach at raster position (p, r), computed on the PC.
@@ -153,11 +157,13 @@ def macro_loops(surface: LagrangeSurface, settings: MachineSettings, raster: Ras
     rounding = (round_statement(var("r"), unit),) if unit else ()
     row_code = rounding + tuple(row_statements(rf, var("r")))
     point_code = ((round_statement(var("p"), unit),) if unit else ()) + tuple(point_statements(rf, var("p"), var("z")))
-    finish = (Assign(var("z"), add(var("z"), const(unit / 2))),) if unit else ()
+    lift = unit / 2 if unit else slope_lift(surface, settings)
+    finish = (Assign(var("z"), add(var("z"), const(lift))),) if lift else ()
     p0, r0 = counted.points.start, counted.rows.start
     return MacroLoops(body=zigzag_loops(counted, row_code, point_code, finish_code=finish), raster=counted, form=rf,
-                      start=_in_xyz(counted, p0, r0, exact_height(rf, p0, r0) + unit / 2),
-                      row_code=row_code, point_code=point_code, finish_code=finish, resolution=unit)
+                      start=_in_xyz(counted, p0, r0, exact_height(rf, p0, r0) + lift),
+                      row_code=row_code, point_code=point_code, finish_code=finish, resolution=unit,
+                      slope_lift=Fraction(0) if unit else lift)
 
 
 def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: MacroRaster, tool: Tool,
@@ -169,10 +175,13 @@ def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: Ma
     lift = checked_tip_lift(rf, counted, offset, unit, surface.grid.source, settings.unit_factor)
     row_code = tuple(row_statements(rf, var("r"), slopes=True))
     point_code = tuple(point_statements(rf, var("p"), var("z"), slopes=True)) + offset_statements(radius, offset)
-    finish = tip_statements(unit, lift) if unit else ()
+    raise_z = Fraction(0) if unit else slope_lift(surface, settings)
+    finish = tip_statements(unit, lift) if unit else (
+        (Assign(var("zt"), add(var("zt"), const(raise_z))),) if raise_z else ())
     p0, r0, z0 = ball_tips(rf, radius, offset, np.array([float(counted.points.start)]),
                            np.array([float(counted.rows.start)]), unit, lift)
+    z0 = z0 + float(raise_z)
     return MacroLoops(body=zigzag_loops(counted, row_code, point_code, TIP_OUTPUTS, finish), raster=counted, form=rf,
                       start=_in_xyz(counted, float(p0[0]), float(r0[0]), float(z0[0])),
                       row_code=row_code, point_code=point_code, finish_code=finish, outputs=TIP_OUTPUTS,
-                      ball_radius=radius, ball_offset=offset, resolution=unit, tip_lift=lift)
+                      ball_radius=radius, ball_offset=offset, resolution=unit, tip_lift=lift, slope_lift=raise_z)

@@ -16,7 +16,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ._placement import placement
 from .ballend import ball_offsets, ball_tips, checked_tip_lift, contact_form, is_ball, refuse_flat_end, tip_points
 from .raster import macro_raster, raster_positions
-from .rounding import resolution, round_half_away
+from .rounding import resolution, round_half_away, slope_lift
 
 __all__ = ["points_at", "planned_points"]
 
@@ -58,11 +58,12 @@ def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: 
         if unit:
             x, y = round_half_away(x, float(unit)), round_half_away(y, float(unit))
         pts = points_at(surface, settings, tool, x, y)
-        pts[:, 2] += float(unit / 2)
+        pts[:, 2] += float(unit / 2 if unit else slope_lift(surface, settings))
         return pts
     radius, offset = ball_offsets(settings, tool)
     form = contact_form(surface, settings, counted.direction)
     lift = checked_tip_lift(form, counted, offset, unit)
     p, r = (x, y) if counted.direction == "x" else (y, x)
     pt, rt, zt = ball_tips(form, radius, offset, p, r, unit, lift)
+    zt = zt + float(0 if unit else slope_lift(surface, settings))
     return np.column_stack([pt, rt, zt] if counted.direction == "x" else [rt, pt, zt])

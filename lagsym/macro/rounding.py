@@ -18,9 +18,27 @@ with ``S = 10**decimals``, and computes Z there:
   bend of the tip's path over the raster (rounded up to a thousandth of a unit).
 
 Z is then raised by half a unit, so that a control rounding it to the
-nearest unit still goes at or above it.  Heidenhain FN arithmetic has no
-rounding, so those programs move to the values as computed (the TNC takes
-them at its own resolution).
+nearest unit still goes at or above it.
+
+Heidenhain FN arithmetic has no rounding function: the TNC 355 and TNC 2500
+era controls of Bridgeport Interact mills offer ``FN 0``-``FN 14`` (assign,
+the four operations, square root, sine, cosine, root of a sum of squares,
+four conditional jumps, an angle from two sides, an error number), and none
+of them gives a whole number (``INT`` and the formula entry came with later
+TNCs).  So the program cannot compute Z at the position the control will go
+to; instead every Z is raised by a proved bound of how much the height can
+change between the computed position and the one reached
+(:func:`slope_lift`).  The TNC takes a position at its resolution, the
+program's last decimal, rounding or truncating: X, Y and Z each move by less
+than one unit ``u``.  The programmed height is a function of the position
+whose slopes are the surface's own (for a ball end, the tip's height over the
+tip position has the slopes of the surface at the contact point), so by the
+mean value theorem it changes by at most ``(Lx + Ly) u`` with ``Lx`` and
+``Ly`` bounds of ``|F_x|`` and ``|F_y|`` over the box: the largest on a
+257 x 257 grid plus how much they can grow between its nodes, from bounds of
+the second partials (the sums of their absolute Chebyshev coefficients: every
+``|T_i T_j|`` is at most 1 there).  Z is raised by ``(1 + Lx + Ly) u``,
+rounded up to a thousandth of a unit, which also covers Z itself.
 """
 
 from __future__ import annotations
@@ -33,7 +51,7 @@ import numpy as np
 from ..machine import MachineSettings
 from .model import Assign, Var, add, const, div, mul, round_, sub, var
 
-__all__ = ["ROUNDING_DIALECTS", "resolution", "round_statement", "round_half_away", "tip_statements",
+__all__ = ["ROUNDING_DIALECTS", "resolution", "slope_lift", "round_statement", "round_half_away", "tip_statements",
            "tips_on_grid", "tip_lift"]
 
 ROUNDING_DIALECTS = ("fanuc", "linuxcnc")  # macro languages with ROUND[..]
@@ -44,6 +62,51 @@ def resolution(settings: MachineSettings) -> Fraction:
     if settings.dialect not in ROUNDING_DIALECTS:
         return Fraction(0)
     return Fraction(1, 10 ** settings.digits)
+
+
+def slope_lift(surface, settings: MachineSettings) -> Fraction:
+    """For a control that cannot round (Heidenhain FN): the proved raise of Z, ``(1 + Lx + Ly) u``, exact.
+
+    0 where the macro rounds on the control (:data:`ROUNDING_DIALECTS`).  See
+    the module docstring for the bound.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_points
+    >>> from lagsym.lagrange import lagrange_surface
+    >>> s = lagrange_surface(grid_from_points([(0, 0, 0), (0, 1, 0), (1, 0, 2), (1, 1, 2)]))  # z = 2 x
+    >>> slope_lift(s, MachineSettings(dialect="heidenhain"))
+    Fraction(3, 1000)
+    """
+    if settings.dialect in ROUNDING_DIALECTS:
+        return Fraction(0)
+    from ..evaluate import surface_evaluator
+
+    slopes = sum(_slope_bounds(surface_evaluator(surface)))
+    unit = Fraction(1, 10 ** settings.digits)
+    step = unit / 1000
+    # 1e-12 of the slopes for the coefficients' float rounding; a millionth of a step (1e-9 of a unit) keeps a
+    # whole number whole.
+    return step * math.ceil((1.0 + slopes * (1 + 1e-12)) * 1000 - 1e-6)
+
+
+def _slope_bounds(ev, samples: int = 257) -> tuple[float, float]:
+    """Proved bounds of ``|F_x|`` and ``|F_y|`` over the box: the largest on a grid plus how far they can grow off it.
+
+    Between grid nodes ``hx``, ``hy`` apart a point is within ``hx / 2`` and
+    ``hy / 2`` of one, where ``F_x`` differs by at most ``Bxx hx / 2 + Bxy hy / 2``,
+    with ``B`` the sums of the absolute Chebyshev coefficients of the second
+    partials (bounds of them over the box, as every ``|T_i T_j| <= 1`` there).
+    """
+    from numpy.polynomial import chebyshev as C
+
+    x0, x1, y0, y1 = (float(v) for v in ev.bounds)
+    hx, hy = (x1 - x0) / (samples - 1), (y1 - y0) / (samples - 1)
+    u = np.linspace(-1.0, 1.0, samples)
+    b = {d: float(np.abs(ev.partial(*d)).sum()) for d in ((2, 0), (1, 1), (0, 2))}
+    lx = float(np.abs(C.chebgrid2d(u, u, ev.partial(1, 0))).max()) + (b[2, 0] * hx + b[1, 1] * hy) / 2
+    ly = float(np.abs(C.chebgrid2d(u, u, ev.partial(0, 1))).max()) + (b[1, 1] * hx + b[0, 2] * hy) / 2
+    return lx, ly
 
 
 def round_statement(v: Var, unit: Fraction, target: Var | None = None) -> Assign:

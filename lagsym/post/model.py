@@ -21,6 +21,7 @@ from ..gcode.limits import check_axis, check_blocks, check_settings, resolution
 from ..gcode.numbers import fixed
 from ..gcode.text import COOLANT_ON, iso_comment, surface_comment
 from ..machine import MachineSettings
+from .arcs import feed_blocks
 from .moves import format_moves
 
 __all__ = ["PointProgram", "point_program", "iso_comment", "body", "units_word", "surface_comment", "check_clearance",
@@ -41,12 +42,15 @@ class PointProgram:
         A comment naming the part (ISO characters only in the output).
     tool_comment : str
         A comment naming the cutter.
+    arcs : Arcs or None
+        Runs of the points written as arcs (:mod:`lagsym.post.arcs`).
     """
 
     points_mm: np.ndarray
     settings: MachineSettings
     title: str = ""
     tool_comment: str = ""
+    arcs: object = None
 
     def __post_init__(self):
         a = np.array(self.points_mm, dtype=float)
@@ -74,7 +78,8 @@ def point_program(toolpath, settings: MachineSettings, title: str = "") -> Point
     tool = f"T{settings.tool_number} {t.label}"
     if toolpath.cusp_mm is not None:  # rows from a scallop height: the worst cusp they are predicted to leave
         tool += f" CUSP AT MOST {toolpath.cusp_mm:.4f} MM NORMAL TO SURFACE"
-    return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool)
+    return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool,
+                        arcs=getattr(toolpath, "arcs", None))
 
 
 def check_clearance(settings: MachineSettings, top_mm: float) -> None:
@@ -122,10 +127,9 @@ def body(program: PointProgram, tool_length: bool = True) -> list[str]:
         out.append(f"Z{program.num(approach)}")
         above = (p[0, 0], p[0, 1], approach)
     out.extend(format_moves(p[:1], s, previous=above, first_feed=s.plunge_feed_mm_min))
-    rest = format_moves(p[1:], s, previous=p[0], first_feed=s.feed_mm_min, motion="") if len(p) > 1 else []
-    if rest:
-        rest[0] = rest[0].lstrip()
-    out.extend(rest)
+    if program.arcs is not None and len(program.arcs):
+        check_axis(np.asarray(program.arcs.centre_mm).ravel() * s.unit_factor, s, "an arc centre")
+    out.extend(feed_blocks(p, program.arcs, s))
     out.append(f"G00 Z{safe}")
     out += coolant_off(s)
     return out

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..machine import MachineSettings
-from ..gcode.numbers import fixed
+from ..gcode.numbers import fixed, program_ints
 
 __all__ = ["format_moves"]
 
@@ -28,17 +28,8 @@ def _words(letter: str, ints: np.ndarray, digits: int, changed: np.ndarray) -> l
 
 
 def _quantize(points_mm, settings: MachineSettings) -> np.ndarray:
-    """Points in units of the program's last decimal: X and Y to the nearest, Z rounded up.
-
-    Rounding Z up means a written point never lies below its cutter location,
-    so the rounding cannot gouge; it raises a point by less than one unit of
-    the last decimal.
-    """
-    v = np.asarray(points_mm, dtype=float) * (settings.unit_factor * 10 ** settings.digits)
-    out = np.empty(v.shape, dtype=np.int64)
-    out[:, :2] = np.rint(v[:, :2])
-    out[:, 2] = np.ceil(v[:, 2] - 1e-6)  # 1e-6 of a unit: a value that is a whole unit up to float error stays
-    return out
+    """Points in units of the program's last decimal (:func:`~lagsym.gcode.numbers.program_ints`)."""
+    return program_ints(points_mm, settings.unit_factor, settings.digits)
 
 
 def format_moves(points_mm: np.ndarray, settings: MachineSettings, previous=None, first_feed: float | None = None,

@@ -10,7 +10,7 @@ the machine.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
 from . import chordal
+from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
 from .filter import filter_rows
 from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
@@ -63,6 +64,9 @@ class Toolpath:
         measured normal to the surface (mm); None for a fixed side step.
     cusp_at_mm : tuple of float or None
         Where that cusp is, ``(x, y)`` on the machine.
+    arcs : Arcs or None
+        With ``raster.arcs``, the circular moves that replace runs of the
+        points (:mod:`lagsym.toolpath.arcs`); None without.
     """
 
     points_mm: np.ndarray
@@ -76,6 +80,7 @@ class Toolpath:
     fine_points: int = 0
     cusp_mm: float | None = None
     cusp_at_mm: tuple[float, float] | None = None
+    arcs: Arcs | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -151,7 +156,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
-    return Toolpath(
+    tp = Toolpath(
         **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
                           _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
         tool=tool,
@@ -162,6 +167,18 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         fine_points=len(path.x),
         **_cusp(scallop, raster.direction, settings),
     )
+    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+
+
+def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSettings, kappa: float) -> Toolpath:
+    """The toolpath with the arcs fitted along its rows from the fine samples (:func:`.arcs.fit_arcs`)."""
+    fine = np.stack(_place(settings, path.x, path.y, path.z), axis=1)
+    x0, x1, y0, y1 = tp.bounds_mm
+    raster = tp.raster
+    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa,
+                                     raster.chordal_tolerance_mm, settings.unit_factor, settings.digits,
+                                     settings.units, (x0, x1) if raster.direction == "x" else (y0, y1),
+                                     cl.radius * cl.mm_per_unit, CHORD_MM.get(settings.dialect, 0.0)))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
