@@ -22,12 +22,13 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ProgramError
-from .words import WordError, numeric_words
+from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
 
 _IGNORED_G = {17, 40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 94, 97}
 _IGNORED_LETTERS = set("NSTMHDP")
+_AXIS = {"X": 0, "Y": 1, "Z": 2}
 
 
 @dataclass(frozen=True)
@@ -153,20 +154,27 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     pts, rapid, feeds, lines, zk = [], [], [], [], []
     z_seen = False
     for no, raw, block in _blocks(text):
-        try:
-            words = numeric_words(block)
-        except WordError as e:
-            raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
-        target = modal.read(words, f"{source}, line {no}")
+        plain = plain_move(block)
+        if plain is not None:  # most blocks of a point list: no need to go word by word
+            if plain[0] is not None:
+                modal.motion = int(plain[0])
+            if plain[4] is not None:
+                modal.feed = float(plain[4])
+            target = {letter: float(v) for letter, v in zip("XYZ", plain[1:4]) if v is not None}
+        else:
+            try:
+                words = numeric_words(block)
+            except WordError as e:
+                raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
+            target = modal.read(words, f"{source}, line {no}")
         if not target:
             continue
         if modal.motion is None:
             raise ProgramError(f"{source}, line {no}: a coordinate before any G00 or G01")
         z_seen = z_seen or "Z" in target
-        for k, letter in enumerate("XYZ"):
-            if letter in target:
-                v = target[letter] * modal.factor
-                pos[k] = v if modal.absolute else pos[k] + v
+        for letter, v in target.items():
+            k = _AXIS[letter]
+            pos[k] = v * modal.factor if modal.absolute else pos[k] + v * modal.factor
         pts.append(tuple(pos))
         rapid.append(modal.motion == 0)
         feeds.append(modal.feed * modal.factor)
