@@ -31,6 +31,7 @@ __all__ = ["press_moves", "height_map_axes", "sweep", "tool_grid", "check_work",
 _MOVES_PER_PASS = 200_000  # moves split and swept at a time
 _PIECE_CELLS = 8.0  # longest segment swept, sideways, in cells
 _CHUNK = 16384  # segments swept together
+_FEW = 1024  # fewer segments than this are swept over their whole footprint at once (see _sweep_few)
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
 MAX_CONTACTS = 20_000_000_000  # segments swept (all, before those far from the box are dropped) times cells under the tool
 
@@ -80,7 +81,7 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
         def run(chunks):
             with np.errstate(invalid="ignore"):
                 for chunk in chunks:
-                    _sweep_chunk(chunk, geometry, lowest)
+                    (_sweep_chunk if len(chunk[1]) >= _FEW else _sweep_few)(chunk, geometry, lowest)
 
         if stripes == 1:
             run(work[0])
@@ -175,6 +176,27 @@ def _sweep_chunk(chunk, geometry, lowest):
             cur = view[base]
             np.fmin(cur, lowest(ax + ay[j + ky], ex + ey[j + ky], seg), out=cur)
             view[base] = cur
+
+
+def _sweep_few(chunk, geometry, lowest):
+    """As :func:`_sweep_chunk` for a handful of segments: all offsets at once, a few segments at a time.
+
+    The offset loop costs the same Python work for two segments as for
+    thousands; here each NumPy operation covers every cell of the square
+    footprint of up to 64 segments, and ``np.fmin.at`` lowers the map.
+    """
+    (az, azr, length, m, k), base, bx, by, (ux, uy), _ = chunk
+    hx, hy, _, kx, ky, stride, flat = geometry
+    di, dj = np.arange(-kx, kx + 1), np.arange(-ky, ky + 1)
+    offsets = (di * stride)[:, None] + dj[None, :]
+    for s in range(0, len(base), 64):
+        g = slice(s, s + 64)
+        wx, wy = bx[g, None] + di * hx, by[g, None] + dj * hy
+        ca = (wx * ux[g, None])[:, :, None] + (wy * uy[g, None])[:, None, :]
+        ce = (-wx * uy[g, None])[:, :, None] + (wy * ux[g, None])[:, None, :]
+        v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)))
+        under = ~np.isnan(v)
+        np.fmin.at(flat, (base[g, None, None] + offsets)[under], v[under])
 
 
 def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tuple[np.ndarray, np.ndarray]:
