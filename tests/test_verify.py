@@ -249,6 +249,11 @@ def test_readme_finishing_example(run_cli, tmp_path):
     # Independently: a ball swept along the program's moves, against the exact polynomial, on the cells of
     # the four box edges: nothing is left there beyond a cusp between passes (on flat ground 0.010 mm).
     moves = parse_moves(prog.read_text())
+    known = np.asarray(moves.z_known)
+    feed = int((known & np.concatenate([[False], known[:-1]]) & ~np.asarray(moves.rapid)).sum())
+    readme = " ".join((EXAMPLES.parent / "README.md").read_text().split())
+    assert f"{feed:,} feed moves, 401 x 401 cells" in doc and f"{feed:,} feed moves over 401x401 cells" in readme
+    assert "simulated 401 x 401 cells" in out
     p = moves.points_mm[np.asarray(moves.z_known)]
     p = p[p[:, 2] < 79.0]
     surf = lagrange_surface(read_points(ex4))

@@ -33,7 +33,7 @@ _PIECE_CELLS = 8.0  # longest segment swept, sideways, in cells
 _CHUNK = 16384  # segments swept together
 _FEW = 1024  # fewer segments than this are swept over their whole footprint at once (see _sweep_few)
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
-MAX_CONTACTS = 20_000_000_000  # segments swept (all, before those far from the box are dropped) times cells under the tool
+MAX_CONTACTS = 20_000_000_000  # segments (all, before those far from the box are dropped) times cells under the tool
 
 
 def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> int:
@@ -69,10 +69,11 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
         # The window of cells they reach, with room for every offset of the footprint.
         i0, j0 = int(ix.min()) - kx, int(iy.min()) - ky
         pad = np.full((int(ix.max()) + kx + 1 - i0, int(iy.max()) + ky + 1 - j0), np.inf)
-        rows, cols = slice(max(i0, 0), min(i0 + pad.shape[0], len(xs))), slice(max(j0, 0), min(j0 + pad.shape[1], len(ys)))
+        rows = slice(max(i0, 0), min(i0 + pad.shape[0], len(xs)))
+        cols = slice(max(j0, 0), min(j0 + pad.shape[1], len(ys)))
         inner = (slice(rows.start - i0, rows.stop - i0), slice(cols.start - j0, cols.stop - j0))
         pad[inner] = cut[rows, cols]
-        stripes = 2 * workers if pad.shape[0] >= 2 * workers * (2 * kx + 1) else 1
+        stripes = 2 * workers if workers > 1 and pad.shape[0] >= 2 * workers * (2 * kx + 1) else 1
         work = [[] for _ in range(stripes)]
         for stripe, chunk in _chunks(a, b, (ix - i0, iy - j0), (i0, j0), (xs, ys, r), pad.shape, stripes):
             work[stripe].append(chunk)

@@ -45,7 +45,7 @@ BISECTIONS = 30
 def lowest_ball(a, e, seg, r):
     """Lowest height of a ball's lower surface over the cells at ``(a, e)`` of the segments ``seg``; NaN where none.
 
-    ``seg`` is ``(az, az + r, length, m, k)`` per segment with ``k = m / sqrt(1 + m**2)``; arrays broadcast with ``a``, ``e``.
+    ``seg`` is ``(az, az + r, length, m, k)`` per segment, ``k = m / sqrt(1 + m**2)``; broadcast with ``a``, ``e``.
     """
     _, azr, length, m, k = seg
     e2 = e * e
@@ -78,7 +78,7 @@ def lowest_flat(a, e, seg, r):
 
 
 def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS):
-    """Lowest height of a bull nose's lower surface over the cells at ``(a, e)`` (bisection on ``g'``); NaN where none."""
+    """Lowest height of a bull nose's lower surface over the cells at ``(a, e)`` (by bisection); NaN where none."""
     az, _, length, m, _ = seg
     flat = r - corner
     e2 = e * e
@@ -104,6 +104,6 @@ def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS):
 
 
 def bull_resolution(corner: float, longest_mm: float, steps: int = BISECTIONS) -> float:
-    """How much lower than :func:`lowest_bull` a bull nose can sweep along moves up to ``longest_mm`` long (sideways)."""
+    """How much lower than :func:`lowest_bull` a bull nose can sweep along moves up to ``longest_mm`` sideways."""
     w = min(longest_mm, 1.0e300) / 2.0**steps
     return math.sqrt(max(2.0 * corner * w - w * w, 0.0))
