@@ -54,7 +54,7 @@ def page() -> str:
         "`sample --max-points` (default 1e8 points), `toolpath --max-points` (2e7 fine",
         "drop-cutter samples), `rough` and `job --max-points` (2e7 points an operation) and",
         "`--max-samples` (1e5 drop-cutter samples a roughing level), `verify --max-cells` (1.6e7",
-        "height-map cells) and `--max-contacts` (2e10 tool positions times cells under the tool),",
+        "height-map cells) and `--max-contacts` (2e10 segments swept times cells under the tool),",
         "`equation --max-terms` (2500 terms).  A program `simulate` runs that would never end",
         "stops within seconds with the runaway alarm (exit 2): at once when a loop can be seen in",
         "the text never to end (its condition one nothing in it changes) or the run comes back to a",

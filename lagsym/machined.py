@@ -124,7 +124,7 @@ class MachinedPart:
 
 
 def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: dict[int, Tool], block,
-                 placement: Placement = Placement(), cell_mm: float | None = None, dz_mm: float = 0.01,
+                 placement: Placement = Placement(), cell_mm: float | None = None,
                  program_resolution_mm: float = 0.0005, gouge_limit_mm: float | None = None,
                  max_cells: int | None = MAX_CELLS) -> MachinedPart:
     """Simulate a whole job's program from the block ``(x0, x1, y0, y1, top_mm)`` (machine mm).
@@ -159,7 +159,7 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
             raise InputError(f"the program changes to tool T{number} (line {first}), which the job does not name; "
                              f"its tools: {', '.join(f'T{k}' for k in sorted(tools))}")
         before = cut.copy()
-        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number], dz_mm)
+        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number])
         resolutions.append(res)
         left = cut - surf
         stages.append(Stage(number, tools[number], first, len(a), float((before - cut).sum() * hx * hy), crash, at,
@@ -246,7 +246,7 @@ def _stages(moves: Moves, changes):
         yield number, first, path[:-1][k], path[1:][k], np.asarray(moves.rapid, dtype=bool)[k]
 
 
-def _run(cut, xs, ys, a, b, rapid, tool: Tool, dz_mm):
+def _run(cut, xs, ys, a, b, rapid, tool: Tool):
     """Press one stage's moves in order; the deepest material a rapid went through, where, and the resolution."""
     deepest, at, res = 0.0, (float(xs[0]), float(ys[0])), 0.0
     # Runs of feed moves and of rapids, in program order: a rapid's cut is measured against the map before it.
@@ -255,10 +255,10 @@ def _run(cut, xs, ys, a, b, rapid, tool: Tool, dz_mm):
         if e <= s:
             continue
         if not rapid[s]:
-            res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, dz_mm)[1]
+            res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool)[1]
             continue
         before = cut.copy()
-        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, dz_mm)[1]
+        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool)[1]
         drop = before - cut
         k = int(np.argmax(drop))
         if drop.flat[k] > deepest:

@@ -149,3 +149,46 @@ def brute_ball(f, box, cx, cy, radius, n=41, rounds=8):
         mx, my = px[rows, k][:, None], py[rows, k][:, None]
         half = half * 4.0 / (n - 1)
     return best
+
+
+def tool_height(d2, radius, corner):
+    """Height of a cutter's lower surface above its tip at squared distance ``d2`` from its axis (``inf`` beyond).
+
+    Written here apart from ``lagsym.machine.cutter_profile``: a flat end of
+    radius ``radius - corner`` rounded by a quarter circle of ``corner``.
+    """
+    d = np.sqrt(d2)
+    out = np.full(np.shape(d2), np.inf)
+    flat = radius - corner
+    inside = d <= radius
+    out[inside & (d <= flat)] = 0.0
+    ring = inside & (d > flat)
+    out[ring] = corner - np.sqrt(np.maximum(corner**2 - (d[ring] - flat) ** 2, 0.0))
+    return out
+
+
+def swept_tool(moves, radius, corner, xs, ys, n=201, rounds=7):
+    """Lowest point a cutter reaches over each cell centre along the straight moves ``(a, b)`` (tip positions).
+
+    For each move and cell, the tip's position along the move is searched on
+    ``n`` points, then ``rounds`` times again on ``n`` points around the best
+    found, each time ``n / 4`` times closer.  Every value is the tool's
+    height at a real position, so never below the true lowest point; the
+    height along a move is convex, so the zooms close in on it.
+    """
+    gx, gy = (v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+    out = np.full(gx.shape, np.inf)
+    for a, b in moves:
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        centre, half = np.full(gx.shape, 0.5), np.full(gx.shape, 0.5)
+        best = np.full(gx.shape, np.inf)
+        for _ in range(rounds + 1):
+            t = np.clip(centre[:, None] + half[:, None] * np.linspace(-1.0, 1.0, n)[None, :], 0.0, 1.0)
+            p = a[None, None, :] + t[..., None] * (b - a)[None, None, :]
+            z = p[..., 2] + tool_height((gx[:, None] - p[..., 0]) ** 2 + (gy[:, None] - p[..., 1]) ** 2, radius, corner)
+            k = np.argmin(z, axis=1)
+            rows = np.arange(len(k))
+            best = np.minimum(best, z[rows, k])
+            centre, half = t[rows, k], half * 4.0 / (n - 1)
+        out = np.minimum(out, best)
+    return out.reshape(len(xs), len(ys))

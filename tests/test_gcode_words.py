@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from lagsym.errors import ProgramError
 from lagsym.gcode import WordError, numeric_words, parse_moves, strip_comments, words
@@ -83,3 +84,23 @@ def test_the_macro_writers_keep_the_controls_limits():
         assert limits.LIMITS[dialect].variables["full"] == limits.MACRO_VARIABLES[dialect]
     for dialect, ranges in limits.MACRO_VARIABLES.items():
         assert all(any(lo <= a and b <= hi for lo, hi in limits.VARIABLE_RANGES[dialect]) for a, b in ranges)
+
+
+@settings(max_examples=300)
+@given(st.lists(st.sampled_from(["G0", "G00", "G1", "G01", "G1.5", "G010", "G2", "X", "Y", "Z", "F", "x", "N10",
+                                 "(C)", "X1.2.3"]), max_size=6),
+       st.lists(st.sampled_from(["1", "-.5", "+2.", "12.345", "0", ".", ""]), min_size=6, max_size=6),
+       st.sampled_from([" ", "", "  "]))
+def test_the_plain_move_fast_path_reads_what_numeric_words_reads(letters, values, gap):
+    """Whenever ``plain_move`` takes a block, ``numeric_words`` finds the same words in it."""
+    from lagsym.gcode.words import plain_move
+
+    block = gap.join(w + (v if len(w) == 1 else "") for w, v in zip(letters, values)).strip()
+    fast = plain_move(block)
+    if fast is None:
+        return
+    slow = dict(numeric_words(block))
+    assert len(slow) == len(numeric_words(block))  # each letter once
+    g = slow.pop("G", None)
+    assert fast[0] == (None if g is None else g.lstrip("0") or "0")
+    assert fast[1:] == tuple(slow.pop(k, None) for k in "XYZF") and not slow

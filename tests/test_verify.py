@@ -18,7 +18,7 @@ from lagsym.toolpath import plan_toolpath
 from lagsym.verify import gouge_limit, program_resolution_mm, simulate_cut
 
 from conftest import EXAMPLES
-from cutters import exact_heights, swept_ball
+from cutters import exact_heights, swept_ball, swept_tool
 
 EX2 = EXAMPLES / "paper-example-2.json"
 
@@ -85,6 +85,30 @@ def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
     tp = plan_toolpath(surf, tool, RasterSpec("x", 20.0, 0.25), s)
     good = parse_moves(write_program(point_program(tp, s)))
     assert not simulate_cut(surf, good, tool, Placement(scale), cell_mm=0.25).gouges
+
+
+@pytest.mark.parametrize("shape, corner", [("ball", 1.5), ("flat", 0.0), ("bull", 0.5)])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_the_height_map_is_the_swept_tool_within_the_resolution(shape, corner, seed):
+    """Random moves in every direction, short and long, level, climbing and plunging, against a brute-force sweep."""
+    from lagsym.verify import press_moves
+
+    rng = np.random.default_rng(seed)
+    xs, ys = np.linspace(0.0, 6.0, 25), np.linspace(0.0, 4.0, 17)
+    a = rng.uniform([-2.0, -2.0, -1.0], [8.0, 6.0, 1.0], (12, 3))
+    b = a + rng.uniform(-3.0, 3.0, (12, 3)) * rng.choice([0.05, 1.0], (12, 1))
+    b[0, :2] = a[0, :2]  # a plunge
+    b[1, 2] = a[1, 2]  # a level move
+    tool = Tool(shape, 3.0, corner_radius_mm=corner) if shape == "bull" else Tool(shape, 3.0)
+    cut = np.full((len(xs), len(ys)), np.inf)
+    count, resolution = press_moves(cut, xs, ys, a, b, tool)
+    ref = swept_tool(zip(a, b), 1.5, corner if shape != "ball" else 1.5, xs, ys)
+    assert count >= 12 and resolution <= 1e-4
+    assert np.array_equal(np.isfinite(cut), np.isfinite(ref)) and np.isfinite(ref).mean() > 0.3
+    both = np.isfinite(ref)
+    # Never below the tool (no cut invented), never above the lowest point the search found by more than the resolution.
+    assert (cut[both] >= ref[both] - 1e-7).all(), float((ref - cut)[both].max())
+    assert (cut[both] <= ref[both] + resolution + 1e-9).all(), float((cut - ref)[both].max())
 
 
 def test_moves_before_the_first_z_do_not_cut():
@@ -225,6 +249,11 @@ def test_readme_finishing_example(run_cli, tmp_path):
     # Independently: a ball swept along the program's moves, against the exact polynomial, on the cells of
     # the four box edges: nothing is left there beyond a cusp between passes (on flat ground 0.010 mm).
     moves = parse_moves(prog.read_text())
+    known = np.asarray(moves.z_known)
+    feed = int((known & np.concatenate([[False], known[:-1]]) & ~np.asarray(moves.rapid)).sum())
+    readme = " ".join((EXAMPLES.parent / "README.md").read_text().split())
+    assert f"{feed:,} feed moves, 401 x 401 cells" in doc and f"{feed:,} feed moves over 401x401 cells" in readme
+    assert "simulated 401 x 401 cells" in out
     p = moves.points_mm[np.asarray(moves.z_known)]
     p = p[p[:, 2] < 79.0]
     surf = lagrange_surface(read_points(ex4))

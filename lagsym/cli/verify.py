@@ -73,7 +73,7 @@ def add_arguments(p) -> None:
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
     p.add_argument("--max-contacts", type=count(1, 10**14), metavar="N",
-                   help=f"refuse a simulation of more than N tool positions times cells under the tool "
+                   help=f"refuse a simulation of more than N segments swept times cells under the tool "
                         f"(default {MAX_CONTACTS:.2g})")
 
 

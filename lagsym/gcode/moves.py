@@ -28,7 +28,7 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import ProgramError
 from .arcs import arc_points
-from .words import WordError, numeric_words
+from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
 
@@ -165,12 +165,20 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     pts, rapid, feeds, lines, zk = [], [], [], [], []
     z_seen = False
     for no, raw, block in _blocks(text):
-        try:
-            words = numeric_words(block)
-        except WordError as e:
-            raise ProgramError(f"{source}, line {no}: {e} in {raw.strip()!r}") from None
         where = f"{source}, line {no}"
-        target = modal.read(words, where)
+        plain = plain_move(block)
+        if plain is not None:  # most blocks of a point list: no need to go word by word
+            if plain[0] is not None:
+                modal.motion = int(plain[0])
+            if plain[4] is not None:
+                modal.feed = float(plain[4])
+            target = {letter: float(v) for letter, v in zip("XYZ", plain[1:4]) if v is not None}
+        else:
+            try:
+                words = numeric_words(block)
+            except WordError as e:
+                raise ProgramError(f"{where}: {e} in {raw.strip()!r}") from None
+            target = modal.read(words, where)
         if not target:
             continue
         if modal.motion is None:

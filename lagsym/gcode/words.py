@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["WordError", "FUNCTIONS", "strip_comments", "numeric_words", "words"]
+__all__ = ["WordError", "FUNCTIONS", "strip_comments", "numeric_words", "plain_move", "words"]
 
 FUNCTIONS = ("SQRT", "ABS", "FIX", "FUP", "ROUND", "SIN", "COS", "TAN", "ATAN", "ASIN", "ACOS", "EXP", "LN")
 
@@ -28,6 +28,9 @@ _NUMERIC_WORD = re.compile(r"([A-Za-z])\s*(" + _NUMBER + ")")
 # Alternatives in one pattern, so whichever comment starts first wins: "; note (x" is one comment.
 _COMMENTS = re.compile(r"\([^)]*\)|;.*")
 _PARENTHESES = re.compile(r"\([^)]*\)")
+# The block a point list is made of, in one piece: an optional G0/G1, then X, Y, Z, F each at most once, in order.
+_PLAIN_MOVE = re.compile(r"(?:G0?([01])(?![0-9.])\s*)?(?:X(" + _NUMBER + r")\s*)?(?:Y(" + _NUMBER + r")\s*)?"
+                         r"(?:Z(" + _NUMBER + r")\s*)?(?:F(" + _NUMBER + r")\s*)?")
 _FUNCTION_NAME = re.compile(r"(?i)(" + "|".join(FUNCTIONS) + r")(?=\s*\[)")
 
 
@@ -112,6 +115,27 @@ def numeric_words(block: str, *, semicolon: bool = True, strict: bool = True) ->
     if not text.isupper():  # some letter is lower case (most programs have none: skip the copy)
         found = [(letter.upper(), value) for letter, value in found]
     return found
+
+
+def plain_move(block: str) -> tuple[str | None, ...] | None:
+    """The words of the commonest point-list block in one step, or None for any other block.
+
+    A block of nothing but ``G0``/``G00``/``G1``/``G01``, ``X``, ``Y``, ``Z``
+    and ``F`` words, upper case, each at most once and in that order, no
+    comment (``X84.195 Z20.524``, ``G01 Z17.214 F200.0``), comes back as
+    ``(g, x, y, z, f)``, the values as written and None for a word not given:
+    the same words :func:`numeric_words` finds in it.  Anything else is None,
+    for the caller to read with :func:`numeric_words`.
+
+    Examples
+    --------
+    >>> plain_move("G01 Z17.214 F200.0"), plain_move("X84.195 Z20.524")
+    (('1', None, None, '17.214', '200.0'), (None, '84.195', None, '20.524', None))
+    >>> plain_move("Y1. X2."), plain_move("G1.5 X1."), plain_move("x1.")
+    (None, None, None)
+    """
+    m = _PLAIN_MOVE.fullmatch(block)
+    return None if m is None or not block else m.groups()
 
 
 def words(block: str) -> list[tuple[str, str]]:

@@ -2,11 +2,11 @@
 
 The box of the control points, in machine millimetres, is covered by a grid
 of cells; each cell keeps the lowest height any part of the tool reached over
-its centre.  Every move of the program is sampled densely enough that
-consecutive tool positions are at most half a cell apart sideways and
-``dz_mm`` apart in height, and at each position the exact lower surface of
-the tool (:func:`lagsym.machine.cutter_profile`: ball, flat or bull nose) is
-pressed into every cell centre under it; feed moves and rapids (``G00``) go into two maps.  The
+its centre.  Every straight move of the program lowers every cell centre its
+tool passes over to the lowest point the exact lower surface of the tool
+(:func:`lagsym.machine.cutter_profile`: ball, flat or bull nose) reaches
+there anywhere along the move, in closed form (:mod:`lagsym.verify.swept`);
+feed moves and rapids (``G00``) go into two maps.  The
 part is the surface over the box and ends at the box edges (the cells on the
 edges are its top edges).  The result is compared with the exact surface at
 the same cell centres:
@@ -21,10 +21,12 @@ the same cell centres:
   the cells a tool radius or more from the box edges;
 * **not reached**: cells no part of the tool passed over.
 
-The simulation errs towards missing a little cut, never towards inventing one:
-every sampled position is on a move, and between two of them the tool sweeps
-at most ``resolution_mm`` lower than the samples show (the sag of its corner over
-half the sample spacing, plus half a height step).  So a gouge it reports is
+The simulation never invents a cut: every height it keeps is one the tool
+reached at a real position on a move.  For the ball and the flat end it is
+the lowest there is over the cell centre (``resolution_mm`` 0: floating-point
+rounding apart); for the bull nose, whose lowest point along a move has no
+closed form, the tool sweeps at most ``resolution_mm`` lower
+(:func:`lagsym.verify.swept.bull_resolution`, below 1e-4 mm).  So a gouge it reports is
 real, and the depth from which a cut counts as a gouge needs no room for the
 simulation: by default it is what the program's rounding can cause,
 :func:`gouge_limit` (half a unit of the last decimal, and that much sideways
@@ -81,8 +83,8 @@ class CutReport:
         The simulation's vertical resolution and the depth from which a cut counts as a gouge.
     max_left_mm, max_scallop_mm : float
         Material left and scallop above which the program fails (``inf``: not checked).
-    positions : int
-        Number of tool positions simulated.
+    segments : int
+        Number of straight segments swept (the moves, split at most 8 cells long sideways).
     """
 
     xs_mm: np.ndarray
@@ -104,7 +106,7 @@ class CutReport:
     gouge_limit_mm: float
     max_left_mm: float
     max_scallop_mm: float
-    positions: int
+    segments: int
 
     def __post_init__(self):
         freeze_fields(self, ("xs_mm", "ys_mm", "cut_mm", "surface_mm"), dtype=float)
@@ -153,7 +155,8 @@ class CutReport:
         left = "all of it (not reached)" if math.isinf(self.left_mm) else f"{self.left_mm:.4f} mm"
         return [
             f"simulated {len(self.xs_mm)} x {len(self.ys_mm)} cells of {cx:.3f} x {cy:.3f} mm, "
-            f"{self.positions} tool positions, resolution {self.resolution_mm:.4f} mm",
+            f"{self.segments} segments swept, resolution {self.resolution_mm:.4f} mm"
+            + (" (exact)" if self.resolution_mm == 0.0 else ""),
             f"worst gouge       {self.gouge_mm:.4f} mm at {at(self.gouge_at)} "
             f"(limit {self.gouge_limit_mm:.4f} mm): {'GOUGE' if self.gouges else 'none'}",
             f"rapid into part   {self.rapid_mm:.4f} mm at {at(self.rapid_at)}"
@@ -206,7 +209,7 @@ def program_resolution_mm(text: str) -> float:
 
 
 def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Placement(),
-                 cell_mm: float | None = None, dz_mm: float = 0.01, program_resolution_mm: float = 0.0005,
+                 cell_mm: float | None = None, program_resolution_mm: float = 0.0005,
                  gouge_limit_mm: float | None = None, max_cells: int | None = MAX_CELLS,
                  max_contacts: int | None = MAX_CONTACTS, max_left_mm: float = MAX_LEFT_MM,
                  max_scallop_mm: float | None = None) -> CutReport:
@@ -224,8 +227,6 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
         Where it sits on the machine (``MachineSettings.placement``).
     cell_mm : float, optional
         Cell size; by default the box's longer side over 400.
-    dz_mm : float
-        Largest height step between simulated positions along a move.
     program_resolution_mm : float
         How far the program's rounding may put a point from the planned one
         (:func:`program_resolution_mm` of its text).
@@ -234,7 +235,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
         :func:`gouge_limit` of the program resolution and the surface's steepest slope.
     max_cells, max_contacts : int or None
         Refuse, before any work, more cells (``--max-cells``) or tool
-        positions times cells under the tool (``--max-contacts``); None: no limit.
+        segments swept times cells under the tool (``--max-contacts``); None: no limit.
     max_left_mm : float
         Material left anywhere above which the program fails (:data:`MAX_LEFT_MM`; ``inf``: not checked).
     max_scallop_mm : float, optional
@@ -252,18 +253,18 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     use = known & np.concatenate([[False], known[:-1]]) if len(moves) else known
     if not use.any():
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
-    r, corner, ds, resolution = tool_grid(tool, xs, ys, dz_mm)
-    check_work(path[:-1][use], path[1:][use], ds, dz_mm, r, hx, hy, max_contacts)
+    r, corner, piece, resolution = tool_grid(tool, xs, ys)
+    check_work(path[:-1][use], path[1:][use], piece, r, hx, hy, max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
     cut = np.full((len(xs), len(ys)), np.inf)
-    positions, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, dz_mm, None)
-    crash, crash_positions = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner, ds, dz_mm))
+    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, None)
+    crash, crash_segments = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner))
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
                      rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
                      unreached_mm2=float((~np.isfinite(cut)).sum() * hx * hy), resolution_mm=resolution,
                      gouge_limit_mm=limit, max_left_mm=float(max_left_mm),
                      max_scallop_mm=math.inf if max_scallop_mm is None else float(max_scallop_mm),
-                     positions=positions + crash_positions)
+                     segments=segments + crash_segments)
 
 
 def _compare(cut, surf, slope, xs, ys, r) -> dict:
@@ -297,22 +298,22 @@ def _slopes(surface, sx, sy) -> np.ndarray:
 
 
 def _rapids(surf, path, use, lines, grid):
-    """The deepest a rapid goes below the surface, where and on which line; and the positions simulated.
+    """The deepest a rapid goes below the surface, where and on which line; and the segments swept.
 
     All rapids are pressed into one map; only those that pass over the worst
     cell are simulated again, one by one, to name the line.
     """
-    xs, ys, r, corner, ds, dz = grid
+    xs, ys, r, corner = grid
     none = (0.0, (float(xs[0]), float(ys[0])), 0)
     k = np.flatnonzero(use)
     if not k.size:
         return none, 0
     cut = np.full(surf.shape, np.inf)
-    positions = sweep(cut, path[k], path[k + 1], xs, ys, r, corner, ds, dz)
+    segments = sweep(cut, path[k], path[k + 1], xs, ys, r, corner)
     depth = np.where(np.isfinite(cut), surf - cut, -np.inf)
     i = int(np.argmax(depth))
     if not depth.flat[i] > 0.0:
-        return none, positions
+        return none, segments
     a, b = np.unravel_index(i, depth.shape)
     px, py = xs[a], ys[b]
     line = 0
@@ -320,10 +321,10 @@ def _rapids(surf, path, use, lines, grid):
         lo, hi = np.minimum(path[m], path[m + 1]), np.maximum(path[m], path[m + 1])
         if lo[0] - r <= px <= hi[0] + r and lo[1] - r <= py <= hi[1] + r:
             one = np.full(surf.shape, np.inf)
-            sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r, corner, ds, dz)
+            sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r, corner)
             if one[a, b] <= cut[a, b]:
                 line = int(lines[m])
                 break
-    return (float(depth.flat[i]), (float(px), float(py)), line), positions
+    return (float(depth.flat[i]), (float(px), float(py)), line), segments
 
 
