@@ -30,7 +30,7 @@ examples:
   lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-shape flat \\
       --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc
   lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-diameter 10 --stepdown 2 \\
-      --safe-z 90 --dialect fanuc --macro -o O1000.nc"""
+      --safe-z 90 --dialect fanuc --macro --program 2000 -o O2000.nc"""
 
 
 def add_arguments(p) -> None:
