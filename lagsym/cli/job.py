@@ -37,8 +37,11 @@ def add_max_points(p) -> None:
 
 def run(args, out, err) -> int:
     from ..job import job_program, plan_job, read_job
+    from ._progress import progress_bar
 
-    planned = plan_job(read_job(args.job), args.max_points, args.max_samples)
+    spec = read_job(args.job)
+    with progress_bar(err) as progress:
+        planned = plan_job(spec, args.max_points, args.max_samples, progress=progress)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

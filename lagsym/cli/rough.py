@@ -149,11 +149,14 @@ def run(args, out, err) -> int:
     from ..job import job_program, plan_job
     from ..job.spec import parse_job
     from ..toolpath.rough import MAX_ROUGH_SAMPLES
+    from ._progress import progress_bar
     from .job import report
 
     _refuse(args)
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
-    planned = plan_job(parse_job(job_data(args), "lagsym rough"), args.max_points, samples)
+    spec = parse_job(job_data(args), "lagsym rough")
+    with progress_bar(err) as progress:
+        planned = plan_job(spec, args.max_points, samples, progress=progress)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

@@ -9,6 +9,7 @@ the machine.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -18,6 +19,7 @@ from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
+from ..progress import Progress, Tally
 from . import chordal
 from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
@@ -29,6 +31,7 @@ from .scallop import scallop_levels
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
 MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
+_PIECE = 1 << 14  # drop-cutter positions between progress reports (a multiple of the drop's own chunk)
 
 
 @dataclass(frozen=True)
@@ -95,7 +98,8 @@ class Toolpath:
 
 
 def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
-                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS) -> Toolpath:
+                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS, *,
+                  progress: Progress | None = None) -> Toolpath:
     """Plan a zig-zag raster of gouge-free cutter locations over the surface.
 
     Parameters
@@ -113,6 +117,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     max_points : int or None
         Refuse, before any work, a plan of more fine drop-cutter samples than
         this (``--max-points``); None for no limit.
+    progress : Progress, optional
+        Told the fine samples dropped, then the checks' (:mod:`lagsym.progress`).
 
     Returns
     -------
@@ -139,7 +145,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
-    path = _fine_path(cl, levels, along, raster.direction, fine, past)
+    path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
@@ -153,7 +159,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
-    vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    checks = Tally(progress, "checking moves")
+    vx, vy, vz, vrow, sag = chordal.check_moves(cl.counted(checks), vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    checks.finish()
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     tp = Toolpath(
@@ -305,6 +313,7 @@ class _Cutter:
     lift_tip: float
     mm_per_unit: float
     grid: ResolutionGrid | None = None
+    tally: Tally | None = field(default=None, compare=False)
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
@@ -318,8 +327,14 @@ class _Cutter:
         return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
+        if self.tally is not None:  # a piece at a time, each counted
+            return self.tally.pieces(functools.partial(replace(self, tally=None), **search), (x, y), _PIECE)
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
+
+    def counted(self, tally: Tally) -> _Cutter:
+        """This cutter, its drops counted in ``tally``."""
+        return replace(self, tally=tally) if tally.live else self
 
     @property
     def unit(self) -> float:
@@ -362,7 +377,8 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None) -> _FinePath:
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None,
+               progress: Progress | None = None) -> _FinePath:
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
 
     With the tool ``past`` the boundary (that far, surface units), positions
@@ -396,7 +412,10 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    fz = cl(fx, fy)
+    drops = Tally(progress, "dropping the tool", len(fx))
+    drops.start()
+    fz = cl.counted(drops)(fx, fy)
+    drops.finish()
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
