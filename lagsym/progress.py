@@ -25,9 +25,10 @@ from __future__ import annotations
 import threading
 from typing import Callable, Protocol
 
-__all__ = ["Progress", "Tally", "no_progress", "prefixed", "MOST_CALLS"]
+__all__ = ["Progress", "Tally", "Counting", "no_progress", "prefixed", "MOST_CALLS", "PIECE"]
 
 MOST_CALLS = 200  # reports a stage with a known total makes at most, besides its last
+PIECE = 1 << 14  # items of a batch done between two reports: positions of a drop-cutter (a multiple of its chunk)
 
 
 class Progress(Protocol):
@@ -84,7 +85,15 @@ class Tally:
             self.done = self._told = end
             self.progress(end, end, self.stage)
 
-    def pieces(self, f: Callable, arrays, piece: int):
+    def __enter__(self) -> Tally:
+        self.start()
+        return self
+
+    def __exit__(self, kind, value, tb) -> None:
+        if kind is None:
+            self.finish()
+
+    def pieces(self, f: Callable, arrays, piece: int = PIECE):
         """``f`` over the arrays ``piece`` items at a time, counted; the results joined as one array.
 
         Without a listener ``f`` gets the whole arrays in one call.  ``f``
@@ -103,6 +112,28 @@ class Tally:
             outs.append(f(*(a[lo:lo + piece] for a in arrays)))
             self.add(len(outs[-1]))
         return np.concatenate(outs)
+
+    def whole(self, f: Callable, arrays, piece: int = PIECE):
+        """The stage from start to finish: :meth:`pieces` of ``f`` over ``arrays``."""
+        with self:
+            return self.pieces(f, arrays, piece)
+
+    def counting(self, f: Callable, piece: int = PIECE) -> Counting:
+        """``f`` (called with arrays and keywords) with every call counted :meth:`pieces` at a time."""
+        return Counting(f, self, piece) if self.live else f
+
+
+class Counting:
+    """A function of arrays whose calls are counted in a :class:`Tally`; its other attributes are ``f``'s."""
+
+    def __init__(self, f: Callable, tally: Tally, piece: int = PIECE):
+        self.f, self.tally, self.piece = f, tally, piece
+
+    def __call__(self, *arrays, **kw):
+        return self.tally.pieces(lambda *a: self.f(*a, **kw), arrays, self.piece)
+
+    def __getattr__(self, name: str):
+        return getattr(self.f, name)
 
 
 def prefixed(progress: Progress | None, prefix: str) -> Progress | None:

@@ -9,7 +9,6 @@ the machine.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -31,7 +30,6 @@ from .scallop import scallop_levels
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
 MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
-_PIECE = 1 << 14  # drop-cutter positions between progress reports (a multiple of the drop's own chunk)
 
 
 @dataclass(frozen=True)
@@ -159,9 +157,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
-    checks = Tally(progress, "checking moves")
-    vx, vy, vz, vrow, sag = chordal.check_moves(cl.counted(checks), vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
-    checks.finish()
+    with Tally(progress, "checking moves") as checks:
+        vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen, dense, tol,
+                                                    cl.radius)
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     tp = Toolpath(
@@ -313,7 +311,6 @@ class _Cutter:
     lift_tip: float
     mm_per_unit: float
     grid: ResolutionGrid | None = None
-    tally: Tally | None = field(default=None, compare=False)
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
@@ -327,14 +324,8 @@ class _Cutter:
         return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        if self.tally is not None:  # a piece at a time, each counted
-            return self.tally.pieces(functools.partial(replace(self, tally=None), **search), (x, y), _PIECE)
         z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
         return (z + self.lift_tip) * self.mm_per_unit
-
-    def counted(self, tally: Tally) -> _Cutter:
-        """This cutter, its drops counted in ``tally``."""
-        return replace(self, tally=tally) if tally.live else self
 
     @property
     def unit(self) -> float:
@@ -377,8 +368,7 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None,
-               progress: Progress | None = None) -> _FinePath:
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None, progress=None) -> _FinePath:
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
 
     With the tool ``past`` the boundary (that far, surface units), positions
@@ -412,10 +402,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    drops = Tally(progress, "dropping the tool", len(fx))
-    drops.start()
-    fz = cl.counted(drops)(fx, fy)
-    drops.finish()
+    fz = Tally(progress, "dropping the tool", len(fx)).whole(cl, (fx, fy))
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 

@@ -332,11 +332,9 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progr
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
         corner = tool.corner_mm / place.mm_per_unit if tool.shape == "bull" else None
-        drops = Tally(progress, "dropping the tool", len(u))
-        drops.start()
-        z = drops.pieces(lambda pu, pv: drop_cutter(surface, pu, pv, tool.radius_mm / place.mm_per_unit, tool.shape,
-                                                    corner=corner, evaluator=ev, **search), (u, v), _PIECE)
-        drops.finish()
+        z = Tally(progress, "dropping the tool", len(u)).whole(
+            lambda pu, pv: drop_cutter(surface, pu, pv, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner,
+                                       evaluator=ev, **search), (u, v), _PIECE)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 
