@@ -11,6 +11,8 @@ each.  Every key of the job file is checked.  The cycle-time estimate of
 each operation and of the whole job is printed and written in the program's
 header.  See docs/roughing.md for the job file.
 
+On a terminal, a progress bar on standard error shows the planning of each operation.
+
 examples:
   lagsym job examples/example-4-job.toml -o job.ngc"""
 

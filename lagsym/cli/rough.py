@@ -26,6 +26,8 @@ over the levels, rows and points and computes each tip height from the
 surface equation, never below the drop-cutter height plus the stock (see
 docs/roughing.md for the proof of its clearance).
 
+On a terminal, a progress bar on standard error shows the planning.
+
 examples:
   lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-shape flat \\
       --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc

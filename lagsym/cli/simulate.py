@@ -25,6 +25,8 @@ it changes (WHILE [1 EQ 1], a GOTO back) or when the run comes back to a block
 with every variable and the position unchanged, after --max-idle-blocks
 blocks without a move, or after --max-blocks blocks in all.
 
+On a terminal, a progress bar on standard error shows the blocks executed.
+
 examples:
   lagsym simulate O1000.nc --precision 8 -o moves.csv
   lagsym simulate surface.ngc --precision 15"""

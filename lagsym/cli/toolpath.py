@@ -19,6 +19,8 @@ drop-cutter against the exact surface, so the tool never cuts below it, also
 where the surface is more concave than the tool.  The programmed point is the
 tool tip; the tool stays down between rows.
 
+On a terminal, a progress bar on standard error shows the planning.
+
 examples:
   lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
       --stepover 0.4 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc

@@ -37,6 +37,8 @@ job gives the tools, scale and origin, so those options are refused with it.
 It exits 1 on a gouge, a rapid through material, or, when --max-left is
 given, more material left than that.
 
+On a terminal, a progress bar on standard error shows the moves swept.
+
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
   lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1
