@@ -32,12 +32,12 @@ from .lagrange import lagrange_surface
 from .machine import Placement, Tool
 from .progress import Progress, Tally
 from .verify import MAX_CELLS, height_map_axes, press_moves
+from .verify.heightmap import segments, tool_grid
 
 __all__ = ["Stage", "MachinedPart", "machine_part", "machine_job", "LEFT_BINS_MM"]
 
 LEFT_BINS_MM = (0.01, 0.05, 0.1, 0.5, 1.0, 2.0, 5.0)
 """Upper edges (mm) of the material-left histogram; the last bin holds everything above 5 mm."""
-_PIECE_MOVES = 5_000  # fewest feed moves pressed between progress reports
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
         Depth from which a cut counts as a gouge (default: the program's
         rounding plus the finest stage's resolution).
     progress : Progress, optional
-        Told the moves pressed, stage ``T1: pressing moves`` and so on for each tool (:mod:`lagsym.progress`).
+        Told the segments swept, stage ``T1: sweeping moves`` and so on for each tool (:mod:`lagsym.progress`).
     """
     x0, x1, y0, y1, top = (float(v) for v in block)
     xs, ys = height_map_axes((x0, x1, y0, y1), cell_mm, max_cells)
@@ -163,8 +163,9 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
             raise InputError(f"the program changes to tool T{number} (line {first}), which the job does not name; "
                              f"its tools: {', '.join(f'T{k}' for k in sorted(tools))}")
         before = cut.copy()
-        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number],
-                              Tally(progress, f"T{number}: pressing moves", len(a)))
+        swept = Tally(progress, f"T{number}: sweeping moves",
+                      None if progress is None else segments(a, b, tool_grid(tools[number], xs, ys)[2]))
+        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number], swept)
         resolutions.append(res)
         left = cut - surf
         stages.append(Stage(number, tools[number], first, len(a), float((before - cut).sum() * hx * hy), crash, at,
@@ -254,8 +255,8 @@ def _stages(moves: Moves, changes):
 
 
 def _run(cut, xs, ys, a, b, rapid, tool: Tool, tally: Tally):
-    """Press one stage's moves in order (counted in ``tally``); the deepest material a rapid went through, where,
-    and the resolution."""
+    """Press one stage's moves in order (their segments counted in ``tally``); the deepest material a rapid went
+    through, where, and the resolution."""
     tally.start()
     deepest, at, res = 0.0, (float(xs[0]), float(ys[0])), 0.0
     # Runs of feed moves and of rapids, in program order: a rapid's cut is measured against the map before it.
@@ -263,15 +264,16 @@ def _run(cut, xs, ys, a, b, rapid, tool: Tool, tally: Tally):
     for s, e in zip(np.r_[0, edges], np.r_[edges, len(a)]):
         if e <= s:
             continue
-        if not rapid[s]:  # feed moves lower the map alike in any grouping: counted a piece at a time
-            piece = max(_PIECE_MOVES, len(a) // 20) if tally.live else e - s
-            for p in range(s, e, piece):
-                res = press_moves(cut, xs, ys, a[p:min(p + piece, e)], b[p:min(p + piece, e)], tool)[1]
-                tally.add(min(p + piece, e) - p)
+        base = tally.done  # each run's segments swept, counted on from the runs before
+
+        def swept(done, total, stage, base=base):
+            tally.add(base + done - tally.done)
+
+        if not rapid[s]:
+            res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, progress=swept if tally.live else None)[1]
             continue
         before = cut.copy()
-        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool)[1]
-        tally.add(e - s)
+        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, progress=swept if tally.live else None)[1]
         drop = before - cut
         k = int(np.argmax(drop))
         if drop.flat[k] > deepest:

@@ -27,7 +27,7 @@ from ..machine import Tool
 from ..progress import Progress, Tally
 from .swept import bull_resolution, lowest_ball, lowest_bull, lowest_flat
 
-__all__ = ["press_moves", "height_map_axes", "sweep", "tool_grid", "check_work", "MAX_CELLS", "MAX_CONTACTS"]
+__all__ = ["press_moves", "height_map_axes", "sweep", "tool_grid", "check_work", "segments", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 200_000  # moves split and swept at a time
 _PIECE_CELLS = 8.0  # longest segment swept, sideways, in cells
@@ -56,7 +56,7 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None, prog
     kx, ky = int(math.ceil((r + piece / 2) / hx)) + 1, int(math.ceil((r + piece / 2) / hy)) + 1
     workers = min(os.cpu_count() or 1, 2) if workers is None else max(int(workers), 1)
     count = 0
-    swept = Tally(progress, "sweeping moves", _segments(a_all, b_all, piece) if progress is not None else None)
+    swept = Tally(progress, "sweeping moves", segments(a_all, b_all, piece) if progress is not None else None)
     swept.start()
     for s in range(0, len(a_all), _MOVES_PER_PASS):
         a, b = _pieces(np.asarray(a_all[s:s + _MOVES_PER_PASS], dtype=float),
@@ -102,7 +102,7 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None, prog
     return count
 
 
-def _segments(a, b, piece: float) -> int:
+def segments(a, b, piece: float) -> int:
     """How many segments :func:`_pieces` splits the moves ``a -> b`` into."""
     d = np.asarray(b, dtype=float)[:, :2] - np.asarray(a, dtype=float)[:, :2]
     return int(np.maximum(np.ceil(np.hypot(d[:, 0], d[:, 1]) / piece), 1).sum()) if len(d) else 0
