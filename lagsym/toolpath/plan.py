@@ -18,6 +18,7 @@ from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
+from ..progress import Progress, Tally
 from . import chordal
 from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
@@ -95,7 +96,8 @@ class Toolpath:
 
 
 def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
-                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS) -> Toolpath:
+                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS, *,
+                  progress: Progress | None = None) -> Toolpath:
     """Plan a zig-zag raster of gouge-free cutter locations over the surface.
 
     Parameters
@@ -113,6 +115,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     max_points : int or None
         Refuse, before any work, a plan of more fine drop-cutter samples than
         this (``--max-points``); None for no limit.
+    progress : Progress, optional
+        Told the fine samples dropped, then the checks' (:mod:`lagsym.progress`).
 
     Returns
     -------
@@ -139,7 +143,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
-    path = _fine_path(cl, levels, along, raster.direction, fine, past)
+    path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
@@ -153,7 +157,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
-    vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    with Tally(progress, "checking moves") as checks:
+        vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen, dense, tol,
+                                                    cl.radius)
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     tp = Toolpath(
@@ -362,7 +368,7 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None) -> _FinePath:
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None, progress=None) -> _FinePath:
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
 
     With the tool ``past`` the boundary (that far, surface units), positions
@@ -396,7 +402,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    fz = cl(fx, fy)
+    fz = Tally(progress, "dropping the tool", len(fx)).whole(cl, (fx, fy))
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
