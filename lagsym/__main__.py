@@ -2,4 +2,5 @@
 
 from .cli import run_console
 
-run_console()
+if __name__ == "__main__":  # not when a worker process (lagsym.toolpath.workers) imports the main module
+    run_console()

@@ -38,6 +38,8 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import TOOL_SHAPES, cutter_profile
 from ..values import choice, positive
+from .newton import newton_ball
+from .workers import Workers
 
 __all__ = ["CL_MARGIN", "drop_cutter"]
 
@@ -51,7 +53,8 @@ _HALF = math.sqrt(0.5)
 
 
 def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: float | None = None, lattice: int = 8,
-                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
+                workers: Workers | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
     Parameters
@@ -77,6 +80,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
         a lower bound of the exact one.
     evaluator : SurfaceEvaluator, optional
         The surface's evaluator (by default :func:`lagsym.evaluate.surface_evaluator`).
+    workers : Workers, optional
+        Worker processes for this evaluator (:mod:`.workers`) that share the
+        positions out in chunks; the values are the same as without.
 
     Returns
     -------
@@ -108,10 +114,13 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
     offsets, inside, nearest = _lattice(radius, spacing)
     span = _height_scale(ev) + radius + 1.0
-    out = np.empty(cx.size)
-    for s in range(0, cx.size, _CHUNK):
-        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, corner, offsets,
-                                        (inside, nearest), spacing, starts, box, 0.01 * CL_MARGIN * span)
+    parallel = workers is not None and workers.parallel and workers.evaluator is ev
+    # Each position's value is independent of the chunk it is computed in.
+    chunk = max(256, min(_CHUNK, -(-cx.size // (4 * workers.processes)))) if parallel else _CHUNK
+    tasks = [(cx[s:s + chunk], cy[s:s + chunk], radius, corner, offsets, (inside, nearest), spacing, starts, box,
+              0.01 * CL_MARGIN * span) for s in range(0, cx.size, chunk)]
+    parts = workers.map(_drop_chunk, tasks) if parallel else [_drop_chunk(ev, *t) for t in tasks]
+    out = np.concatenate(parts) if parts else np.empty(0)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
@@ -292,9 +301,12 @@ def _drop_chunk(ev, cx, cy, radius, corner, offsets, lattice, spacing, starts, b
     val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box)
     order = _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts)
     rows = np.arange(cx.size)[:, None]
-    found = _refine(ev, px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel(),
-                    np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1]), radius, corner, box,
-                    spacing, settle)
+    sx, sy, sv = px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel()
+    scx, scy = np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1])
+    # A ball's starts first climb by Newton steps, which leave the pattern search a short way to settle.
+    h, done = newton_ball(ev, sx, sy, sv, scx, scy, radius, box, spacing, settle) if corner == radius \
+        else (spacing, None)
+    found = _refine(ev, sx, sy, sv, scx, scy, radius, corner, box, h, settle, done)
     return np.maximum(found.reshape(cx.size, -1).max(axis=1), val.max(axis=1))
 
 
@@ -338,15 +350,19 @@ def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
     return _spread_starts(val, px, py, starts, 2.5 * spacing, rank)
 
 
-def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, spacing, settle):
+def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, step, settle, poll=None):
     """Pattern search from each start, in place: the best contact height found from each.
 
-    Eight steps a round, along the axes and along and across the radius;
+    Eight steps a round, along the axes and along and across the radius,
+    from ``step`` (one for all, or one for each start);
     the step halves where none climbs, down to ``1e-9`` of the radius.
+    A start marked in ``poll`` (a maximum Newton's method converged to) is
+    done when its first round does not climb; where it does, the search
+    goes on from there as for any start.
     """
-    h = np.full(px.size, spacing)
+    h = np.array(np.broadcast_to(step, px.shape), dtype=float)
     stop = radius * 1e-9
-    for _ in range(120):
+    for rnd in range(120):
         active = h > stop
         if not active.any():
             break
@@ -378,6 +394,8 @@ def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, spacing, settle):
         h[iu[creep]] *= 0.5
         # Where no neighbour differs by more than a hundredth of the margin, the value has settled.
         settled = ~up & (np.max(np.abs(np.where(np.isfinite(qv), qv, val[ia, None]) - val[ia, None]), axis=1) < settle)
+        if rnd == 0 and poll is not None:
+            settled |= ~up & poll[ia]
         h[ia[settled]] = 0.0
     return val
 

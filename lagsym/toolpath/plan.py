@@ -25,6 +25,7 @@ from .filter import filter_rows
 from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
 from .resolution import ResolutionGrid, without_repeats
 from .scallop import scallop_levels
+from .workers import MIN_POINTS, Workers
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
@@ -139,8 +140,24 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
-    path = _fine_path(cl, levels, along, raster.direction, fine, past)
     kappa = ev.curvature_bound() / mm_per_unit
+    # Worker processes on the other cores, where the plan is large enough to pay for starting them.
+    with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
+        cl = replace(cl, workers=workers)
+        path = _fine_path(cl, levels, along, raster.direction, fine, past)
+        tp = _checked(ev, cl, path, tol, raster, kappa, every, settings)
+    b = ev.bounds
+    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
+    tp = Toolpath(**tp, tool=tool, raster=raster,
+                  stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1
+                  else float(_side_step(tool, raster)),
+                  step_mm=float(step), bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
+                  fine_points=len(path.x), **_cusp(scallop, raster.direction, settings))
+    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+
+
+def _checked(ev, cl, path, tol, raster, kappa, every, settings) -> dict:
+    """The emitted points of the fine path, its moves checked and lifted: the point fields of a :class:`Toolpath`."""
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
@@ -154,20 +171,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
     vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
-    b = ev.bounds
-    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
-    tp = Toolpath(
-        **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
-                          _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
-        tool=tool,
-        raster=raster,
-        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(_side_step(tool, raster)),
-        step_mm=float(step),
-        bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
-        fine_points=len(path.x),
-        **_cusp(scallop, raster.direction, settings),
-    )
-    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+    return without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                           _place(settings, vx, vy, vz)[2], cl.unit * cl.mm_per_unit)
 
 
 def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSettings, kappa: float) -> Toolpath:
@@ -305,6 +310,7 @@ class _Cutter:
     lift_tip: float
     mm_per_unit: float
     grid: ResolutionGrid | None = None
+    workers: Workers | None = None
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
@@ -318,7 +324,8 @@ class _Cutter:
         return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev,
+                        workers=self.workers, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
     @property

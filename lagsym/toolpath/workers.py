@@ -1,0 +1,78 @@
+"""Drop-cutter on every core: chunks of tool positions shared among worker processes.
+
+A plan drops the tool at tens of thousands of positions, each independent of
+the others, so they are computed in chunks by worker processes, one per
+core the process may run on, started once per plan (:class:`Workers`).  The
+workers are *spawned* (a fresh interpreter, not a fork: the caller may hold
+threads, a progress display's for one), which costs a fraction of a second
+once, so a plan uses them only where it has enough positions to pay for it
+(:data:`MIN_POINTS`).  Each worker gets the surface's evaluator once, when it
+starts; a chunk's result is the same whichever process computes it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+
+__all__ = ["Workers", "MIN_POINTS", "available_cores"]
+
+MIN_POINTS = 40_000
+"""Fine samples from which a plan starts worker processes (below it, one process does all)."""
+
+_EVALUATOR = None  # in a worker process only: the evaluator its initializer received
+
+
+def available_cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on every platform
+        return os.cpu_count() or 1
+
+
+def _start(evaluator) -> None:
+    global _EVALUATOR
+    _EVALUATOR = evaluator
+
+
+def _call(task):
+    fn, args = task
+    return fn(_EVALUATOR, *args)
+
+
+class Workers:
+    """A pool of worker processes for one evaluator, used as a context manager; ``map`` runs chunks in order.
+
+    With fewer than two cores, or ``processes`` below 2, no process is
+    started and :meth:`map` runs the chunks here.
+    """
+
+    def __init__(self, evaluator, processes: int | None = None):
+        self.evaluator = evaluator
+        self.processes = available_cores() if processes is None else processes
+        self._pool = None
+
+    def __enter__(self) -> Workers:
+        if self.processes > 1:
+            ctx = multiprocessing.get_context("spawn")
+            self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator,))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    @property
+    def parallel(self) -> bool:
+        """Whether chunks run in worker processes."""
+        return self._pool is not None
+
+    def map(self, fn, chunks) -> list:
+        """``[fn(evaluator, *args) for args in chunks]``, in the worker processes where there are any."""
+        chunks = list(chunks)
+        if self._pool is None or len(chunks) < 2:
+            return [fn(self.evaluator, *args) for args in chunks]
+        return self._pool.map(_call, [(fn, args) for args in chunks], chunksize=1)
