@@ -18,6 +18,8 @@ of them.  Needs ``opencamlib`` (``pip install opencamlib``).
 from __future__ import annotations
 
 import argparse
+import os
+import resource
 import statistics
 import sys
 import time
@@ -40,13 +42,21 @@ EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "paper-example-4
 SCALE, DIAMETER, STEP = 20.0, 6.0, 0.2
 
 
+def _cpu() -> float:
+    """CPU seconds of this process and of its finished children (a plan's worker processes)."""
+    own, done = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + done.ru_utime + done.ru_stime
+
+
 def _times(run, runs: int):
-    out, result = [], None
+    """Wall and CPU seconds of ``runs`` runs: ``(wall min, wall median, cpu min, cpu median, result)``."""
+    wall, cpu, result = [], [], None
     for _ in range(runs):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), _cpu()
         result = run()
-        out.append(time.perf_counter() - t)
-    return min(out), statistics.median(out), result
+        wall.append(time.perf_counter() - t)
+        cpu.append(_cpu() - c)
+    return min(wall), statistics.median(wall), min(cpu), statistics.median(cpu), result
 
 
 def main(argv=None) -> int:
@@ -64,12 +74,14 @@ def main(argv=None) -> int:
     raster = RasterSpec("x", stepover, STEP)
     settings = MachineSettings(mm_per_unit=SCALE)
     tool = Tool("ball", DIAMETER)
-    best, median, tp = _times(lambda: plan_toolpath(surface, tool, raster, settings, evaluator=ev), args.runs)
+    best, median, cbest, cmedian, tp = _times(lambda: plan_toolpath(surface, tool, raster, settings, evaluator=ev),
+                                              args.runs)
     n = len(tp)
     print(f"Example 4 at scale {SCALE:g}, ball D{DIAMETER:g} mm, side step {stepover:g} mm, step {STEP:g} mm: "
           f"{n} cutter locations in {int(tp.rows.max()) + 1} rows (from {tp.fine_points} samples)")
-    print(f"lagsym whole plan (drop-cutter, chordal checks, filter): min {best:.2f} s, median {median:.2f} s "
-          f"({args.runs} runs)")
+    print(f"lagsym whole plan (drop-cutter, chordal checks, filter): wall min {best:.2f} s, median {median:.2f} s; "
+          f"CPU min {cbest:.2f} s, median {cmedian:.2f} s ({args.runs} runs, load average "
+          f"{os.getloadavg()[0]:.1f})")
 
     x, y = tp.points_mm[:, 0], tp.points_mm[:, 1]
     m = min(n, args.ocl_points) if args.quick else n
@@ -77,7 +89,7 @@ def main(argv=None) -> int:
     stl = stl_surface(ocl, surface, args.mesh, SCALE)
     t_mesh = time.perf_counter() - t
     floor = float(np.min(surface.grid.z_array)) * SCALE - 100.0
-    o_best, o_median, zo = _times(lambda: ocl_drop(ocl, stl, DIAMETER, x[:m], y[:m], floor), args.runs)
+    o_best, o_median, o_cbest, o_cmedian, zo = _times(lambda: ocl_drop(ocl, stl, DIAMETER, x[:m], y[:m], floor), args.runs)
     scale = n / m
     # The mesh's error: against the exact drop-cutter value at a sample of the positions inside the box.
     x0, x1, y0, y1 = (float(v) * SCALE for v in surface.grid.bounds)
@@ -88,8 +100,10 @@ def main(argv=None) -> int:
     note = f", {m} positions timed, scaled by {scale:.2f}" if m < n else ""
     print(f"OpenCAMLib BatchDropCutter, STL {args.mesh}x{args.mesh}x2 ({t_mesh:.1f} s to build; max error "
           f"{err * 1000:.2f} um on {inside.size} positions), {ocl.max_threads()} threads{note}: "
-          f"min {o_best * scale:.2f} s, median {o_median * scale:.2f} s")
-    print(f"ratio OpenCAMLib / lagsym: {o_best * scale / best:.2f} (min), {o_median * scale / median:.2f} (median)")
+          f"wall min {o_best * scale:.2f} s, median {o_median * scale:.2f} s; CPU min {o_cbest * scale:.2f} s, "
+          f"median {o_cmedian * scale:.2f} s")
+    print(f"ratio OpenCAMLib / lagsym: wall {o_best * scale / best:.2f} (min), {o_median * scale / median:.2f} "
+          f"(median); CPU {o_cbest * scale / cbest:.2f} (min), {o_cmedian * scale / cmedian:.2f} (median)")
     return 0
 
 

@@ -234,16 +234,28 @@ def _project(px, py, cx, cy, radius, box):
     the axis onto the rim (the box is convex and holds the axis).  With the
     axis beyond the box (``--boundary past``), it is pulled along the line to
     the box point nearest the axis (in both, the two being convex) until it
-    meets the rim.
+    meets the rim.  Candidates are ``(positions, k)`` arrays, the axis
+    ``(positions, 1)``; only the rows with a point outside the disc take the
+    second step.
     """
     x0, x1, y0, y1 = box
-    px = np.clip(px, x0, x1)
-    py = np.clip(py, y0, y1)
+    px = np.minimum(np.maximum(px, x0), x1)
+    py = np.minimum(np.maximum(py, y0), y1)
     dx, dy = px - cx, py - cy
     d2 = dx * dx + dy * dy
     over = d2 > radius * radius
     if not np.any(over):
         return px, py, d2
+    rows = np.flatnonzero(over.any(axis=1))  # px, py and d2 are this call's own arrays: changed in place
+    cx, cy = np.broadcast_to(cx, px.shape), np.broadcast_to(cy, px.shape)
+    px[rows], py[rows], d2[rows] = _onto_disc(px[rows], py[rows], dx[rows], dy[rows], d2[rows], over[rows],
+                                              cx[rows], cy[rows], radius, box)
+    return px, py, d2
+
+
+def _onto_disc(px, py, dx, dy, d2, over, cx, cy, radius, box):
+    """The second step of :func:`_project`, for the points in the box ``over`` the rim (all arrays one shape)."""
+    x0, x1, y0, y1 = box
     beyond = np.broadcast_to((cx < x0) | (cx > x1) | (cy < y0) | (cy > y1), px.shape)
     radial = over & ~beyond
     if np.any(radial):
@@ -298,7 +310,7 @@ def _height(ev, px, py, d2, radius, corner):
 
 def _drop_chunk(ev, cx, cy, radius, corner, offsets, lattice, spacing, starts, box, settle):
     """Drop-cutter over one chunk of positions: dense candidates, then a local search from the best of each basin."""
-    val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box)
+    val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box, int(lattice[0].sum()))
     order = _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts)
     rows = np.arange(cx.size)[:, None]
     sx, sy, sv = px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel()
@@ -310,25 +322,30 @@ def _drop_chunk(ev, cx, cy, radius, corner, offsets, lattice, spacing, starts, b
     return np.maximum(found.reshape(cx.size, -1).max(axis=1), val.max(axis=1))
 
 
-def _candidates(ev, cx, cy, radius, corner, offsets, box):
+def _candidates(ev, cx, cy, radius, corner, offsets, box, m):
     """Heights and contact points of the lattice and rim under each tool, then of the corners of the region under it.
 
     The corners are the box corners and where the rim crosses a box edge.
+    The first ``m`` offsets are the lattice's, inside the disc.
     Returns arrays of shape ``(positions, candidates)``.
     """
     n, k = cx.size, len(offsets)
-    # Dense candidates, a block of offsets at a time to bound memory.
+    # Dense candidates, a block of offsets at a time to bound memory; the lattice apart from the rim, which
+    # rounding puts just outside the disc, so the lattice's points need no more than the box.
     block = max(1, (1 << 22) // max(n, 1))
-    val, px, py = np.empty((n, k)), np.empty((n, k)), np.empty((n, k))
-    for s in range(0, k, block):
-        ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
+    ex, ey = _edge_points(cx, cy, radius, box)
+    w = k + ex.shape[1]
+    val, px, py = np.empty((n, w)), np.empty((n, w)), np.empty((n, w))
+    cuts = sorted(set(range(0, k, block)) | {m, k})
+    for s, e in zip(cuts[:-1], cuts[1:]):
+        block = e - s
+        ox, oy = offsets[s:e, 0], offsets[s:e, 1]
         qx, qy, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
         val[:, s:s + block] = _height(ev, qx, qy, d2, radius, corner)
         px[:, s:s + block], py[:, s:s + block] = qx, qy
-    ex, ey = _edge_points(cx, cy, radius, box)
     qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
-    return (np.concatenate([val, _height(ev, qx, qy, d2, radius, corner)], axis=1),
-            np.concatenate([px, qx], axis=1), np.concatenate([py, qy], axis=1))
+    val[:, k:], px[:, k:], py[:, k:] = _height(ev, qx, qy, d2, radius, corner), qx, qy
+    return val, px, py
 
 
 def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
@@ -410,7 +427,10 @@ def _spread_starts(val, px, py, starts, apart, rank=None):
     """
     n, k = val.shape
     key = val if rank is None else val - rank * (np.ptp(val, axis=1, keepdims=True) + 1.0)
-    top = np.argsort(-key, axis=1)[:, :min(k, 8 * starts + 32)]
+    many = min(k, 8 * starts + 32)
+    # The best ``many`` of each row, best first: partitioned out, then only those sorted.
+    top = np.argpartition(-key, many - 1, axis=1)[:, :many] if many < k else np.tile(np.arange(k), (n, 1))
+    top = np.take_along_axis(top, np.argsort(-np.take_along_axis(key, top, axis=1), axis=1), axis=1)
     rows = np.arange(n)[:, None]
     tx, ty = px[rows, top], py[rows, top]
     chosen = [top[:, 0]]

@@ -30,6 +30,7 @@ from .workers import MIN_POINTS, Workers
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
 MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
+_ROW_BLOCK = 1 << 15  # fine samples dropped at a time, whole rows
 
 
 @dataclass(frozen=True)
@@ -146,8 +147,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         cl = replace(cl, workers=workers)
         path = _fine_path(cl, levels, along, raster.direction, fine, past)
         tp = _checked(ev, cl, path, tol, raster, kappa, every, settings)
-    b = ev.bounds
-    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
+    bx, by, _ = _place(settings, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     tp = Toolpath(**tp, tool=tool, raster=raster,
                   stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1
                   else float(_side_step(tool, raster)),
@@ -403,7 +403,9 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    fz = cl(fx, fy)
+    # Whole rows and their links, about _ROW_BLOCK samples at a time: where a plan's progress can show.
+    cuts = [lo for lo, _, row in pieces if row][::max(1, _ROW_BLOCK // len(along))] + [len(fx)]
+    fz = np.concatenate([cl(fx[a:b], fy[a:b]) for a, b in zip(cuts[:-1], cuts[1:])])
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 

@@ -15,10 +15,13 @@ from __future__ import annotations
 import multiprocessing
 import os
 
-__all__ = ["Workers", "MIN_POINTS", "available_cores"]
+__all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
 
 MIN_POINTS = 40_000
 """Fine samples from which a plan starts worker processes (below it, one process does all)."""
+
+MAX_PROCESSES = 8
+"""Worker processes at most, whatever the cores: each holds its own interpreter and NumPy."""
 
 _EVALUATOR = None  # in a worker process only: the evaluator its initializer received
 
@@ -50,7 +53,7 @@ class Workers:
 
     def __init__(self, evaluator, processes: int | None = None):
         self.evaluator = evaluator
-        self.processes = available_cores() if processes is None else processes
+        self.processes = min(available_cores(), MAX_PROCESSES) if processes is None else processes
         self._pool = None
 
     def __enter__(self) -> Workers:
