@@ -2,5 +2,5 @@
 
 from .cli import run_console
 
-if __name__ == "__main__":  # not when a worker process (lagsym.toolpath.workers) imports the main module
+if __name__ == "__main__":  # not when another process imports it as its main module
     run_console()

@@ -2,18 +2,22 @@
 
 A plan drops the tool at tens of thousands of positions, each independent of
 the others, so they are computed in chunks by worker processes, one per
-core the process may run on, started once per plan (:class:`Workers`).  The
-workers are *spawned* (a fresh interpreter, not a fork: the caller may hold
-threads, a progress display's for one), which costs a fraction of a second
-once, so a plan uses them only where it has enough positions to pay for it
-(:data:`MIN_POINTS`).  Each worker gets the surface's evaluator once, when it
-starts; a chunk's result is the same whichever process computes it.
+core the process may run on, started once per plan (:class:`Workers`), and
+only where a plan has enough positions to pay for it (:data:`MIN_POINTS`).
+The workers are *forked*: a fresh interpreter would import the caller's main
+module again, which a script without a ``__main__`` guard cannot bear.  A
+fork is safe only while the process runs no other thread (one holding a lock
+at the fork would leave it held in the child), so with other threads
+running (a progress display's, say) the chunks are computed here, one after
+the other.  Each worker has the surface's evaluator from the fork; a chunk's
+result is the same whichever process computes it.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import threading
 
 __all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
 
@@ -47,8 +51,9 @@ def _call(task):
 class Workers:
     """A pool of worker processes for one evaluator, used as a context manager; ``map`` runs chunks in order.
 
-    With fewer than two cores, or ``processes`` below 2, no process is
-    started and :meth:`map` runs the chunks here.
+    With fewer than two cores, ``processes`` below 2, other threads running
+    or no ``fork`` on the platform, no process is started and :meth:`map`
+    runs the chunks here.
     """
 
     def __init__(self, evaluator, processes: int | None = None):
@@ -57,8 +62,9 @@ class Workers:
         self._pool = None
 
     def __enter__(self) -> Workers:
-        if self.processes > 1:
-            ctx = multiprocessing.get_context("spawn")
+        if (self.processes > 1 and threading.active_count() == 1
+                and "fork" in multiprocessing.get_all_start_methods()):
+            ctx = multiprocessing.get_context("fork")
             self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator,))
         return self
 
