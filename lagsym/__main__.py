@@ -2,4 +2,5 @@
 
 from .cli import run_console
 
-run_console()
+if __name__ == "__main__":  # not when another process imports it as its main module
+    run_console()

@@ -277,3 +277,31 @@ def test_the_toolpaths_page_quotes_the_arc_figures(rs274, tmp_path, name, label)
     assert low >= -0.1 and high <= 6.1  # never below; the tolerance and a unit of rounding above
     assert (f"{label}: {before:,} feed moves, {after:,} with {arcs:,} arcs, which lie {low:.1f} to {high:.1f} um "
             f"above the cutter path") in page("toolpaths.md")
+
+
+def test_the_toolpaths_page_quotes_the_planning_figures():
+    from lagsym.toolpath.workers import MAX_PROCESSES, MIN_POINTS
+
+    text = page("toolpaths.md")
+    assert f"Plans of {MIN_POINTS:,} fine samples or more share the positions" in text
+    assert MAX_PROCESSES == 8 and "one per core up to eight" in text
+    assert "STL mesh of 360 cells a side, fine enough to come within about 5 um" in text
+
+
+def test_the_planning_benchmark_mesh_comes_within_5_um():
+    """OpenCAMLib on the 360-cell mesh against the exact drop-cutter, at positions over the box."""
+    ocl = pytest.importorskip("opencamlib")
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from bench_dropcutter import ocl_drop, stl_surface
+
+    from lagsym.toolpath import drop_cutter
+
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    rng = np.random.default_rng(2)
+    x, y = rng.uniform(1.15, 4.85, 150), rng.uniform(1.15, 4.85, 150)
+    exact = drop_cutter(surface, x, y, 0.15, lattice=24, starts=8, margin=False) * 20
+    z = ocl_drop(ocl, stl_surface(ocl, surface, 360, 20.0), 6.0, x * 20, y * 20, -100.0)
+    err = np.abs(z - exact).max()
+    assert 1e-3 < err <= 5e-3  # mm: a mesh of the surface, within 5 um of it

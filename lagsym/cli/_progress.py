@@ -39,14 +39,17 @@ def progress_bar(err):
 
     columns = (TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), MofNCompleteColumn(),
                TimeElapsedColumn())
-    # stdout and stderr are left alone: a program written to standard output must reach it unchanged
+    # stdout and stderr are left alone: a program written to standard output must reach it unchanged.  Drawn
+    # on each report, not by a refresh thread: the toolpath planner forks its workers only while no other
+    # thread runs, and a bar must not cost it the other core.
     with Progress(*columns, console=Console(file=err), transient=True, redirect_stdout=False,
-                  redirect_stderr=False) as bars:
+                  redirect_stderr=False, auto_refresh=False) as bars:
         tasks = {}
 
         def update(done: int, total: int | None, stage: str) -> None:
             if stage not in tasks:
                 tasks[stage] = bars.add_task(stage, total=total)
             bars.update(tasks[stage], completed=done, total=total)
+            bars.refresh()
 
         yield update

@@ -177,29 +177,38 @@ def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
     est = d + np.maximum(0.0, 2.0 * d - left - right) / 4.0
     order = np.lexsort((-est, idx))
     worst = order[start]  # the worst sample of each move
-    du, dz, zw = _zoom(cl, (ax, ay, az, bx, by, bz), u[worst], d[worst], zc[worst], 1.0 / (n_move + 1))
+    # The zoom's first round reaches the worst sample's neighbours, a move's end where it is one: known already.
+    lo, hi = np.maximum(worst - 1, 0), np.minimum(worst + 1, idx.size - 1)
+    ends = (np.where(first[worst], az, zc[lo]), np.where(last[worst], bz, zc[hi]))
+    du, dz, zw = _zoom(cl, (ax, ay, az, bx, by, bz), u[worst], d[worst], zc[worst], 1.0 / (n_move + 1), ends)
     return np.maximum(np.maximum(est[worst], dz), 0.0), du, zw
 
 
 _ZOOM_SAMPLES, _ZOOM_ROUNDS = 6, 3
 
 
-def _zoom(cl, move, u, d, z, half):
+def _zoom(cl, move, u, d, z, half, ends=None):
     """The dip of each move searched closer around its worst sample ``u`` (fraction along it; ``half`` apart).
 
     A path that bends sharply next to a sample (where the tool starts to
     rest on a box edge) can rise above the move between two samples by more
     than their second differences show; :data:`_ZOOM_ROUNDS` rounds of
     :data:`_ZOOM_SAMPLES` samples, each over a third of the span before,
-    find that peak.  Returns the best fraction, the dip there and the cutter
-    location there.
+    find that peak.  ``ends``, where given, are the cutter locations at the
+    first round's two outer samples, ``u - half`` and ``u + half`` (the
+    samples either side, or the move's ends).  Returns the best fraction,
+    the dip there and the cutter location there.
     """
     ax, ay, az, bx, by, bz = move
     t = np.linspace(-1.0, 1.0, _ZOOM_SAMPLES)
-    for _ in range(_ZOOM_ROUNDS):
+    for r in range(_ZOOM_ROUNDS):
         q = np.clip(u[:, None] + half[:, None] * t[None, :], 0.0, 1.0)
-        zq = cl((ax[:, None] + q * (bx - ax)[:, None]).ravel(), (ay[:, None] + q * (by - ay)[:, None]).ravel())
-        zq = np.asarray(zq).reshape(q.shape)
+        known = r == 0 and ends is not None
+        qn = q[:, 1:-1] if known else q
+        zq = cl((ax[:, None] + qn * (bx - ax)[:, None]).ravel(), (ay[:, None] + qn * (by - ay)[:, None]).ravel())
+        zq = np.asarray(zq).reshape(qn.shape)
+        if known:
+            zq = np.concatenate([ends[0][:, None], zq, ends[1][:, None]], axis=1)
         dq = zq - (az[:, None] + q * (bz - az)[:, None])
         k = np.argmax(dq, axis=1)
         rows = np.arange(len(u))

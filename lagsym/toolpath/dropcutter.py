@@ -38,6 +38,8 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import TOOL_SHAPES, cutter_profile
 from ..values import choice, positive
+from .newton import newton_ball
+from .workers import Workers
 
 __all__ = ["CL_MARGIN", "drop_cutter"]
 
@@ -51,7 +53,8 @@ _HALF = math.sqrt(0.5)
 
 
 def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: float | None = None, lattice: int = 8,
-                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None) -> np.ndarray:
+                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
+                workers: Workers | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
     Parameters
@@ -77,6 +80,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
         a lower bound of the exact one.
     evaluator : SurfaceEvaluator, optional
         The surface's evaluator (by default :func:`lagsym.evaluate.surface_evaluator`).
+    workers : Workers, optional
+        Worker processes for this evaluator (:mod:`.workers`) that share the
+        positions out in chunks; the values are the same as without.
 
     Returns
     -------
@@ -108,10 +114,13 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
     offsets, inside, nearest = _lattice(radius, spacing)
     span = _height_scale(ev) + radius + 1.0
-    out = np.empty(cx.size)
-    for s in range(0, cx.size, _CHUNK):
-        out[s:s + _CHUNK] = _drop_chunk(ev, cx[s:s + _CHUNK], cy[s:s + _CHUNK], radius, corner, offsets,
-                                        (inside, nearest), spacing, starts, box, 0.01 * CL_MARGIN * span)
+    parallel = workers is not None and workers.parallel and workers.evaluator is ev
+    # Each position's value is independent of the chunk it is computed in.
+    chunk = max(256, min(_CHUNK, -(-cx.size // (4 * workers.processes)))) if parallel else _CHUNK
+    tasks = [(cx[s:s + chunk], cy[s:s + chunk], radius, corner, offsets, (inside, nearest), spacing, starts, box,
+              0.01 * CL_MARGIN * span) for s in range(0, cx.size, chunk)]
+    parts = workers.map(_drop_chunk, tasks) if parallel else [_drop_chunk(ev, *t) for t in tasks]
+    out = np.concatenate(parts) if parts else np.empty(0)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
@@ -225,16 +234,28 @@ def _project(px, py, cx, cy, radius, box):
     the axis onto the rim (the box is convex and holds the axis).  With the
     axis beyond the box (``--boundary past``), it is pulled along the line to
     the box point nearest the axis (in both, the two being convex) until it
-    meets the rim.
+    meets the rim.  Candidates are ``(positions, k)`` arrays, the axis
+    ``(positions, 1)``; only the rows with a point outside the disc take the
+    second step.
     """
     x0, x1, y0, y1 = box
-    px = np.clip(px, x0, x1)
-    py = np.clip(py, y0, y1)
+    px = np.minimum(np.maximum(px, x0), x1)
+    py = np.minimum(np.maximum(py, y0), y1)
     dx, dy = px - cx, py - cy
     d2 = dx * dx + dy * dy
     over = d2 > radius * radius
     if not np.any(over):
         return px, py, d2
+    rows = np.flatnonzero(over.any(axis=1))  # px, py and d2 are this call's own arrays: changed in place
+    cx, cy = np.broadcast_to(cx, px.shape), np.broadcast_to(cy, px.shape)
+    px[rows], py[rows], d2[rows] = _onto_disc(px[rows], py[rows], dx[rows], dy[rows], d2[rows], over[rows],
+                                              cx[rows], cy[rows], radius, box)
+    return px, py, d2
+
+
+def _onto_disc(px, py, dx, dy, d2, over, cx, cy, radius, box):
+    """The second step of :func:`_project`, for the points in the box ``over`` the rim (all arrays one shape)."""
+    x0, x1, y0, y1 = box
     beyond = np.broadcast_to((cx < x0) | (cx > x1) | (cy < y0) | (cy > y1), px.shape)
     radial = over & ~beyond
     if np.any(radial):
@@ -289,34 +310,42 @@ def _height(ev, px, py, d2, radius, corner):
 
 def _drop_chunk(ev, cx, cy, radius, corner, offsets, lattice, spacing, starts, box, settle):
     """Drop-cutter over one chunk of positions: dense candidates, then a local search from the best of each basin."""
-    val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box)
+    val, px, py = _candidates(ev, cx, cy, radius, corner, offsets, box, int(lattice[0].sum()))
     order = _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts)
     rows = np.arange(cx.size)[:, None]
-    found = _refine(ev, px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel(),
-                    np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1]), radius, corner, box,
-                    spacing, settle)
+    sx, sy, sv = px[rows, order].ravel(), py[rows, order].ravel(), val[rows, order].ravel()
+    scx, scy = np.repeat(cx, order.shape[1]), np.repeat(cy, order.shape[1])
+    # A ball's starts first climb by Newton steps, which leave the pattern search a short way to settle.
+    h, done = newton_ball(ev, sx, sy, sv, scx, scy, radius, box, spacing, settle) if corner == radius \
+        else (spacing, None)
+    found = _refine(ev, sx, sy, sv, scx, scy, radius, corner, box, h, settle, done)
     return np.maximum(found.reshape(cx.size, -1).max(axis=1), val.max(axis=1))
 
 
-def _candidates(ev, cx, cy, radius, corner, offsets, box):
+def _candidates(ev, cx, cy, radius, corner, offsets, box, m):
     """Heights and contact points of the lattice and rim under each tool, then of the corners of the region under it.
 
     The corners are the box corners and where the rim crosses a box edge.
+    The first ``m`` offsets are the lattice's, inside the disc.
     Returns arrays of shape ``(positions, candidates)``.
     """
     n, k = cx.size, len(offsets)
-    # Dense candidates, a block of offsets at a time to bound memory.
+    # Dense candidates, a block of offsets at a time to bound memory; the lattice apart from the rim, which
+    # rounding puts just outside the disc, so the lattice's points need no more than the box.
     block = max(1, (1 << 22) // max(n, 1))
-    val, px, py = np.empty((n, k)), np.empty((n, k)), np.empty((n, k))
-    for s in range(0, k, block):
-        ox, oy = offsets[s:s + block, 0], offsets[s:s + block, 1]
+    ex, ey = _edge_points(cx, cy, radius, box)
+    w = k + ex.shape[1]
+    val, px, py = np.empty((n, w)), np.empty((n, w)), np.empty((n, w))
+    cuts = sorted(set(range(0, k, block)) | {m, k})
+    for s, e in zip(cuts[:-1], cuts[1:]):
+        block = e - s
+        ox, oy = offsets[s:e, 0], offsets[s:e, 1]
         qx, qy, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
         val[:, s:s + block] = _height(ev, qx, qy, d2, radius, corner)
         px[:, s:s + block], py[:, s:s + block] = qx, qy
-    ex, ey = _edge_points(cx, cy, radius, box)
     qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
-    return (np.concatenate([val, _height(ev, qx, qy, d2, radius, corner)], axis=1),
-            np.concatenate([px, qx], axis=1), np.concatenate([py, qy], axis=1))
+    val[:, k:], px[:, k:], py[:, k:] = _height(ev, qx, qy, d2, radius, corner), qx, qy
+    return val, px, py
 
 
 def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
@@ -338,15 +367,19 @@ def _starts(val, px, py, cx, cy, offsets, lattice, spacing, starts):
     return _spread_starts(val, px, py, starts, 2.5 * spacing, rank)
 
 
-def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, spacing, settle):
+def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, step, settle, poll=None):
     """Pattern search from each start, in place: the best contact height found from each.
 
-    Eight steps a round, along the axes and along and across the radius;
+    Eight steps a round, along the axes and along and across the radius,
+    from ``step`` (one for all, or one for each start);
     the step halves where none climbs, down to ``1e-9`` of the radius.
+    A start marked in ``poll`` (a maximum Newton's method converged to) is
+    done when its first round does not climb; where it does, the search
+    goes on from there as for any start.
     """
-    h = np.full(px.size, spacing)
+    h = np.array(np.broadcast_to(step, px.shape), dtype=float)
     stop = radius * 1e-9
-    for _ in range(120):
+    for rnd in range(120):
         active = h > stop
         if not active.any():
             break
@@ -378,6 +411,8 @@ def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, spacing, settle):
         h[iu[creep]] *= 0.5
         # Where no neighbour differs by more than a hundredth of the margin, the value has settled.
         settled = ~up & (np.max(np.abs(np.where(np.isfinite(qv), qv, val[ia, None]) - val[ia, None]), axis=1) < settle)
+        if rnd == 0 and poll is not None:
+            settled |= ~up & poll[ia]
         h[ia[settled]] = 0.0
     return val
 
@@ -392,7 +427,10 @@ def _spread_starts(val, px, py, starts, apart, rank=None):
     """
     n, k = val.shape
     key = val if rank is None else val - rank * (np.ptp(val, axis=1, keepdims=True) + 1.0)
-    top = np.argsort(-key, axis=1)[:, :min(k, 8 * starts + 32)]
+    many = min(k, 8 * starts + 32)
+    # The best ``many`` of each row, best first: partitioned out, then only those sorted.
+    top = np.argpartition(-key, many - 1, axis=1)[:, :many] if many < k else np.tile(np.arange(k), (n, 1))
+    top = np.take_along_axis(top, np.argsort(-np.take_along_axis(key, top, axis=1), axis=1), axis=1)
     rows = np.arange(n)[:, None]
     tx, ty = px[rows, top], py[rows, top]
     chosen = [top[:, 0]]

@@ -26,10 +26,12 @@ from .filter import filter_rows
 from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
 from .resolution import ResolutionGrid, without_repeats
 from .scallop import scallop_levels
+from .workers import MIN_POINTS, Workers
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
 MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
+_ROW_BLOCK = 1 << 15  # fine samples dropped at a time, whole rows
 
 
 @dataclass(frozen=True)
@@ -143,8 +145,23 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
-    path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
     kappa = ev.curvature_bound() / mm_per_unit
+    # Worker processes on the other cores, where the plan is large enough to pay for starting them.
+    with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
+        cl = replace(cl, workers=workers)
+        path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
+        tp = _checked(ev, cl, path, tol, raster, kappa, every, settings, progress)
+    bx, by, _ = _place(settings, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
+    tp = Toolpath(**tp, tool=tool, raster=raster,
+                  stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1
+                  else float(_side_step(tool, raster)),
+                  step_mm=float(step), bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
+                  fine_points=len(path.x), **_cusp(scallop, raster.direction, settings))
+    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+
+
+def _checked(ev, cl, path, tol, raster, kappa, every, settings, progress=None) -> dict:
+    """The emitted points of the fine path, its moves checked and lifted: the point fields of a :class:`Toolpath`."""
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
     sag, seen = chordal.move_sags(path.s_mm, path.z, kept, bend, kappa)
@@ -160,20 +177,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     with Tally(progress, "checking moves") as checks:
         vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen, dense, tol,
                                                     cl.radius)
-    b = ev.bounds
-    bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
-    tp = Toolpath(
-        **without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
-                          _place(settings, vx, vy, vz)[2], cl.unit * mm_per_unit),
-        tool=tool,
-        raster=raster,
-        stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1 else float(_side_step(tool, raster)),
-        step_mm=float(step),
-        bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
-        fine_points=len(path.x),
-        **_cusp(scallop, raster.direction, settings),
-    )
-    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+    return without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                           _place(settings, vx, vy, vz)[2], cl.unit * cl.mm_per_unit)
 
 
 def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSettings, kappa: float) -> Toolpath:
@@ -311,6 +316,7 @@ class _Cutter:
     lift_tip: float
     mm_per_unit: float
     grid: ResolutionGrid | None = None
+    workers: Workers | None = None
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
@@ -324,7 +330,8 @@ class _Cutter:
         return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev, **search)
+        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev,
+                        workers=self.workers, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
     @property
@@ -402,7 +409,14 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    fz = Tally(progress, "dropping the tool", len(fx)).whole(cl, (fx, fy))
+    # Whole rows and their links, about _ROW_BLOCK samples at a time, each block counted as it is dropped.
+    cuts = [lo for lo, _, row in pieces if row][::max(1, _ROW_BLOCK // len(along))] + [len(fx)]
+    with Tally(progress, "dropping the tool", len(fx)) as drops:
+        fz = []
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            fz.append(cl(fx[a:b], fy[a:b]))
+            drops.add(b - a)
+    fz = np.concatenate(fz)
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 

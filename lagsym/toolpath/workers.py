@@ -1,0 +1,87 @@
+"""Drop-cutter on every core: chunks of tool positions shared among worker processes.
+
+A plan drops the tool at tens of thousands of positions, each independent of
+the others, so they are computed in chunks by worker processes, one per
+core the process may run on, started once per plan (:class:`Workers`), and
+only where a plan has enough positions to pay for it (:data:`MIN_POINTS`).
+The workers are *forked*: a fresh interpreter would import the caller's main
+module again, which a script without a ``__main__`` guard cannot bear.  A
+fork is safe only while the process runs no other thread (one holding a lock
+at the fork would leave it held in the child), so with other threads
+running (a progress display's, say) the chunks are computed here, one after
+the other.  Each worker has the surface's evaluator from the fork; a chunk's
+result is the same whichever process computes it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import threading
+
+__all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
+
+MIN_POINTS = 40_000
+"""Fine samples from which a plan starts worker processes (below it, one process does all)."""
+
+MAX_PROCESSES = 8
+"""Worker processes at most, whatever the cores: each holds its own interpreter and NumPy."""
+
+_EVALUATOR = None  # in a worker process only: the evaluator its initializer received
+
+
+def available_cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on every platform
+        return os.cpu_count() or 1
+
+
+def _start(evaluator) -> None:
+    global _EVALUATOR
+    _EVALUATOR = evaluator
+
+
+def _call(task):
+    fn, args = task
+    return fn(_EVALUATOR, *args)
+
+
+class Workers:
+    """A pool of worker processes for one evaluator, used as a context manager; ``map`` runs chunks in order.
+
+    With fewer than two cores, ``processes`` below 2, other threads running
+    or no ``fork`` on the platform, no process is started and :meth:`map`
+    runs the chunks here.
+    """
+
+    def __init__(self, evaluator, processes: int | None = None):
+        self.evaluator = evaluator
+        self.processes = min(available_cores(), MAX_PROCESSES) if processes is None else processes
+        self._pool = None
+
+    def __enter__(self) -> Workers:
+        if (self.processes > 1 and threading.active_count() == 1
+                and "fork" in multiprocessing.get_all_start_methods()):
+            ctx = multiprocessing.get_context("fork")
+            self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator,))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    @property
+    def parallel(self) -> bool:
+        """Whether chunks run in worker processes."""
+        return self._pool is not None
+
+    def map(self, fn, chunks) -> list:
+        """``[fn(evaluator, *args) for args in chunks]``, in the worker processes where there are any."""
+        chunks = list(chunks)
+        if self._pool is None or len(chunks) < 2:
+            return [fn(self.evaluator, *args) for args in chunks]
+        return self._pool.map(_call, [(fn, args) for args in chunks], chunksize=1)

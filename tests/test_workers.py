@@ -1,0 +1,76 @@
+"""Drop-cutter in worker processes gives the values one process gives."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+
+import numpy as np
+
+from lagsym.evaluate import surface_evaluator
+from lagsym.io import read_points
+from lagsym.lagrange import lagrange_surface
+from lagsym.toolpath import drop_cutter
+from lagsym.toolpath.workers import Workers
+
+from conftest import EXAMPLES, ROOT
+from cutters import brute
+
+
+def test_worker_processes_give_the_same_values_as_one_process():
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(11)
+    x, y = rng.uniform(1, 5, 3000), rng.uniform(1, 5, 3000)
+    alone = drop_cutter(surface, x, y, 0.15, evaluator=ev)
+    with Workers(ev, 2) as workers:
+        assert workers.parallel
+        shared = drop_cutter(surface, x, y, 0.15, evaluator=ev, workers=workers)
+    assert np.array_equal(shared, alone)
+    for k in range(3):  # and the values are drop-cutter's: never below a brute-force search
+        assert shared[k] >= brute(surface, x[k], y[k], 0.15)
+
+
+def test_one_process_runs_the_chunks_here():
+    ev = surface_evaluator(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")))
+    with Workers(ev, 1) as workers:
+        assert not workers.parallel
+        assert workers.map(lambda e, a: (e is ev, a), [(1,), (2,)]) == [(True, 1), (True, 2)]
+
+
+def test_a_script_without_a_main_guard_runs_with_workers(tmp_path):
+    # A worker that imported the caller's main module again would run this script once more, without end.
+    script = tmp_path / "plan.py"
+    script.write_text(
+        "from lagsym.evaluate import surface_evaluator\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        "from lagsym.toolpath import drop_cutter\n"
+        "from lagsym.toolpath.workers import Workers\n"
+        f"s = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-4.json')!r}))\n"
+        "ev = surface_evaluator(s)\n"
+        "with Workers(ev, 2) as w:\n"
+        "    z = drop_cutter(s, [2.0] * 600, [3.0] * 600, 0.15, evaluator=ev, workers=w)\n"
+        "print(w.processes, float(z[0]) == float(drop_cutter(s, 2.0, 3.0, 0.15)))\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["2", "True"]
+
+
+def test_with_another_thread_running_the_chunks_run_here():
+    ev = surface_evaluator(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")))
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        with Workers(ev, 2) as workers:
+            assert not workers.parallel
+    finally:
+        stop.set()
+        other.join()
+    with Workers(ev, 2) as workers:
+        assert workers.parallel
