@@ -24,7 +24,7 @@ from .dropcutter import drop_cutter
 from .filter import filter_rows
 from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
 from .resolution import ResolutionGrid, without_repeats
-from .scallop import scallop_levels
+from .scallop import row_cusps, scallop_levels
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
@@ -60,10 +60,15 @@ class Toolpath:
         How many cutter locations the filter chose the points from (the
         blocks a program would have without filtering).
     cusp_mm : float or None
-        With a scallop height, the worst cusp predicted between the rows,
-        measured normal to the surface (mm); None for a fixed side step.
+        For a ball end, the worst cusp predicted between the rows, measured
+        normal to the surface (mm), outside hollows tighter than the ball
+        (:mod:`lagsym.toolpath.scallop`); None for other cutters.
     cusp_at_mm : tuple of float or None
         Where that cusp is, ``(x, y)`` on the machine.
+    hollow_share : float or None
+        The share of the box (of the prediction's samples) in hollows
+        tighter than the ball, whose bottom it cannot reach: there the cusp
+        prediction does not hold.
     arcs : Arcs or None
         With ``raster.arcs``, the circular moves that replace runs of the
         points (:mod:`lagsym.toolpath.arcs`); None without.
@@ -81,6 +86,7 @@ class Toolpath:
     cusp_mm: float | None = None
     cusp_at_mm: tuple[float, float] | None = None
     arcs: Arcs | None = None
+    hollow_share: float | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -139,6 +145,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
+    if scallop is None and tool.shape == "ball" and tool.radius_mm > 0:  # the cusps a fixed side step leaves
+        scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     path = _fine_path(cl, levels, along, raster.direction, fine, past)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
@@ -213,12 +221,13 @@ def _span(bounds, direction: str) -> float:
 
 
 def _cusp(scallop, direction: str, settings: MachineSettings) -> dict:
-    """The worst predicted cusp and where it is on the machine, for a plan from a scallop height."""
+    """The worst predicted cusp, where it is on the machine and the share of hollows too tight for the ball."""
     if scallop is None:
         return {}
     p, c = scallop.worst_at
     x, y = settings.placement.to_machine(*((p, c) if direction == "x" else (c, p)))
-    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y))}
+    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y)),
+            "hollow_share": scallop.tight / max(scallop.samples, 1)}
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
@@ -408,9 +417,9 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
     With a chordal tolerance alone, the filter keeps the moves within it.
     With a fixed step (the longest move), every ``every``-th sample of a
     row is kept (:func:`_fixed_step_samples`), and along a link the samples
-    a move apart (:func:`_every_step`); where a move's sag exceeds the
-    tolerance, the samples inside it too: points are added where the path
-    bends.  ``extra`` is the sag between samples added to what the samples
+    a move apart (:func:`_every_step`); where a move passes more than the
+    tolerance below the path (its sag) or above the samples it skips, the
+    samples inside it too: points are added where the path bends.  ``extra`` is the sag between samples added to what the samples
     show.
     """
     s_mm, z = path.s_mm, path.z
@@ -423,7 +432,8 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
     kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else _every_step(s_mm, lo, hi, longest_mm)
                                      for lo, hi, is_row in path.pieces]))
     sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
-    split = np.flatnonzero((sag > tol) & (np.diff(kept) > 1))
+    off = np.maximum(sag, chordal.move_rises(s_mm, z, kept))  # either side of the path, as the filter's
+    split = np.flatnonzero((off > tol) & (np.diff(kept) > 1))
     if not split.size:
         return kept
     inner = np.concatenate([np.arange(kept[m] + 1, kept[m + 1]) for m in split])
