@@ -30,7 +30,9 @@ from .io import read_points
 from .job.operations import job_stock
 from .lagrange import lagrange_surface
 from .machine import Placement, Tool
+from .progress import Progress, Tally
 from .verify import MAX_CELLS, height_map_axes, press_moves
+from .verify.heightmap import segments, tool_grid
 
 __all__ = ["Stage", "MachinedPart", "machine_part", "machine_job", "LEFT_BINS_MM"]
 
@@ -126,7 +128,7 @@ class MachinedPart:
 def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: dict[int, Tool], block,
                  placement: Placement = Placement(), cell_mm: float | None = None,
                  program_resolution_mm: float = 0.0005, gouge_limit_mm: float | None = None,
-                 max_cells: int | None = MAX_CELLS) -> MachinedPart:
+                 max_cells: int | None = MAX_CELLS, progress: Progress | None = None) -> MachinedPart:
     """Simulate a whole job's program from the block ``(x0, x1, y0, y1, top_mm)`` (machine mm).
 
     Parameters
@@ -144,6 +146,8 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
     gouge_limit_mm : float, optional
         Depth from which a cut counts as a gouge (default: the program's
         rounding plus the finest stage's resolution).
+    progress : Progress, optional
+        Told the segments swept, stage ``T1: sweeping moves`` and so on for each tool (:mod:`lagsym.progress`).
     """
     x0, x1, y0, y1, top = (float(v) for v in block)
     xs, ys = height_map_axes((x0, x1, y0, y1), cell_mm, max_cells)
@@ -159,7 +163,9 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
             raise InputError(f"the program changes to tool T{number} (line {first}), which the job does not name; "
                              f"its tools: {', '.join(f'T{k}' for k in sorted(tools))}")
         before = cut.copy()
-        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number])
+        swept = Tally(progress, f"T{number}: sweeping moves",
+                      None if progress is None else segments(a, b, tool_grid(tools[number], xs, ys)[2]))
+        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number], swept)
         resolutions.append(res)
         left = cut - surf
         stages.append(Stage(number, tools[number], first, len(a), float((before - cut).sum() * hx * hy), crash, at,
@@ -179,13 +185,15 @@ def machine_job(spec, text: str, source: str = "<program>", **options) -> Machin
 
     The surface is read from the job's points file, the block and the
     placement are the job's, each tool number its cutter; ``options`` go to
-    :func:`machine_part` (``cell_mm``, ``gouge_limit_mm``, ``max_cells``).
+    :func:`machine_part` (``cell_mm``, ``gouge_limit_mm``, ``max_cells``, ``progress``), which for a
+    macro program is told the blocks executed too (:func:`lagsym.simulate.simulate`).
     """
     surface = lagrange_surface(read_points(spec.points))
     stock = job_stock(spec, surface)
     # in a macro program the macro statements are blanked (the lines kept): its tool changes are plain words
     plain = _MACRO_BLOCK.sub("", text) if _MACRO_LINE.search(text) else text
-    return machine_part(surface, job_moves(spec, text, source), tool_changes(plain, source=source),
+    moves = job_moves(spec, text, source, options.get("progress"))
+    return machine_part(surface, moves, tool_changes(plain, source=source),
                         {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
                         Placement(spec.mm_per_unit, spec.origin_mm), **options)
 
@@ -194,7 +202,7 @@ _MACRO_LINE = re.compile(r"^[ \t]*(#|WHILE\b|o\d+[ \t])", re.I | re.M)
 _MACRO_BLOCK = re.compile(r"^[^\n]*(#|\[|^[ \t]*o\d+[ \t]|^[ \t]*END\d)[^\n]*$", re.I | re.M)
 
 
-def job_moves(spec, text: str, source: str = "<program>") -> Moves:
+def job_moves(spec, text: str, source: str = "<program>", progress: Progress | None = None) -> Moves:
     """The moves of a job's program: read as a point list or, where it holds macro loops (a roughing macro,
     ``macro = true``), as lagsym's simulator runs it at the precision of the job's macros."""
     if not _MACRO_LINE.search(text):
@@ -205,7 +213,7 @@ def job_moves(spec, text: str, source: str = "<program>") -> Moves:
     precision = max(op.options.get("precision", DEFAULT_PRECISION[spec.dialect]) for op in spec.operations
                     if op.options.get("macro")) if any(op.options.get("macro") for op in spec.operations) \
         else DEFAULT_PRECISION.get(spec.dialect, 15)
-    sim = simulate(text, spec.dialect, precision).moves
+    sim = simulate(text, spec.dialect, precision, progress=progress).moves
     n = len(sim)
     scale = 25.4 if spec.units == "inch" else 1.0
     pts = np.column_stack([np.frombuffer(c, dtype=float) if n else np.zeros(0) for c in (sim._x, sim._y, sim._z)])
@@ -246,23 +254,31 @@ def _stages(moves: Moves, changes):
         yield number, first, path[:-1][k], path[1:][k], np.asarray(moves.rapid, dtype=bool)[k]
 
 
-def _run(cut, xs, ys, a, b, rapid, tool: Tool):
-    """Press one stage's moves in order; the deepest material a rapid went through, where, and the resolution."""
+def _run(cut, xs, ys, a, b, rapid, tool: Tool, tally: Tally):
+    """Press one stage's moves in order (their segments counted in ``tally``); the deepest material a rapid went
+    through, where, and the resolution."""
+    tally.start()
     deepest, at, res = 0.0, (float(xs[0]), float(ys[0])), 0.0
     # Runs of feed moves and of rapids, in program order: a rapid's cut is measured against the map before it.
     edges = np.flatnonzero(np.diff(rapid.astype(np.int8))) + 1
     for s, e in zip(np.r_[0, edges], np.r_[edges, len(a)]):
         if e <= s:
             continue
+        base = tally.done  # each run's segments swept, counted on from the runs before
+
+        def swept(done, total, stage, base=base):
+            tally.add(base + done - tally.done)
+
         if not rapid[s]:
-            res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool)[1]
+            res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, progress=swept if tally.live else None)[1]
             continue
         before = cut.copy()
-        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool)[1]
+        res = press_moves(cut, xs, ys, a[s:e], b[s:e], tool, progress=swept if tally.live else None)[1]
         drop = before - cut
         k = int(np.argmax(drop))
         if drop.flat[k] > deepest:
             deepest, at = float(drop.flat[k]), _at(xs, ys, k)
+    tally.finish()
     return deepest, at, res
 
 

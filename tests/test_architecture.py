@@ -32,6 +32,7 @@ def test_the_import_contracts_hold():
     ("lagrange.py", "from . import sampling  # noqa: F401", "lagsym.lagrange -> lagsym.sampling"),
     ("grid.py", "from .toolpath import drop_cutter  # noqa: F401", "lagsym.grid -> lagsym.toolpath"),
     ("evaluate.py", "import serial  # noqa: F401", "lagsym.evaluate -> serial"),
+    ("toolpath/plan.py", "import rich  # noqa: F401", "lagsym.toolpath.plan -> rich"),
 ])
 def test_a_reintroduced_cycle_or_stray_import_fails(tmp_path, module, line, broken):
     """The contract is not vacuous: put one wrong import back and it breaks, naming the import."""

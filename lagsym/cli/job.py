@@ -12,6 +12,8 @@ each.  Every key of the job file is checked.  The cycle-time estimate of
 each operation and of the whole job is printed and written in the program's
 header.  See docs/roughing.md for the job file.
 
+On a terminal, a progress bar on standard error shows the planning of each operation.
+
 examples:
   lagsym job examples/example-4-job.toml -o job.ngc"""
 
@@ -38,8 +40,11 @@ def add_max_points(p) -> None:
 
 def run(args, out, err) -> int:
     from ..job import job_program, plan_job, read_job
+    from ._progress import progress_bar
 
-    planned = plan_job(read_job(args.job), args.max_points, args.max_samples)
+    spec = read_job(args.job)
+    with progress_bar(err) as progress:
+        planned = plan_job(spec, args.max_points, args.max_samples, progress=progress)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

@@ -26,6 +26,8 @@ over the levels, rows and points and computes each tip height from the
 surface equation, never below the drop-cutter height plus the stock (see
 docs/roughing.md for the proof of its clearance).
 
+On a terminal, a progress bar on standard error shows the planning.
+
 examples:
   lagsym rough examples/paper-example-4.json --scale 20 --stock-above 2 --tool-shape flat \\
       --tool-diameter 10 --stepdown 2 --stepover 5 --stock-to-leave 0.3 --safe-z 90 --dialect linuxcnc -o rough.ngc
@@ -149,11 +151,14 @@ def run(args, out, err) -> int:
     from ..job import job_program, plan_job
     from ..job.spec import parse_job
     from ..toolpath.rough import MAX_ROUGH_SAMPLES
+    from ._progress import progress_bar
     from .job import report
 
     _refuse(args)
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
-    planned = plan_job(parse_job(job_data(args), "lagsym rough"), args.max_points, samples)
+    spec = parse_job(job_data(args), "lagsym rough")
+    with progress_bar(err) as progress:
+        planned = plan_job(spec, args.max_points, samples, progress=progress)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

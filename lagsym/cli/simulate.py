@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..io import read_program
 from ..simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, SIM_DIALECTS, detect_dialect, moves_csv, simulate
 from ._common import count, emit
+from ._progress import progress_bar
 
 MAX_BLOCKS_LIMIT = 100_000_000  # the moves of a run this long take at most 3.7 GB
 
@@ -23,6 +24,8 @@ A program that would never end stops within seconds with the runaway alarm
 it changes (WHILE [1 EQ 1], a GOTO back) or when the run comes back to a block
 with every variable and the position unchanged, after --max-idle-blocks
 blocks without a move, or after --max-blocks blocks in all.
+
+On a terminal, a progress bar on standard error shows the blocks executed.
 
 examples:
   lagsym simulate O1000.nc --precision 8 -o moves.csv
@@ -46,7 +49,9 @@ def run(args, out, err) -> int:
     text = read_program(args.program)
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or (15 if dialect == "linuxcnc" else 8)
-    sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks)
+    with progress_bar(err) as progress:
+        sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks,
+                       progress=progress)
     emit(moves_csv(sim), args.output, out)
     feeds = sim.moves.feeds()
     err.write(f"{args.program}: {dialect}, {precision} digits: {sim.blocks} blocks executed, "

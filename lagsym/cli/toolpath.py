@@ -11,12 +11,15 @@ from ..toolpath.plan import MAX_PLAN_POINTS
 
 from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
+from ._progress import progress_bar
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
 FILE and write it as a point-list G-code program.  Cutter locations come from
 drop-cutter against the exact surface, so the tool never cuts below it, also
 where the surface is more concave than the tool.  The programmed point is the
 tool tip; the tool stays down between rows.
+
+On a terminal, a progress bar on standard error shows the planning.
 
 examples:
   lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
@@ -88,7 +91,9 @@ def run(args, out, err) -> int:
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary, args.arcs)
-    tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points)
+    with progress_bar(err) as progress:
+        tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points,
+                           progress=progress)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
     if args.output and args.output != "-":

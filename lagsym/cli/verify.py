@@ -12,6 +12,7 @@ from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
 from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
+from ._progress import progress_bar
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
 height map over the box of the control points in SURFACE, and compare the
@@ -35,6 +36,8 @@ the material left above the surface (largest, where, and a histogram).  The
 job gives the tools, scale and origin, so those options are refused with it.
 It exits 1 on a gouge, a rapid through material, or, when --max-left is
 given, more material left than that.
+
+On a terminal, a progress bar on standard error shows the moves swept.
 
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6
@@ -79,7 +82,7 @@ def add_arguments(p) -> None:
 
 def run(args, out, err) -> int:
     if args.job:
-        return _run_job(args, out)
+        return _run_job(args, out, err)
     for key, default in _SINGLE_TOOL.items():
         if getattr(args, key) is None:
             setattr(args, key, default)
@@ -87,16 +90,18 @@ def run(args, out, err) -> int:
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
-    report = simulate_cut(surface, moves, Tool(args.tool_shape, args.tool_diameter, args.corner_radius), place,
-                          cell_mm=args.cell, program_resolution_mm=program_resolution_mm(text),
-                          gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells, max_contacts=args.max_contacts,
-                          max_left_mm=MAX_LEFT_MM if args.max_left is None else args.max_left,
-                          max_scallop_mm=args.max_scallop)
+    tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
+    with progress_bar(err) as progress:
+        report = simulate_cut(surface, moves, tool, place, cell_mm=args.cell,
+                              program_resolution_mm=program_resolution_mm(text), gouge_limit_mm=args.gouge_limit,
+                              max_cells=args.max_cells, max_contacts=args.max_contacts,
+                              max_left_mm=MAX_LEFT_MM if args.max_left is None else args.max_left,
+                              max_scallop_mm=args.max_scallop, progress=progress)
     out.write("\n".join(report.summary()) + "\n")
     return ExitStatus.WARNING if report.fails else ExitStatus.OK
 
 
-def _run_job(args, out) -> int:
+def _run_job(args, out, err) -> int:
     from ..job import read_job
     from ..machined import machine_job
 
@@ -108,8 +113,10 @@ def _run_job(args, out) -> int:
         option = "--" + given[0].replace("_", "-")
         raise InputError(f"{option} is not for --job: the job file {args.surface} names the tools, scale and origin")
     spec = read_job(args.surface)
-    part = machine_job(spec, read_program(args.program), source=args.program, cell_mm=args.cell,
-                       gouge_limit_mm=args.gouge_limit, max_cells=args.max_cells)
+    text = read_program(args.program)
+    with progress_bar(err) as progress:
+        part = machine_job(spec, text, source=args.program, cell_mm=args.cell, gouge_limit_mm=args.gouge_limit,
+                           max_cells=args.max_cells, progress=progress)
     out.write("\n".join(part.summary()) + "\n")
     too_much = args.max_left is not None and part.left_mm > args.max_left
     if too_much:

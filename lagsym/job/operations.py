@@ -21,6 +21,7 @@ from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec
 from ..macro import DEFAULT_PRECISION
 from ..macro.roughing import rough_macro
+from ..progress import Progress, Tally, prefixed
 from ..toolpath import plan_toolpath
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
@@ -90,11 +91,14 @@ def _settings(spec: JobSpec, op: OperationSpec | None = None, stock_mm: float = 
 
 
 def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
-             max_samples: int | None = MAX_ROUGH_SAMPLES) -> PlannedJob:
+             max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None) -> PlannedJob:
     """Read the points, build the block and plan every operation in order.
 
     Each operation is estimated before it is planned: at most ``max_points``
     points, and a roughing level at most ``max_samples`` drop-cutter samples.
+    ``progress`` is told the operations planned (stage ``operations``) and
+    each planner's own stages after the operation's label
+    (``rough T1: dropping the tool``; :mod:`lagsym.progress`).
     """
     surface = lagrange_surface(read_points(spec.points))
     ev = surface_evaluator(surface)
@@ -102,16 +106,22 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     if spec.safe_z_mm <= stock.top_mm:
         raise InputError(f"{spec.source}: safe_z = {spec.safe_z_mm:g} mm is not above the stock top {stock.top_mm:g} mm")
     ops = []
+    planned = Tally(progress, "operations", len(spec.operations))
+    planned.start()
     for i, op in enumerate(spec.operations):
+        tool = spec.tools[op.tool]
         try:
-            ops.append(_plan(spec, op, spec.tools[op.tool], surface, ev, stock, i, (max_points, max_samples)))
+            ops.append(_plan(spec, op, tool, surface, ev, stock, i, (max_points, max_samples),
+                             prefixed(progress, f"{op.kind} T{tool.number}")))
         except ToolpathError as e:
             raise InputError(f"{spec.source}: operations[{i}] ({op.kind}): {e}") from None
+        planned.add(1)
+    planned.finish()
     return PlannedJob(spec, surface, stock, tuple(ops))
 
 
 def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, i: int,
-          limits: tuple) -> Operation:
+          limits: tuple, progress: Progress | None = None) -> Operation:
     o = op.options
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
@@ -126,7 +136,7 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
             kinds = np.full(len(rm.points_mm), FEED, dtype=np.int8)
             kinds[0] = PLUNGE
             return Operation(op, tool, rm.points_mm, kinds, rm)
-        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev, *limits)
+        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev, *limits, progress=progress)
         return Operation(op, tool, rp.points_mm, rp.kinds, rp)
     default_dir = "y" if op.kind == "cross-finish" else "x"
     stepover = o.get("stepover", None if "scallop" in o else 0.5)
@@ -136,7 +146,7 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
     except LagsymError as e:
         raise ToolpathError(str(e)) from None
     tp = plan_toolpath(surface, tool.tool, raster, _settings(spec, op, o.get("stock_to_leave", 0.0)), ev,
-                       max_points=limits[0])
+                       max_points=limits[0], progress=progress)
     _check_reach(tool, stock, tp.points_mm[:, 2].min())
     p = tp.points_mm
     above = stock.top_mm + 2.0

@@ -7,6 +7,7 @@ from decimal import localcontext
 
 from ..errors import ProgramError
 from ..gcode.limits import VARIABLE_RANGES
+from ..progress import MOST_CALLS, Progress, Tally
 from ..values import choice
 from .alarms import BlockAlarm, ControlAlarm, alarm_at
 from .blocks import Block, End, Label, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, While
@@ -22,7 +23,8 @@ MAX_DO = 3  # Fanuc: DO1..DO3
 
 
 def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
-             variable_ranges=None, max_blocks: int = MAX_BLOCKS, max_idle_blocks: int = MAX_IDLE_BLOCKS) -> Simulation:
+             variable_ranges=None, max_blocks: int = MAX_BLOCKS, max_idle_blocks: int = MAX_IDLE_BLOCKS,
+             progress: Progress | None = None) -> Simulation:
     """Execute ``text`` as the control would, with ``precision`` significant digits.
 
     Parameters
@@ -44,6 +46,9 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         Blocks executed without a move before the run is stopped as a runaway
         loop.  A run that comes back to a block with every variable and the
         position unchanged is stopped at once (see :mod:`~lagsym.simulate.runaway`).
+    progress : Progress, optional
+        Told the blocks executed, every ``max_blocks`` / 200 (stage ``executing blocks``; the total
+        is known only at the end: :mod:`lagsym.progress`).
 
     Raises
     ------
@@ -67,19 +72,25 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     m = Control(dialect, int(precision), variable_ranges or VARIABLE_RANGES[dialect])
     runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, dialect, int(precision)), blocks)
     table, where = compile_program(m, blocks, labels)
-    executed = _run(table, where, blocks, m, runaway)
+    executed = _run(table, where, blocks, m, runaway, Tally(progress, "executing blocks"))
     return Simulation(dialect=dialect, precision=int(precision), moves=m.moves, blocks=executed)
 
 
-def _run(table, where, blocks, m: Control, runaway: Runaway) -> int:
-    """Run the compiled segments from the first block; the number of blocks executed."""
+def _run(table, where, blocks, m: Control, runaway: Runaway, tally: Tally) -> int:
+    """Run the compiled segments from the first block; the number of blocks executed, counted in ``tally``."""
     pc, executed, n = 0, 0, len(blocks)
+    step = max(runaway.max_blocks // MOST_CALLS, 1)
+    tell = step if tally.live else 1 << 62
+    tally.start()
     try:
         with localcontext(m.ctx):  # the operators of the compiled code round as the control does
             while pc < n:
                 run, count, last = table[pc]
                 nxt = run()
                 executed += count
+                if executed >= tell:
+                    tally.add(executed - tally.done)
+                    tell = executed + step
                 if nxt is None:
                     break
                 if nxt <= last:  # a run that never ends jumps back again and again: the guard looks only here
@@ -92,6 +103,8 @@ def _run(table, where, blocks, m: Control, runaway: Runaway) -> int:
         if k is None:
             raise
         raise alarm_at(e, blocks[k]) from None
+    tally.add(executed - tally.done)
+    tally.finish()
     return executed
 
 

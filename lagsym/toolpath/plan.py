@@ -18,11 +18,13 @@ from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
+from ..progress import Progress, Tally
 from . import chordal
 from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
 from .filter import filter_rows
-from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
+from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
+                      tool_reach, within_reach)
 from .resolution import ResolutionGrid, without_repeats
 from .scallop import row_cusps, scallop_levels
 
@@ -101,7 +103,8 @@ class Toolpath:
 
 
 def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
-                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS) -> Toolpath:
+                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS, *,
+                  progress: Progress | None = None) -> Toolpath:
     """Plan a zig-zag raster of gouge-free cutter locations over the surface.
 
     Parameters
@@ -119,6 +122,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     max_points : int or None
         Refuse, before any work, a plan of more fine drop-cutter samples than
         this (``--max-points``); None for no limit.
+    progress : Progress, optional
+        Told the fine samples dropped, then the checks' (:mod:`lagsym.progress`).
 
     Returns
     -------
@@ -147,7 +152,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
     if scallop is None and tool.shape == "ball" and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
-    path = _fine_path(cl, levels, along, raster.direction, fine, past)
+    path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
     kappa = ev.curvature_bound() / mm_per_unit
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
@@ -161,7 +166,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     corner = ((vx < x0) | (vx > x1)) & ((vy < y0) | (vy > y1))
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
-    vx, vy, vz, vrow, sag = chordal.check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, cl.radius)
+    with Tally(progress, "checking moves") as checks:
+        vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen, dense, tol,
+                                                    cl.radius)
     b = ev.bounds
     bx, by, _ = _place(settings, np.array(b[:2]), np.array(b[2:]), 0.0)
     tp = Toolpath(
@@ -209,7 +216,7 @@ def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float
         levels = reach_levels(scallop.levels, *(reach[2:] if raster.direction == "x" else reach[:2]))
     every = None
     if raster.step_mm is not None:
-        along, every = _fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
+        along, every = fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
                                            lambda v: cl.snap_axis(v, 0 if raster.direction == "x" else 1))
     return scallop, levels, along, every
 
@@ -275,22 +282,6 @@ def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float)
     if raster.step_mm is None:
         return fine, fine
     return raster.step_mm, min(raster.step_mm / 2.0, fine)
-
-
-def _fixed_step_samples(a0: float, a1: float, step: float, fine: float, snap):
-    """Samples along a row for a fixed step, and how many samples make one move (surface units).
-
-    The row is cut into equal moves no longer than ``step`` once moved onto
-    the program's resolution (``snap``), each sampled at least twice and no
-    further apart than ``fine``.
-    """
-    moves = max(int(math.ceil((a1 - a0) / step - 1e-9)), 1)
-    while True:
-        every = max(2, int(math.ceil((a1 - a0) / moves / fine - 1e-9)))
-        along = np.linspace(a0, a1, moves * every + 1)
-        if np.diff(snap(along[::every])).max() <= step * (1 + 1e-9):
-            return along, every
-        moves += 1
 
 
 @dataclass(frozen=True)
@@ -371,7 +362,7 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None) -> _FinePath:
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None, progress=None) -> _FinePath:
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
 
     With the tool ``past`` the boundary (that far, surface units), positions
@@ -405,7 +396,7 @@ def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: fl
     # Every position on the program's resolution before the tool is dropped there (one inside the box stays
     # inside): the written X and Y are then the positions whose heights were computed.
     fx, fy = cl.snap(fx, fy)
-    fz = cl(fx, fy)
+    fz = Tally(progress, "dropping the tool", len(fx)).whole(cl, (fx, fy))
     s_mm = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(fx), np.diff(fy)))]) * cl.mm_per_unit
     return _FinePath(fx, fy, fz, frow, s_mm, tuple(pieces))
 
@@ -416,8 +407,8 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
 
     With a chordal tolerance alone, the filter keeps the moves within it.
     With a fixed step (the longest move), every ``every``-th sample of a
-    row is kept (:func:`_fixed_step_samples`), and along a link the samples
-    a move apart (:func:`_every_step`); where a move passes more than the
+    row is kept (:func:`~lagsym.toolpath.pattern.fixed_step_samples`), and along a link the samples
+    a move apart (:func:`~lagsym.toolpath.pattern.every_step`); where a move passes more than the
     tolerance below the path (its sag) or above the samples it skips, the
     samples inside it too: points are added where the path bends.  ``extra`` is the sag between samples added to what the samples
     show.
@@ -429,7 +420,7 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
             k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], z[lo:hi + 1], tol, extra[lo:hi + 1]) + lo
             kept.extend(int(v) for v in k[1:])
         return np.array(kept, dtype=int)
-    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else _every_step(s_mm, lo, hi, longest_mm)
+    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else every_step(s_mm, lo, hi, longest_mm)
                                      for lo, hi, is_row in path.pieces]))
     sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
     off = np.maximum(sag, chordal.move_rises(s_mm, z, kept))  # either side of the path, as the filter's
@@ -438,14 +429,3 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
         return kept
     inner = np.concatenate([np.arange(kept[m] + 1, kept[m + 1]) for m in split])
     return np.union1d(kept, inner)
-
-
-def _every_step(s_mm: np.ndarray, lo: int, hi: int, longest_mm: float) -> np.ndarray:
-    """The samples ``lo..hi`` of one piece a move apart: from each, the furthest no more than ``longest_mm`` on."""
-    s = s_mm[lo:hi + 1] - s_mm[lo]
-    reach = np.maximum(np.searchsorted(s, s + longest_mm * (1 + 1e-9), side="right") - 1, np.arange(len(s)) + 1)
-    out, i = [0], 0
-    while i < len(s) - 1:
-        i = int(min(reach[i], len(s) - 1))
-        out.append(i)
-    return np.array(out, dtype=int) + lo

@@ -41,6 +41,7 @@ from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import DIRECTIONS, TOOL_SHAPES, MachineSettings, Tool
+from ..progress import Progress, Tally
 from ..values import choice, finite, positive
 from .chordal import check_moves, crosses_box_edge, lift
 from .dropcutter import drop_cutter
@@ -55,6 +56,7 @@ MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked ex
 
 MILLING = ("zigzag", "climb", "conventional")
 _SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
+_PIECE = 1 << 12  # drop-cutter positions between progress reports (the drop's own chunk)
 
 
 @dataclass(frozen=True)
@@ -165,7 +167,7 @@ class RoughPath:
 
 def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings,
                    evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS,
-                   max_samples: int | None = MAX_ROUGH_SAMPLES) -> RoughPath:
+                   max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None) -> RoughPath:
     """Plan z-level roughing of ``stock`` down to the surface plus the stock to leave.
 
     Parameters
@@ -184,6 +186,8 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     max_samples : int or None
         Refuse, before any drop-cutter work, more samples than this in one
         level (rows times samples per row: the slow part); None: no limit.
+    progress : Progress, optional
+        Told the samples dropped, then the rows checked (:mod:`lagsym.progress`).
 
     Examples
     --------
@@ -204,7 +208,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
     if spec.pattern == "offset":
         x, y = offset_line(stock, box, tool.radius_mm, spec)
-        floors = floor_at(surface, ev, place, tool, box, [x], [y], spec.stock_to_leave_mm)
+        floors = floor_at(surface, ev, place, tool, box, [x], [y], spec.stock_to_leave_mm, progress=progress)
 
         def cl(px, py, **search):
             return floor_at(surface, ev, place, tool, box, [np.asarray(px, float)], [np.asarray(py, float)],
@@ -214,8 +218,8 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
         floors, lifts = [floor], [up]
     else:
         rows = _rows(stock, box, tool.radius_mm, spec)
-        rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec), surface, ev,
-                                       place, tool, box, spec, sigma)
+        rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec, progress), surface,
+                                       ev, place, tool, box, spec, sigma, progress)
     reachable = np.concatenate([f for f in floors])
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
@@ -301,23 +305,25 @@ def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
             for c in spaced(c0, c1, spec.stepover_mm)]
 
 
-def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec) -> list[np.ndarray]:
+def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec, progress=None) -> list[np.ndarray]:
     """``CL + stock`` (mm) at every sample of every row, ``-inf`` where the tool does not touch the box."""
     along_x = spec.direction == "x"
     xs, ys = [], []
     for r in rows:
         xs.append(r.along if along_x else np.full(len(r.along), r.cross))
         ys.append(np.full(len(r.along), r.cross) if along_x else r.along)
-    return floor_at(surface, ev, place, tool, box, xs, ys, spec.stock_to_leave_mm)
+    return floor_at(surface, ev, place, tool, box, xs, ys, spec.stock_to_leave_mm, progress=progress)
 
 
-def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **search) -> list[np.ndarray]:
+def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progress: Progress | None = None,
+             **search) -> list[np.ndarray]:
     """``CL + stock`` (mm) at tool positions ``xs, ys`` (lists of mm arrays) anywhere on the machine.
 
     A position outside the box but within the tool radius of it takes the
     height at the nearest point of the box; farther out the tool touches
     nothing (``-inf``).  ``search`` goes to
-    :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``).
+    :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``); ``progress`` is
+    told the positions dropped (stage ``dropping the tool``).
     """
     x, y = np.concatenate(xs), np.concatenate(ys)
     px, py = np.clip(x, box[0], box[1]), np.clip(y, box[2], box[3])
@@ -326,8 +332,9 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, **sea
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
         corner = tool.corner_mm / place.mm_per_unit if tool.shape == "bull" else None
-        z = drop_cutter(surface, u, v, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner, evaluator=ev,
-                        **search)
+        z = Tally(progress, "dropping the tool", len(u)).whole(
+            lambda pu, pv: drop_cutter(surface, pu, pv, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner,
+                                       evaluator=ev, **search), (u, v), _PIECE)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 
@@ -352,7 +359,7 @@ def checked_line(cl, vx, vy, f, box, radius: float, sigma: float):
     return nx, ny, floor, sigma + lift(sag)
 
 
-def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float):
+def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float, progress=None):
     """Rows whose moves are checked against the true floor where the tool meets a box edge, and each sample's lift.
 
     Away from the box edges the flat or ball end's height is semi-convex and
@@ -374,6 +381,8 @@ def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec,
                         spec.stock_to_leave_mm, **search)[0]
 
     out_rows, out_floors, lifts = [], [], []
+    checks = Tally(progress, "checking rows", len(rows))
+    checks.start()
     for r, f in zip(rows, floors):
         cross = np.full(len(r.along), r.cross)
         vx, vy = (r.along, cross) if along_x else (cross, r.along)
@@ -381,4 +390,6 @@ def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec,
         out_rows.append(_Row(r.cross, vx if along_x else vy))
         out_floors.append(floor)
         lifts.append(up)
+        checks.add(1)
+    checks.finish()
     return out_rows, out_floors, lifts

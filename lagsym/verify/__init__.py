@@ -47,6 +47,7 @@ from ..errors import InputError
 from ..evaluate import evaluate_grid, surface_evaluator
 from ..gcode import Moves
 from ..machine import MAX_LEFT_MM, Placement, Tool
+from ..progress import Progress
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
 
 __all__ = ["CutReport", "simulate_cut", "press_moves", "height_map_axes", "gouge_limit", "program_resolution_mm",
@@ -212,7 +213,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
                  cell_mm: float | None = None, program_resolution_mm: float = 0.0005,
                  gouge_limit_mm: float | None = None, max_cells: int | None = MAX_CELLS,
                  max_contacts: int | None = MAX_CONTACTS, max_left_mm: float = MAX_LEFT_MM,
-                 max_scallop_mm: float | None = None) -> CutReport:
+                 max_scallop_mm: float | None = None, *, progress: Progress | None = None) -> CutReport:
     """Simulate the moves with the tool on a height map over the surface's box and compare with the surface.
 
     Parameters
@@ -240,6 +241,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
         Material left anywhere above which the program fails (:data:`MAX_LEFT_MM`; ``inf``: not checked).
     max_scallop_mm : float, optional
         Scallop (normal to the surface) above which the program fails; by default not checked.
+    progress : Progress, optional
+        Told the segments of the feed moves swept (:mod:`lagsym.progress`).
     """
     xs, ys = height_map_axes(placement.box_mm(surface.grid.bounds), cell_mm, max_cells)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
@@ -257,7 +260,8 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     check_work(path[:-1][use], path[1:][use], piece, r, hx, hy, max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
     cut = np.full((len(xs), len(ys)), np.inf)
-    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, None)
+    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, None,
+                               progress)
     crash, crash_segments = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner))
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
                      rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],

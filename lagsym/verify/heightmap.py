@@ -24,9 +24,10 @@ import numpy as np
 
 from ..errors import InputError, ToolpathError
 from ..machine import Tool
+from ..progress import Progress, Tally
 from .swept import bull_resolution, lowest_ball, lowest_bull, lowest_flat
 
-__all__ = ["press_moves", "height_map_axes", "sweep", "tool_grid", "check_work", "MAX_CELLS", "MAX_CONTACTS"]
+__all__ = ["press_moves", "height_map_axes", "sweep", "tool_grid", "check_work", "segments", "MAX_CELLS", "MAX_CONTACTS"]
 
 _MOVES_PER_PASS = 200_000  # moves split and swept at a time
 _PIECE_CELLS = 8.0  # longest segment swept, sideways, in cells
@@ -36,7 +37,7 @@ MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB
 MAX_CONTACTS = 20_000_000_000  # segments (all, before those far from the box are dropped) times cells under the tool
 
 
-def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> int:
+def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None, progress: Progress | None = None) -> int:
     """Lower ``cut`` to the tool's lowest surface along every move (in place); the number of segments swept.
 
     Moves are split into segments no longer sideways than ``_PIECE_CELLS``
@@ -45,7 +46,9 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
     ``workers`` threads (default: up to 2, one a core) the cells the moves
     reach are cut into ``2 * workers`` stripes across X, each at least a
     footprint wide: the even ones are swept at the same time, then the odd
-    ones, so no two threads ever write the same cell.
+    ones, so no two threads ever write the same cell.  ``progress`` is told
+    the segments swept (stage ``sweeping moves``), those far from the map
+    counted as they are dropped.
     """
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     piece = _PIECE_CELLS * max(hx, hy)
@@ -53,11 +56,14 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
     kx, ky = int(math.ceil((r + piece / 2) / hx)) + 1, int(math.ceil((r + piece / 2) / hy)) + 1
     workers = min(os.cpu_count() or 1, 2) if workers is None else max(int(workers), 1)
     count = 0
+    swept = Tally(progress, "sweeping moves", segments(a_all, b_all, piece) if progress is not None else None)
+    swept.start()
     for s in range(0, len(a_all), _MOVES_PER_PASS):
         a, b = _pieces(np.asarray(a_all[s:s + _MOVES_PER_PASS], dtype=float),
                        np.asarray(b_all[s:s + _MOVES_PER_PASS], dtype=float), piece)
         near = ((np.maximum(a[:, 0], b[:, 0]) >= xs[0] - r - hx) & (np.minimum(a[:, 0], b[:, 0]) <= xs[-1] + r + hx)
                 & (np.maximum(a[:, 1], b[:, 1]) >= ys[0] - r - hy) & (np.minimum(a[:, 1], b[:, 1]) <= ys[-1] + r + hy))
+        swept.add(len(a) - int(near.sum()))
         a, b = a[near], b[near]
         count += len(a)
         if not len(a):
@@ -83,6 +89,7 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
             with np.errstate(invalid="ignore"):
                 for chunk in chunks:
                     (_sweep_chunk if len(chunk[1]) >= _FEW else _sweep_few)(chunk, geometry, lowest)
+                    swept.add(len(chunk[1]))
 
         if stripes == 1:
             run(work[0])
@@ -91,7 +98,14 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None) -> i
                 for phase in (0, 1):
                     list(pool.map(run, work[phase::2]))
         np.minimum(cut[rows, cols], pad[inner], out=cut[rows, cols])
+    swept.finish()
     return count
+
+
+def segments(a, b, piece: float) -> int:
+    """How many segments :func:`_pieces` splits the moves ``a -> b`` into."""
+    d = np.asarray(b, dtype=float)[:, :2] - np.asarray(a, dtype=float)[:, :2]
+    return int(np.maximum(np.ceil(np.hypot(d[:, 0], d[:, 1]) / piece), 1).sum()) if len(d) else 0
 
 
 def _kernel(r, corner):
@@ -233,18 +247,18 @@ def check_work(a, b, piece: float, r: float, hx: float, hy: float, max_contacts:
 
 
 def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool,
-                max_contacts: int | None = MAX_CONTACTS) -> tuple[int, float]:
+                max_contacts: int | None = MAX_CONTACTS, progress: Progress | None = None) -> tuple[int, float]:
     """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
 
     ``cut[i, j]`` is the height over ``(xs[i], ys[j])``, evenly spaced cell
     centres.  Returns the number of segments swept and the simulation's
-    vertical resolution (as :func:`simulate_cut` states it).
+    vertical resolution (as :func:`simulate_cut` states it); ``progress`` as :func:`sweep` tells it.
     """
     r, corner, piece, resolution = tool_grid(tool, xs, ys)
     if not len(a):
         return 0, resolution
     check_work(a, b, piece, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts)
-    return sweep(cut, a, b, xs, ys, r, corner), resolution
+    return sweep(cut, a, b, xs, ys, r, corner, progress=progress), resolution
 
 
 def tool_grid(tool: Tool, xs: np.ndarray, ys: np.ndarray) -> tuple[float, float, float, float]:
