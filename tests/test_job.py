@@ -164,19 +164,73 @@ def test_the_job_cuts_no_gouge(machined):
     assert left.min() >= -0.002, f"gouge of {-left.min():.4f} mm"
 
 
-@pytest.mark.xfail(strict=True, reason="open: 0.069 mm is left at (91, 45.25) mm where the cusp bound of rows "
-                   "0.5 mm apart is 0.012 mm: along the rows the surface is a hollow of radius 2.78 mm there "
-                   "(F_xx = 0.36 / mm), tighter than the 3 mm ball, which rests on both walls (its tip 0.2 mm "
-                   "above the surface at x = 91) and cannot reach the bottom at any side step; the bound "
-                   "does not allow for that")
-def test_the_job_leaves_at_most_the_finishing_cusp(machined):
-    """Away from the box edges, what the finish leaves is at most the cusp of its rows on the local slope."""
+def _tight_hollows(f, cell, radius):
+    """Cells where a principal curvature of the surface (finite differences of ``f``) is ``1 / radius`` or more."""
+    fx_, fy_ = np.gradient(f, cell, axis=0), np.gradient(f, cell, axis=1)
+    fxx, fxy, fyy = np.gradient(fx_, cell, axis=0), np.gradient(fx_, cell, axis=1), np.gradient(fy_, cell, axis=1)
+    w2 = 1 + fx_ ** 2 + fy_ ** 2
+    # The shape operator I^-1 II of z = f: its larger eigenvalue.
+    a = ((1 + fy_ ** 2) * fxx - fx_ * fy_ * fxy) / w2 ** 1.5
+    b = ((1 + fy_ ** 2) * fxy - fx_ * fy_ * fyy) / w2 ** 1.5
+    c = ((1 + fx_ ** 2) * fxy - fx_ * fy_ * fxx) / w2 ** 1.5
+    d = ((1 + fx_ ** 2) * fyy - fx_ * fy_ * fxy) / w2 ** 1.5
+    half = (a + d) / 2
+    return half + np.sqrt(np.maximum(half ** 2 - (a * d - b * c), 0)) >= 1 / radius, np.sqrt(w2)
+
+
+def test_the_job_leaves_at_most_the_finishing_guarantee(machined, job_run):
+    """What the finish leaves is at most the cusp it states for its rows, plus its chordal tolerance.
+
+    Measured on the height map (rs274's moves, the ball stamped along them,
+    the polynomial evaluated apart), normal to the surface, a tool radius
+    inside the box and more than a tool radius from hollows tighter than the
+    ball (found here from the heights' curvature): there the ball rests on
+    both walls and cannot reach the bottom, and the job says how much of the
+    box that is.  The prediction is lagsym's (``gap_cusps``, the cusp of each
+    gap between rows over the band its passes touch); the job prints its
+    worst.  Two effects the rows' section alone misses: at (92.25, 67) the
+    surface is a hollow of radius 3.09 mm along the rows, and there fixed
+    0.2 mm moves rode 0.011 mm above the cutter path (the ball's contact point
+    races along the hollow), twice the tolerance: 0.023 mm was left where
+    0.012 was predicted.
+    """
+    from scipy.ndimage import binary_dilation, maximum_filter1d
+
+    from lagsym.evaluate import surface_evaluator
+    from lagsym.io import read_points
+    from lagsym.lagrange import lagrange_surface
+    from lagsym.toolpath.scallop import gap_cusps
+
     fx, fy, f, _, left = machined
+    _, printed, moves, _ = job_run
     cell = 0.25
-    # The largest cusp between rows 0.5 mm apart on a slope of angle a across them: the flat cusp of rows
-    # 0.5 / cos a apart, measured vertically.
-    inner = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL)
-    cos = 1 / np.sqrt(1 + np.gradient(f, cell, axis=1) ** 2)
-    bound = (R_BALL - np.sqrt(R_BALL ** 2 - (0.25 / cos) ** 2)) / cos + 0.002
-    worst = np.unravel_index(np.argmax(np.where(inner, left - bound, -np.inf)), left.shape)
-    assert (left - bound)[inner].max() <= 0, (left[worst], bound[worst], fx[worst], fy[worst])
+    m = re.search(r"finish T2: \d+ moves, about [\d.]+ min, worst predicted cusp ([\d.]+) mm normal to the "
+                  r"surface at X([\d.]+) Y([\d.]+) outside hollows tighter than the ball \(([\d.]+) % of the box\)",
+                  printed)
+    assert m, printed
+    ys, counts = np.unique(np.round([mv[3] for mv in moves if mv[0] == 2 and mv[1]], 3), return_counts=True)
+    rows = ys[counts > 50]
+    assert np.allclose(np.diff(rows), 0.5, atol=0.002), np.diff(rows)
+    ev = surface_evaluator(lagrange_surface(read_points(EX4)))
+    along, cusps = gap_cusps(ev, "x", rows / 20, R_BALL, 20.0, 0.5)
+    assert float(m.group(1)) == pytest.approx(np.nanmax(cusps), rel=0.01)  # the rows rounded to 0.001 mm
+    along_mm = along * 20
+    spacing = along_mm[1] - along_mm[0]
+    # The cusp at a point comes from the passes a tool radius either side of it along the rows too.
+    band = maximum_filter1d(np.nan_to_num(cusps, nan=np.inf), 2 * int(np.ceil(R_BALL / spacing)) + 1, axis=1)
+    gap = np.clip(np.searchsorted(rows, fy, side="right") - 1, 0, len(rows) - 2)
+    predicted = band[gap, np.clip(np.rint((fx - along_mm[0]) / spacing).astype(int), 0, len(along) - 1)]
+    tight, w = _tight_hollows(f, cell, R_BALL)
+    near = binary_dilation(tight, iterations=int(R_BALL / cell))
+    inner = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL) & ~near
+    assert tight.any() and inner.sum() > 0.9 * (74 / cell) ** 2
+    over = np.where(inner, left / w - predicted - 0.005 - 0.002, -np.inf)
+    worst = np.unravel_index(np.argmax(over), over.shape)
+    assert over.max() <= 0, (left[worst] / w[worst], predicted[worst], fx[worst], fy[worst])
+    assert np.isinf(predicted[inner]).sum() < 0.001 * inner.sum()  # cells the prediction leaves out as tight
+    assert 0 < float(m.group(4)) < 5
+    # docs/roughing.md: on the flanks beside y = 20 the rows leave up to 0.1 mm normal (0.32 mm above).
+    box = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL)
+    at = np.unravel_index(np.argmax(np.where(box, left, -np.inf)), left.shape)
+    assert round(float((left / w)[box].max()), 2) == 0.1 and round(float(left[at]), 2) == 0.32, left[at]
+    assert fy[at] < 30 and np.degrees(np.arctan(np.gradient(f, cell, axis=1)[at])) == pytest.approx(72, abs=1)

@@ -218,6 +218,36 @@ def test_a_scallop_height_holds_normal_to_the_surface_on_a_steep_flank():
     assert 0 <= tp.cusp_at_mm[0] <= 6 and 0 <= tp.cusp_at_mm[1] <= 6
 
 
+def test_a_fixed_side_step_states_the_cusp_of_its_rows_on_a_saddle():
+    """A ball's fixed side step is given the cusp predicted for its rows, and on a saddle it is what is left.
+
+    Over ``z = 0.3 x y`` (principal curvatures +-0.3 / mm at the middle, a
+    hollow along a diagonal that a 3 mm ball barely fits) the cusp between
+    rows 0.5 mm apart is the flat floor's, measured on a ball swept along the
+    planned points over the polynomial itself: the section across the rows
+    is straight.  A prediction from the curvature across the rows of the
+    surface the ball centres run on would be 5.4 times too large.
+    """
+    from lagsym.evaluate import surface_evaluator
+    from lagsym.toolpath.scallop import gap_cusps
+
+    xs = [Fraction(-6), Fraction(6)]
+    a = Fraction(3, 10)
+    surf = lagrange_surface(grid_from_table(xs, xs, [[a * x * y for y in xs] for x in xs]))
+    tp = plan(surf, raster=RasterSpec("x", 0.5, 0.25, None, None), scale=1.0)
+    assert tp.cusp_mm is not None and tp.hollow_share == 0
+    gx, gy = np.array([-0.5, 0.0, 0.5]), np.arange(-1.0, 1.0, 0.002)
+    left = _swept_ball_left(tp.points_mm, lambda x, y: 0.3 * x * y, lambda x, y: 0.3 * y, lambda x, y: 0.3 * x,
+                            gx, gy, 3.0)
+    rows = np.unique(tp.points_mm[np.abs(tp.points_mm[:, 0]) < 6, 1])
+    along, cusps = gap_cusps(surface_evaluator(surf), "x", rows, 3.0, 1.0, 0.5)
+    near = np.abs(along) <= 1.0
+    predicted = np.nanmax(cusps[(rows[:-1] >= -1.5) & (rows[1:] <= 1.5)][:, near])
+    assert left.min() >= -1e-6
+    assert 0.9 * predicted <= left.max() <= predicted + 1e-4, (left.max(), predicted)
+    assert tp.cusp_mm >= predicted
+
+
 def test_the_command_and_the_program_header_state_the_worst_predicted_cusp(run_cli, tmp_path):
     import json
 
@@ -237,4 +267,8 @@ def test_the_command_and_the_program_header_state_the_worst_predicted_cusp(run_c
     assert f"(T1 BALL END D4 MM CUSP AT MOST {cusp:.4f} MM NORMAL TO SURFACE)" in out.read_text()
     status, _, err = run_cli("toolpath", src, "--tool-diameter", 4, "--stepover", 1, "--step", 0.5,
                              "--safe-z", 60, "-o", out)
+    wider = float(re.search(r"worst predicted cusp ([\d.]+) mm normal to the surface at X[\d.]+ Y[\d.]+", err).group(1))
+    assert status == 0 and wider > cusp and f"CUSP AT MOST {wider:.4f} MM NORMAL TO SURFACE" in out.read_text()
+    status, _, err = run_cli("toolpath", src, "--tool-shape", "flat", "--tool-diameter", 4, "--stepover", 1,
+                             "--step", 0.5, "--safe-z", 60, "-o", out)
     assert status == 0 and "cusp" not in err and "CUSP" not in out.read_text()

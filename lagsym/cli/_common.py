@@ -167,3 +167,15 @@ def program_settings(args, grid, **kw):
         safe_z_mm=args.safe_z, program_number=args.program, work_offset=args.work_offset,
         line_ending=args.line_ending, decimals=args.decimals, tool_number=args.tool_number,
         length_offset=args.length_offset, feed_height_mm=args.feed_height, coolant=args.coolant, **kw)
+
+
+def cusp_note(tp) -> str:
+    """For a ball: the worst cusp the rows are predicted to leave, where, and the hollows it cannot reach."""
+    if tp.cusp_mm is None:
+        return ""
+    x, y = tp.cusp_at_mm
+    note = f", worst predicted cusp {tp.cusp_mm:.4f} mm normal to the surface at X{x:.3f} Y{y:.3f}"
+    if tp.hollow_share:
+        note += (f" outside hollows tighter than the ball ({100 * tp.hollow_share:.1f} % of the box), "
+                 "whose bottom it cannot reach")
+    return note

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..io import write_text
+from ._common import cusp_note
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
@@ -54,7 +55,8 @@ def run(args, out, err) -> int:
 
 
 def report(planned, prog, err) -> None:
-    """One line per operation (moves and minutes) and the total."""
+    """One line per operation (moves and minutes, for a ball's raster the cusp it leaves) and the total."""
     for op, m in zip(planned.operations, prog.minutes):
-        err.write(f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min\n")
+        cusp = cusp_note(op.path) if getattr(op.path, "cusp_mm", None) is not None else ""
+        err.write(f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min{cusp}\n")
     err.write(f"cycle time about {prog.total_minutes:.1f} min (rapids at {planned.spec.rapid_mm_min:g} mm/min)\n")

@@ -10,7 +10,7 @@ from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
 from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
-                      TOOL_MM, DECIMALS, add_program_arguments, count, program_settings)
+                      TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._progress import progress_bar
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
@@ -101,18 +101,10 @@ def run(args, out, err) -> int:
         err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
                   f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
                   f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"
-                  + _cusp_note(tp) + _arc_note(tp) + "\n")
+                  + cusp_note(tp) + _arc_note(tp) + "\n")
     else:
         out.write(text)
     return 0
-
-
-def _cusp_note(tp) -> str:
-    """With a scallop height: the worst cusp the rows are predicted to leave, and where."""
-    if tp.cusp_mm is None:
-        return ""
-    x, y = tp.cusp_at_mm
-    return f", worst predicted cusp {tp.cusp_mm:.4f} mm normal to the surface at X{x:.3f} Y{y:.3f}"
 
 
 def _arc_note(tp) -> str:

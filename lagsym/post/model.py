@@ -76,8 +76,10 @@ def point_program(toolpath, settings: MachineSettings, title: str = "") -> Point
     """The program model of a :class:`~lagsym.toolpath.Toolpath` for one machine."""
     t = toolpath.tool
     tool = f"T{settings.tool_number} {t.label}"
-    if toolpath.cusp_mm is not None:  # rows from a scallop height: the worst cusp they are predicted to leave
+    if toolpath.cusp_mm is not None:  # a ball's rows: the worst cusp they are predicted to leave
         tool += f" CUSP AT MOST {toolpath.cusp_mm:.4f} MM NORMAL TO SURFACE"
+        if getattr(toolpath, "hollow_share", None):
+            tool += " OUTSIDE HOLLOWS TIGHTER THAN THE TOOL"
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool,
                         arcs=getattr(toolpath, "arcs", None))
 

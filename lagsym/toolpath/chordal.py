@@ -45,8 +45,8 @@ import numpy as np
 
 from ..evaluate import SurfaceEvaluator
 
-__all__ = ["tolerance_step", "bends", "semi_convex_sag", "move_sags", "crosses_box_edge", "bent_moves", "check_moves",
-           "lift"]
+__all__ = ["tolerance_step", "bends", "semi_convex_sag", "move_sags", "move_rises", "crosses_box_edge",
+           "bent_moves", "check_moves", "lift"]
 
 _CHECK_SAMPLES = 6  # interior samples of a checked move, at least
 _CHECK_SPLITS = 40  # at most this many rounds of splitting
@@ -103,6 +103,23 @@ def move_sags(t, z, keep, extra, kappa):
     semi = kappa * np.maximum.reduceat(t[k + 1] - t[k], starts) ** 2 / 8.0
     sag = np.maximum(np.maximum(np.maximum.reduceat(inner, starts), 0.0), seen + semi)
     return sag, seen
+
+
+def move_rises(t, z, keep):
+    """How far each kept move lies above the fine samples it skips (0 where none lies below it).
+
+    A move above the cutter path does not gouge but leaves that much
+    material: in a hollow the ball barely fits, the path bends up fast and a
+    fixed step would ride well above it.
+    """
+    keep = np.asarray(keep, dtype=int)
+    if len(keep) < 2:
+        return np.zeros(0)
+    k = np.arange(keep[0], keep[-1])
+    m = np.searchsorted(keep, k, side="right") - 1
+    i, j = keep[m], keep[m + 1]
+    below = (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i])) - z[k]
+    return np.maximum(np.maximum.reduceat(below, keep[:-1] - keep[0]), 0.0)
 
 
 def crosses_box_edge(vx, vy, bounds, radius):

@@ -15,7 +15,8 @@ from ..errors import ToolpathError
 from ..machine import BOUNDARIES, DIRECTIONS
 from ..values import choice, finite, positive
 
-__all__ = ["raster_pattern", "levels", "scallop_stepover", "tool_reach", "within_reach", "past_reach", "reach_levels"]
+__all__ = ["raster_pattern", "levels", "scallop_stepover", "tool_reach", "within_reach", "past_reach", "reach_levels",
+           "fixed_step_samples", "every_step"]
 
 
 def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
@@ -158,3 +159,30 @@ def reach_levels(inner, lo: float, hi: float) -> np.ndarray:
     mid = inner[(inner > lo + eps) & (inner < hi - eps)]
     ends = ([lo] if lo >= inner[0] else []), ([hi] if hi <= inner[-1] else [])
     return np.concatenate([before, ends[0], mid, ends[1], after])
+
+
+def fixed_step_samples(a0: float, a1: float, step: float, fine: float, snap):
+    """Samples along a row for a fixed step, and how many samples make one move (surface units).
+
+    The row is cut into equal moves no longer than ``step`` once moved onto
+    the program's resolution (``snap``), each sampled at least twice and no
+    further apart than ``fine``.
+    """
+    moves = max(int(math.ceil((a1 - a0) / step - 1e-9)), 1)
+    while True:
+        every = max(2, int(math.ceil((a1 - a0) / moves / fine - 1e-9)))
+        along = np.linspace(a0, a1, moves * every + 1)
+        if np.diff(snap(along[::every])).max() <= step * (1 + 1e-9):
+            return along, every
+        moves += 1
+
+
+def every_step(s_mm: np.ndarray, lo: int, hi: int, longest_mm: float) -> np.ndarray:
+    """The samples ``lo..hi`` of one piece a move apart: from each, the furthest no more than ``longest_mm`` on."""
+    s = s_mm[lo:hi + 1] - s_mm[lo]
+    reach = np.maximum(np.searchsorted(s, s + longest_mm * (1 + 1e-9), side="right") - 1, np.arange(len(s)) + 1)
+    out, i = [0], 0
+    while i < len(s) - 1:
+        i = int(min(reach[i], len(s) - 1))
+        out.append(i)
+    return np.array(out, dtype=int) + lo

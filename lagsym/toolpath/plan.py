@@ -23,9 +23,10 @@ from . import chordal
 from .arcs import CHORD_MM, Arcs, fit_arcs
 from .dropcutter import drop_cutter
 from .filter import filter_rows
-from .pattern import past_reach, raster_pattern, reach_levels, scallop_stepover, tool_reach, within_reach
+from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
+                      tool_reach, within_reach)
 from .resolution import ResolutionGrid, without_repeats
-from .scallop import scallop_levels
+from .scallop import row_cusps, scallop_levels
 from .workers import MIN_POINTS, Workers
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
@@ -63,10 +64,15 @@ class Toolpath:
         How many cutter locations the filter chose the points from (the
         blocks a program would have without filtering).
     cusp_mm : float or None
-        With a scallop height, the worst cusp predicted between the rows,
-        measured normal to the surface (mm); None for a fixed side step.
+        For a ball end, the worst cusp predicted between the rows, measured
+        normal to the surface (mm), outside hollows tighter than the ball
+        (:mod:`lagsym.toolpath.scallop`); None for other cutters.
     cusp_at_mm : tuple of float or None
         Where that cusp is, ``(x, y)`` on the machine.
+    hollow_share : float or None
+        The share of the box (of the prediction's samples) in hollows
+        tighter than the ball, whose bottom it cannot reach: there the cusp
+        prediction does not hold.
     arcs : Arcs or None
         With ``raster.arcs``, the circular moves that replace runs of the
         points (:mod:`lagsym.toolpath.arcs`); None without.
@@ -84,6 +90,7 @@ class Toolpath:
     cusp_mm: float | None = None
     cusp_at_mm: tuple[float, float] | None = None
     arcs: Arcs | None = None
+    hollow_share: float | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
@@ -145,6 +152,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
+    if scallop is None and tool.shape == "ball" and tool.radius_mm > 0:  # the cusps a fixed side step leaves
+        scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     kappa = ev.curvature_bound() / mm_per_unit
     # Worker processes on the other cores, where the plan is large enough to pay for starting them.
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
@@ -212,7 +221,7 @@ def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float
         levels = reach_levels(scallop.levels, *(reach[2:] if raster.direction == "x" else reach[:2]))
     every = None
     if raster.step_mm is not None:
-        along, every = _fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
+        along, every = fixed_step_samples(along[0], along[-1], step / mm_per_unit, fine / mm_per_unit,
                                            lambda v: cl.snap_axis(v, 0 if raster.direction == "x" else 1))
     return scallop, levels, along, every
 
@@ -224,12 +233,13 @@ def _span(bounds, direction: str) -> float:
 
 
 def _cusp(scallop, direction: str, settings: MachineSettings) -> dict:
-    """The worst predicted cusp and where it is on the machine, for a plan from a scallop height."""
+    """The worst predicted cusp, where it is on the machine and the share of hollows too tight for the ball."""
     if scallop is None:
         return {}
     p, c = scallop.worst_at
     x, y = settings.placement.to_machine(*((p, c) if direction == "x" else (c, p)))
-    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y))}
+    return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y)),
+            "hollow_share": scallop.tight / max(scallop.samples, 1)}
 
 
 def _place(settings: MachineSettings, x, y, z_mm):
@@ -277,22 +287,6 @@ def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float)
     if raster.step_mm is None:
         return fine, fine
     return raster.step_mm, min(raster.step_mm / 2.0, fine)
-
-
-def _fixed_step_samples(a0: float, a1: float, step: float, fine: float, snap):
-    """Samples along a row for a fixed step, and how many samples make one move (surface units).
-
-    The row is cut into equal moves no longer than ``step`` once moved onto
-    the program's resolution (``snap``), each sampled at least twice and no
-    further apart than ``fine``.
-    """
-    moves = max(int(math.ceil((a1 - a0) / step - 1e-9)), 1)
-    while True:
-        every = max(2, int(math.ceil((a1 - a0) / moves / fine - 1e-9)))
-        along = np.linspace(a0, a1, moves * every + 1)
-        if np.diff(snap(along[::every])).max() <= step * (1 + 1e-9):
-            return along, every
-        moves += 1
 
 
 @dataclass(frozen=True)
@@ -427,10 +421,10 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
 
     With a chordal tolerance alone, the filter keeps the moves within it.
     With a fixed step (the longest move), every ``every``-th sample of a
-    row is kept (:func:`_fixed_step_samples`), and along a link the samples
-    a move apart (:func:`_every_step`); where a move's sag exceeds the
-    tolerance, the samples inside it too: points are added where the path
-    bends.  ``extra`` is the sag between samples added to what the samples
+    row is kept (:func:`~lagsym.toolpath.pattern.fixed_step_samples`), and along a link the samples
+    a move apart (:func:`~lagsym.toolpath.pattern.every_step`); where a move passes more than the
+    tolerance below the path (its sag) or above the samples it skips, the
+    samples inside it too: points are added where the path bends.  ``extra`` is the sag between samples added to what the samples
     show.
     """
     s_mm, z = path.s_mm, path.z
@@ -440,22 +434,12 @@ def _emitted(path: _FinePath, tol: float, extra: np.ndarray, longest_mm: float |
             k = filter_rows(s_mm[lo:hi + 1] - s_mm[lo], z[lo:hi + 1], tol, extra[lo:hi + 1]) + lo
             kept.extend(int(v) for v in k[1:])
         return np.array(kept, dtype=int)
-    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else _every_step(s_mm, lo, hi, longest_mm)
+    kept = np.unique(np.concatenate([np.arange(lo, hi + 1, every) if is_row else every_step(s_mm, lo, hi, longest_mm)
                                      for lo, hi, is_row in path.pieces]))
     sag, _ = chordal.move_sags(s_mm, z, kept, extra, 0.0)
-    split = np.flatnonzero((sag > tol) & (np.diff(kept) > 1))
+    off = np.maximum(sag, chordal.move_rises(s_mm, z, kept))  # either side of the path, as the filter's
+    split = np.flatnonzero((off > tol) & (np.diff(kept) > 1))
     if not split.size:
         return kept
     inner = np.concatenate([np.arange(kept[m] + 1, kept[m + 1]) for m in split])
     return np.union1d(kept, inner)
-
-
-def _every_step(s_mm: np.ndarray, lo: int, hi: int, longest_mm: float) -> np.ndarray:
-    """The samples ``lo..hi`` of one piece a move apart: from each, the furthest no more than ``longest_mm`` on."""
-    s = s_mm[lo:hi + 1] - s_mm[lo]
-    reach = np.maximum(np.searchsorted(s, s + longest_mm * (1 + 1e-9), side="right") - 1, np.arange(len(s)) + 1)
-    out, i = [0], 0
-    while i < len(s) - 1:
-        i = int(min(reach[i], len(s) - 1))
-        out.append(i)
-    return np.array(out, dtype=int) + lo

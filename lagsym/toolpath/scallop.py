@@ -38,7 +38,7 @@ import numpy as np
 from ..evaluate import SurfaceEvaluator
 from .pattern import scallop_stepover
 
-__all__ = ["cusp_height", "ScallopRows", "scallop_levels"]
+__all__ = ["cusp_height", "ScallopRows", "scallop_levels", "row_cusps", "gap_cusps"]
 
 _ALONG_SAMPLES = 401  # samples along a row (slopes and curvature are polynomials of low degree)
 _CROSS_PER_STEP = 4  # cross samples per flat-floor side step
@@ -91,21 +91,25 @@ class ScallopRows:
 
     ``worst_at`` is ``(p, c)``, the surface position (along the rows, across
     them) of the worst predicted cusp; ``tight`` the number of samples where
-    the section is a hollow tighter than the ball.
+    the surface is a hollow tighter than the ball (left out of the
+    prediction), of ``samples``.
     """
 
     levels: np.ndarray
     worst_mm: float
     worst_at: tuple[float, float]
     tight: int
+    samples: int = 0
 
 
-def _samples(ev: SurfaceEvaluator, direction: str, mm_per_unit: float, flat_step_mm: float):
+def _samples(ev: SurfaceEvaluator, direction: str, mm_per_unit: float, flat_step_mm: float, radius_mm: float):
     """Along and cross sample positions (surface units) and the gap allowed per unit of centre distance.
 
     Returns ``(along, cross, stretch, k)``: ``stretch = sqrt(1 + fp**2) / w``
-    turns a centre distance into a horizontal gap; ``k`` the normal
-    curvature (1/mm) across the rows; both shaped ``(cross, along)``.
+    turns a centre distance into a horizontal gap; ``k`` the normal curvature
+    (1/mm) across the rows, ``nan`` where the surface is a hollow tighter
+    than the ball in some direction (:func:`_across_curvature`); both shaped
+    ``(cross, along)``.
     """
     x0, x1, y0, y1 = (float(v) for v in ev.bounds)
     (a0, a1), (c0, c1) = ((x0, x1), (y0, y1)) if direction == "x" else ((y0, y1), (x0, x1))
@@ -121,17 +125,39 @@ def _samples(ev: SurfaceEvaluator, direction: str, mm_per_unit: float, flat_step
 
     fp, fc, fpp, fpc, fcc = d(1, 0), d(0, 1), d(2, 0), d(1, 1), d(0, 2)
     w = np.sqrt(1.0 + fp * fp + fc * fc)
-    # The tangent direction across the passes: perpendicular to the path (1, 0, fp) in the tangent plane.
+    return along, cross, np.sqrt(1.0 + fp * fp) / w, _across_curvature(fp, fc, fpp, fpc, fcc, radius_mm)
+
+
+def _across_curvature(fp, fc, fpp, fpc, fcc, radius: float) -> np.ndarray:
+    """The surface's normal curvature across the rows (the tangent direction perpendicular to the path).
+
+    ``nan`` where a principal curvature is ``1 / R`` or more: a hollow
+    tighter than the ball in some direction (along the rows too), whose
+    bottom the ball cannot reach; there it rests on both walls and the
+    cross-section's cusp says nothing.  (On a saddle the section's own
+    curvature is the one that counts: a ball swept along rows over
+    ``z = a x y`` leaves the flat floor's cusp, measured, to 1 %, with
+    ``a R`` up to 0.9.)
+    """
+    w2 = 1.0 + fp * fp + fc * fc
+    w = np.sqrt(w2)
     a, b = -fp * fc, 1.0 + fp * fp
     k = (fpp * a * a + 2 * fpc * a * b + fcc * b * b) / (w * (a * a + b * b + (a * fp + b * fc) ** 2))
-    return along, cross, np.sqrt(1.0 + fp * fp) / w, k
+    # The larger eigenvalue of the shape operator I^-1 II of z = F.
+    s00 = ((1 + fc * fc) * fpp - fp * fc * fpc) / (w2 * w)
+    s01 = ((1 + fc * fc) * fpc - fp * fc * fcc) / (w2 * w)
+    s10 = ((1 + fp * fp) * fpc - fp * fc * fpp) / (w2 * w)
+    s11 = ((1 + fp * fp) * fcc - fp * fc * fpc) / (w2 * w)
+    half = (s00 + s11) / 2
+    k1 = half + np.sqrt(np.maximum(half * half - (s00 * s11 - s01 * s10), 0.0))
+    return np.where(k1 * radius >= 1.0, np.nan, k)
 
 
 def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scallop_mm: float,
                    mm_per_unit: float) -> ScallopRows:
     """Row levels across the box whose cusps, normal to the surface, are at most ``scallop_mm`` (see the module)."""
     flat = scallop_stepover(radius_mm, scallop_mm)
-    along, cross, stretch, k = _samples(ev, direction, mm_per_unit, flat)
+    along, cross, stretch, k = _samples(ev, direction, mm_per_unit, flat, radius_mm)
     d = _allowed_d(k, radius_mm, scallop_mm)
     d = np.where(d < _TIGHT * flat, np.nan, d)
     k = np.where(np.isnan(d), np.nan, k)  # left out of the prediction too
@@ -162,7 +188,44 @@ def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scall
         levels.append(min(c + s, c1) if c1 - (c + s) > 1e-9 * (c1 - c0) else c1)
     levels = np.array(levels)
     worst, at = _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit)
-    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight)
+    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight, samples=k.size)
+
+
+def row_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm_per_unit: float,
+              stepover_mm: float) -> ScallopRows:
+    """The cusps predicted between rows at given ``levels`` (surface units, across the box), as for a scallop height.
+
+    For a plan with a fixed side step: ``worst_mm`` and ``worst_at`` as
+    :func:`scallop_levels` reports them, ``tight`` the samples in hollows
+    tighter than the ball, which the prediction leaves out.
+    """
+    along, cross, stretch, k = _samples(ev, direction, mm_per_unit, stepover_mm, radius_mm)
+    levels = np.asarray(levels, dtype=float)
+    worst, at = _worst(levels, along, cross, stretch, k, radius_mm, radius_mm / mm_per_unit, mm_per_unit)
+    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=int(np.isnan(k).sum()), samples=k.size)
+
+
+def gap_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm_per_unit: float,
+              stepover_mm: float) -> tuple[np.ndarray, np.ndarray]:
+    """The predicted cusp of each gap between ``levels`` at each sample along the rows: ``(along, cusps)``.
+
+    ``cusps[g, i]`` (mm, normal to the surface) is the largest predicted over
+    the band gap ``g`` touches (one tool radius before its first row to one
+    past its second) at ``along[i]``; ``nan`` where every sample there is in a
+    hollow tighter than the ball.
+    """
+    along, cross, stretch, k = _samples(ev, direction, mm_per_unit, stepover_mm, radius_mm)
+    levels = np.asarray(levels, dtype=float)
+    r = radius_mm / mm_per_unit
+    out = np.full((max(len(levels) - 1, 0), len(along)), np.nan)
+    for g, (c, nxt) in enumerate(zip(levels[:-1], levels[1:])):
+        band = slice(int(np.searchsorted(cross, c - r)), int(np.searchsorted(cross, nxt + r, side="right")))
+        h = cusp_height((nxt - c) * mm_per_unit / stretch[band], k[band], radius_mm)
+        if h.size and np.isfinite(h).any():
+            with np.errstate(invalid="ignore"):
+                out[g] = np.nanmax(np.where(np.isfinite(h), h, -np.inf), axis=0)
+    out[np.isneginf(out)] = np.nan
+    return along, out
 
 
 def _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit):
