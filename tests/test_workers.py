@@ -74,3 +74,27 @@ def test_with_another_thread_running_the_chunks_run_here():
         other.join()
     with Workers(ev, 2) as workers:
         assert workers.parallel
+
+
+def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
+    # The command's SIGTERM handler raised in each worker when the pool ended it: a traceback per worker.
+    script = tmp_path / "plan.py"
+    script.write_text(
+        "from lagsym.cli import _signals_as_interrupts\n"
+        "from lagsym.evaluate import surface_evaluator\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        "from lagsym.toolpath import drop_cutter\n"
+        "from lagsym.toolpath.workers import Workers\n"
+        f"s = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-4.json')!r}))\n"
+        "ev = surface_evaluator(s)\n"
+        "with _signals_as_interrupts():\n"
+        "    for _ in range(3):\n"
+        "        with Workers(ev, 2) as w:\n"
+        "            z = drop_cutter(s, [2.0] * 600, [3.0] * 600, 0.15, evaluator=ev, workers=w)\n"
+        "print(w.processes)\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0 and done.stdout.split() == ["2"], done.stderr[-2000:]
+    assert done.stderr == "", done.stderr[-2000:]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import threading
 
 __all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
@@ -39,8 +40,19 @@ def available_cores() -> int:
 
 
 def _start(evaluator) -> None:
+    """A worker's start: the evaluator kept, and the signals a command catches given back to the system.
+
+    The fork copies the command's handlers (SIGTERM and SIGHUP stop it with
+    one line, :mod:`lagsym.cli`); in a worker they would turn the pool's own
+    SIGTERM at the end of every plan into a traceback.  Ctrl-C reaches the
+    whole process group: the command stops and ends the pool, so a worker
+    ignores it.
+    """
     global _EVALUATOR
     _EVALUATOR = evaluator
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _call(task):
