@@ -19,13 +19,15 @@ finds at each sample the largest ``s`` whose cusp is at most the request,
 and walks across the box: the gap after a row is the smallest allowed ``s``
 over every sample along the row and across the band the two passes touch
 (from one tool radius before the row to one radius past the next), so the
-request holds wherever that band's worst sample holds it.  Where the section
-is a hollow tighter than the ball (``k R >= 1``) the ball cannot reach its
-bottom at any step, and where it barely fits (a radius within 1.6 % of the
-ball's: the centre distance allowed is below an eighth of the flat floor's)
-no practical step meets the request; those samples do not limit the gap and
-are counted apart.  The cusp predicted for the gaps chosen elsewhere is
-reported with where it is worst.
+request holds wherever that band's worst sample holds it.  Where the surface
+is a hollow tighter than the ball in any direction (a principal curvature
+``k1 R >= 1``, along the rows too) the ball rests on both walls and cannot
+reach its bottom at any step, and where the section barely fits (a radius
+within 1.6 % of the ball's: the centre distance allowed is below an eighth
+of the flat floor's) no practical step meets the request; those samples do
+not limit the gap and are counted apart.  The cusp predicted for the gaps
+chosen elsewhere is reported with where it is worst; :func:`row_cusps` and
+:func:`gap_cusps` predict it for rows given (a fixed side step).
 """
 
 from __future__ import annotations
