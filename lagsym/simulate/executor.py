@@ -76,8 +76,9 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     return Simulation(dialect=dialect, precision=int(precision), moves=m.moves, blocks=executed)
 
 
-def _run(table, where, blocks, m: Control, runaway: Runaway, tally: Tally) -> int:
+def _run(table, where, blocks, m: Control, runaway: Runaway, tally: Tally | None = None) -> int:
     """Run the compiled segments from the first block; the number of blocks executed, counted in ``tally``."""
+    tally = tally if tally is not None else Tally(None, "executing blocks")
     pc, executed, n = 0, 0, len(blocks)
     step = max(runaway.max_blocks // MOST_CALLS, 1)
     tell = step if tally.live else 1 << 62
