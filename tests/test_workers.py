@@ -5,30 +5,53 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import threading
 
 import numpy as np
 
 from lagsym.evaluate import surface_evaluator
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.toolpath import drop_cutter
 from lagsym.toolpath.workers import Workers
 
 from conftest import EXAMPLES, ROOT
 from cutters import brute
 
 
-def test_worker_processes_give_the_same_values_as_one_process():
+def _fresh(code: str, tmp_path) -> str:
+    """Run ``code`` in a fresh interpreter (the suite's other tests may leave threads running here, and
+    workers fork only where no other thread runs); its standard output."""
+    script = tmp_path / "run.py"
+    script.write_text(code)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done.stdout
+
+
+def test_worker_processes_give_the_same_values_as_one_process(tmp_path):
+    out = _fresh(
+        "import numpy as np\n"
+        "from lagsym.evaluate import surface_evaluator\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        "from lagsym.toolpath import drop_cutter\n"
+        "from lagsym.toolpath.workers import Workers\n"
+        f"surface = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-4.json')!r}))\n"
+        "ev = surface_evaluator(surface)\n"
+        "rng = np.random.default_rng(11)\n"
+        "x, y = rng.uniform(1, 5, 3000), rng.uniform(1, 5, 3000)\n"
+        "alone = drop_cutter(surface, x, y, 0.15, evaluator=ev)\n"
+        "with Workers(ev, 2) as workers:\n"
+        "    parallel = workers.parallel\n"
+        "    shared = drop_cutter(surface, x, y, 0.15, evaluator=ev, workers=workers)\n"
+        f"np.save({str(tmp_path / 'shared.npy')!r}, shared)\n"
+        "print(parallel, np.array_equal(shared, alone))\n", tmp_path)
+    assert out.split() == ["True", "True"]
     surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
-    ev = surface_evaluator(surface)
     rng = np.random.default_rng(11)
     x, y = rng.uniform(1, 5, 3000), rng.uniform(1, 5, 3000)
-    alone = drop_cutter(surface, x, y, 0.15, evaluator=ev)
-    with Workers(ev, 2) as workers:
-        assert workers.parallel
-        shared = drop_cutter(surface, x, y, 0.15, evaluator=ev, workers=workers)
-    assert np.array_equal(shared, alone)
+    shared = np.load(tmp_path / "shared.npy")
     for k in range(3):  # and the values are drop-cutter's: never below a brute-force search
         assert shared[k] >= brute(surface, x[k], y[k], 0.15)
 
@@ -61,19 +84,25 @@ def test_a_script_without_a_main_guard_runs_with_workers(tmp_path):
     assert done.stdout.split() == ["2", "True"]
 
 
-def test_with_another_thread_running_the_chunks_run_here():
-    ev = surface_evaluator(lagrange_surface(read_points(EXAMPLES / "paper-example-4.json")))
-    stop = threading.Event()
-    other = threading.Thread(target=stop.wait)
-    other.start()
-    try:
-        with Workers(ev, 2) as workers:
-            assert not workers.parallel
-    finally:
-        stop.set()
-        other.join()
-    with Workers(ev, 2) as workers:
-        assert workers.parallel
+def test_with_another_thread_running_the_chunks_run_here(tmp_path):
+    out = _fresh(
+        "import threading\n"
+        "from lagsym.evaluate import surface_evaluator\n"
+        "from lagsym.io import read_points\n"
+        "from lagsym.lagrange import lagrange_surface\n"
+        "from lagsym.toolpath.workers import Workers\n"
+        f"ev = surface_evaluator(lagrange_surface(read_points({str(EXAMPLES / 'paper-example-4.json')!r})))\n"
+        "stop = threading.Event()\n"
+        "other = threading.Thread(target=stop.wait)\n"
+        "other.start()\n"
+        "with Workers(ev, 2) as workers:\n"
+        "    during = workers.parallel\n"
+        "stop.set()\n"
+        "other.join()\n"
+        "with Workers(ev, 2) as workers:\n"
+        "    after = workers.parallel\n"
+        "print(during, after)\n", tmp_path)
+    assert out.split() == ["False", "True"]
 
 
 def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
