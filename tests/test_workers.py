@@ -17,16 +17,16 @@ from conftest import EXAMPLES, ROOT
 from cutters import brute
 
 
-def _fresh(code: str, tmp_path) -> str:
-    """Run ``code`` in a fresh interpreter (the suite's other tests may leave threads running here, and
-    workers fork only where no other thread runs); its standard output."""
+def _fresh(code: str, tmp_path, stderr: bool = False):
+    """Run ``code`` as a script in a fresh interpreter (the suite's other tests may leave threads running
+    here, and workers fork only where no other thread runs); its standard output, or both streams."""
     script = tmp_path / "run.py"
     script.write_text(code)
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
                           timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
-    return done.stdout
+    return (done.stdout, done.stderr) if stderr else done.stdout
 
 
 def test_worker_processes_give_the_same_values_as_one_process(tmp_path):
@@ -65,8 +65,7 @@ def test_one_process_runs_the_chunks_here():
 
 def test_a_script_without_a_main_guard_runs_with_workers(tmp_path):
     # A worker that imported the caller's main module again would run this script once more, without end.
-    script = tmp_path / "plan.py"
-    script.write_text(
+    out = _fresh(
         "from lagsym.evaluate import surface_evaluator\n"
         "from lagsym.io import read_points\n"
         "from lagsym.lagrange import lagrange_surface\n"
@@ -76,12 +75,8 @@ def test_a_script_without_a_main_guard_runs_with_workers(tmp_path):
         "ev = surface_evaluator(s)\n"
         "with Workers(ev, 2) as w:\n"
         "    z = drop_cutter(s, [2.0] * 600, [3.0] * 600, 0.15, evaluator=ev, workers=w)\n"
-        "print(w.processes, float(z[0]) == float(drop_cutter(s, 2.0, 3.0, 0.15)))\n")
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
-                          timeout=120)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.split() == ["2", "True"]
+        "print(w.processes, float(z[0]) == float(drop_cutter(s, 2.0, 3.0, 0.15)))\n", tmp_path)
+    assert out.split() == ["2", "True"]
 
 
 def test_with_another_thread_running_the_chunks_run_here(tmp_path):
@@ -107,8 +102,7 @@ def test_with_another_thread_running_the_chunks_run_here(tmp_path):
 
 def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
     # The command's SIGTERM handler raised in each worker when the pool ended it: a traceback per worker.
-    script = tmp_path / "plan.py"
-    script.write_text(
+    out, err = _fresh(
         "from lagsym.cli import _signals_as_interrupts\n"
         "from lagsym.evaluate import surface_evaluator\n"
         "from lagsym.io import read_points\n"
@@ -121,9 +115,5 @@ def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
         "    for _ in range(3):\n"
         "        with Workers(ev, 2) as w:\n"
         "            z = drop_cutter(s, [2.0] * 600, [3.0] * 600, 0.15, evaluator=ev, workers=w)\n"
-        "print(w.processes)\n")
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True,
-                          timeout=120)
-    assert done.returncode == 0 and done.stdout.split() == ["2"], done.stderr[-2000:]
-    assert done.stderr == "", done.stderr[-2000:]
+        "print(w.processes)\n", tmp_path, stderr=True)
+    assert out.split() == ["2"] and err == "", err[-2000:]
