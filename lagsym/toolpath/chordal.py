@@ -93,11 +93,7 @@ def move_sags(t, z, keep, extra, kappa):
     keep = np.asarray(keep, dtype=int)
     if len(keep) < 2:
         return np.zeros(0), np.zeros(0)
-    k = np.arange(keep[0], keep[-1])
-    m = np.searchsorted(keep, k, side="right") - 1  # the move each fine sample starts or lies inside
-    i, j = keep[m], keep[m + 1]
-    dev = z[k] - (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i]))
-    starts = keep[:-1] - keep[0]
+    k, i, dev, starts = _deviations(t, z, keep)
     seen = np.maximum(np.maximum.reduceat(dev, starts), 0.0)
     inner = np.where(k == i, -np.inf, dev + extra[k])
     semi = kappa * np.maximum.reduceat(t[k + 1] - t[k], starts) ** 2 / 8.0
@@ -115,11 +111,22 @@ def move_rises(t, z, keep):
     keep = np.asarray(keep, dtype=int)
     if len(keep) < 2:
         return np.zeros(0)
+    _, _, dev, starts = _deviations(t, z, keep)
+    return np.maximum(np.maximum.reduceat(-dev, starts), 0.0)
+
+
+def _deviations(t, z, keep):
+    """Each fine sample from the first kept to the last against the move it lies in: ``(k, i, dev, starts)``.
+
+    ``k`` the samples, ``i`` the start of each one's move, ``dev`` how far
+    the sample lies above the move, ``starts`` where each move's samples
+    begin in ``k`` (for ``reduceat``).
+    """
     k = np.arange(keep[0], keep[-1])
-    m = np.searchsorted(keep, k, side="right") - 1
+    m = np.searchsorted(keep, k, side="right") - 1  # the move each fine sample starts or lies inside
     i, j = keep[m], keep[m + 1]
-    below = (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i])) - z[k]
-    return np.maximum(np.maximum.reduceat(below, keep[:-1] - keep[0]), 0.0)
+    dev = z[k] - (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i]))
+    return k, i, dev, keep[:-1] - keep[0]
 
 
 def crosses_box_edge(vx, vy, bounds, radius):
