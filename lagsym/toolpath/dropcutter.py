@@ -214,11 +214,9 @@ def _peaks(val, inside, nearest):
     g = np.full((n, w + 2, w + 2), -np.inf)
     g[:, 1:-1, 1:-1][:, inside] = val[:, :m]
     c = g[:, 1:-1, 1:-1]
-    top = np.ones(c.shape, dtype=bool)
-    for di in (0, 1, 2):
-        for dj in (0, 1, 2):
-            if di != 1 or dj != 1:
-                top &= c >= g[:, di:di + w, dj:dj + w]
+    # No neighbour higher: as high as the largest of the 3 x 3 block around it (a separable maximum).
+    across = np.maximum(np.maximum(g[:, :, :-2], g[:, :, 1:-1]), g[:, :, 2:])
+    top = c >= np.maximum(np.maximum(across[:, :-2], across[:, 1:-1]), across[:, 2:])
     peak = np.ones(val.shape, dtype=bool)
     peak[:, :m] = top[:, inside]
     rim = val[:, m:m + len(nearest)]
@@ -337,12 +335,28 @@ def _candidates(ev, cx, cy, radius, corner, offsets, box, m):
     w = k + ex.shape[1]
     val, px, py = np.empty((n, w)), np.empty((n, w)), np.empty((n, w))
     cuts = sorted(set(range(0, k, block)) | {m, k})
+    # The lattice and rim lie under the tool already (the rim to rounding: its distance is taken as the
+    # radius).  Only a tool over a box edge needs them moved: into the box, which with the axis inside it
+    # keeps them in the disc; with the axis beyond the box, onto the disc too (:func:`_project`).
+    x0, x1, y0, y1 = box
+    beyond = (cx < x0) | (cx > x1) | (cy < y0) | (cy > y1)
+    edge = np.flatnonzero(~beyond & ((cx - radius < x0) | (cx + radius > x1) | (cy - radius < y0)
+                                     | (cy + radius > y1)))
+    beyond = np.flatnonzero(beyond)
+    reach2 = np.minimum(offsets[:, 0] ** 2 + offsets[:, 1] ** 2, radius * radius)
     for s, e in zip(cuts[:-1], cuts[1:]):
-        block = e - s
         ox, oy = offsets[s:e, 0], offsets[s:e, 1]
-        qx, qy, d2 = _project(cx[:, None] + ox, cy[:, None] + oy, cx[:, None], cy[:, None], radius, box)
-        val[:, s:s + block] = _height(ev, qx, qy, d2, radius, corner)
-        px[:, s:s + block], py[:, s:s + block] = qx, qy
+        qx, qy = cx[:, None] + ox, cy[:, None] + oy
+        d2 = np.repeat(reach2[None, s:e], n, axis=0)
+        if edge.size:
+            ex_, ey_ = np.clip(qx[edge], x0, x1), np.clip(qy[edge], y0, y1)
+            qx[edge], qy[edge] = ex_, ey_
+            d2[edge] = np.minimum((ex_ - cx[edge, None]) ** 2 + (ey_ - cy[edge, None]) ** 2, d2[edge])
+        if beyond.size:
+            qx[beyond], qy[beyond], d2[beyond] = _project(qx[beyond], qy[beyond], cx[beyond, None],
+                                                          cy[beyond, None], radius, box)
+        val[:, s:e] = _height(ev, qx, qy, d2, radius, corner)
+        px[:, s:e], py[:, s:e] = qx, qy
     qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
     val[:, k:], px[:, k:], py[:, k:] = _height(ev, qx, qy, d2, radius, corner), qx, qy
     return val, px, py
