@@ -22,7 +22,7 @@ import threading
 
 __all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
 
-MIN_POINTS = 40_000
+MIN_POINTS = 5_000
 """Fine samples from which a plan starts worker processes (below it, one process does all)."""
 
 MAX_PROCESSES = 8
