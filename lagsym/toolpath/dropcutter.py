@@ -39,6 +39,7 @@ from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import TOOL_SHAPES, cutter_profile
 from ..values import choice, positive
 from .newton import newton_ball
+from .region import edge_points, project
 from .workers import Workers
 
 __all__ = ["CL_MARGIN", "drop_cutter"]
@@ -225,79 +226,6 @@ def _peaks(val, inside, nearest):
     return peak
 
 
-def _project(px, py, cx, cy, radius, box):
-    """Move candidate contact points into the region under the tool: the box, then the disc.
-
-    With the axis inside the box, a point outside the disc is pulled towards
-    the axis onto the rim (the box is convex and holds the axis).  With the
-    axis beyond the box (``--boundary past``), it is pulled along the line to
-    the box point nearest the axis (in both, the two being convex) until it
-    meets the rim.  Candidates are ``(positions, k)`` arrays, the axis
-    ``(positions, 1)``; only the rows with a point outside the disc take the
-    second step.
-    """
-    x0, x1, y0, y1 = box
-    px = np.minimum(np.maximum(px, x0), x1)
-    py = np.minimum(np.maximum(py, y0), y1)
-    dx, dy = px - cx, py - cy
-    d2 = dx * dx + dy * dy
-    over = d2 > radius * radius
-    if not np.any(over):
-        return px, py, d2
-    rows = np.flatnonzero(over.any(axis=1))  # px, py and d2 are this call's own arrays: changed in place
-    cx, cy = np.broadcast_to(cx, px.shape), np.broadcast_to(cy, px.shape)
-    px[rows], py[rows], d2[rows] = _onto_disc(px[rows], py[rows], dx[rows], dy[rows], d2[rows], over[rows],
-                                              cx[rows], cy[rows], radius, box)
-    return px, py, d2
-
-
-def _onto_disc(px, py, dx, dy, d2, over, cx, cy, radius, box):
-    """The second step of :func:`_project`, for the points in the box ``over`` the rim (all arrays one shape)."""
-    x0, x1, y0, y1 = box
-    beyond = np.broadcast_to((cx < x0) | (cx > x1) | (cy < y0) | (cy > y1), px.shape)
-    radial = over & ~beyond
-    if np.any(radial):
-        f = np.where(radial, radius / np.sqrt(np.where(radial, d2, 1.0)), 1.0)
-        px, py = cx + dx * f, cy + dy * f
-    line = over & beyond
-    if np.any(line):
-        cxb, cyb = np.broadcast_to(cx, px.shape)[line], np.broadcast_to(cy, px.shape)[line]
-        ax, ay = np.clip(cxb, x0, x1), np.clip(cyb, y0, y1)
-        wx, wy = ax - cxb, ay - cyb
-        ex, ey = px[line] - ax, py[line] - ay
-        ee = ex * ex + ey * ey
-        ee = np.where(ee > 0, ee, 1.0)
-        we = wx * ex + wy * ey
-        t = (-we + np.sqrt(np.maximum(we * we - ee * (wx * wx + wy * wy - radius * radius), 0.0))) / ee
-        t = np.clip(t, 0.0, 1.0)
-        px, py = px.copy(), py.copy()
-        px[line], py[line] = ax + t * ex, ay + t * ey
-    dx, dy = px - cx, py - cy
-    return px, py, np.minimum(dx * dx + dy * dy, radius * radius)
-
-
-def _edge_points(cx, cy, radius, box):
-    """Box corners, and for each box edge the foot of the perpendicular from the centre and the rim crossings."""
-    x0, x1, y0, y1 = box
-    n = cx.size
-    xs, ys = [], []
-    for a in (x0, x1):
-        for b in (y0, y1):
-            xs.append(np.full(n, a))
-            ys.append(np.full(n, b))
-    for a in (x0, x1):  # vertical edges
-        w = np.sqrt(np.maximum(radius**2 - (cx - a) ** 2, 0.0))
-        for off in (0.0, 1.0, -1.0):
-            xs.append(np.full(n, a))
-            ys.append(cy + off * w)
-    for b in (y0, y1):  # horizontal edges
-        w = np.sqrt(np.maximum(radius**2 - (cy - b) ** 2, 0.0))
-        for off in (0.0, 1.0, -1.0):
-            xs.append(cx + off * w)
-            ys.append(np.full(n, b))
-    return np.stack(xs, axis=1), np.stack(ys, axis=1)
-
-
 def _height(ev, px, py, d2, radius, corner):
     """Tip height of the tool in contact at ``(px, py)``, ``d2`` the squared distance from its axis."""
     z = ev.fast_points(px, py)
@@ -331,13 +259,13 @@ def _candidates(ev, cx, cy, radius, corner, offsets, box, m):
     # Dense candidates, a block of offsets at a time to bound memory; the lattice apart from the rim, which
     # rounding puts just outside the disc, so the lattice's points need no more than the box.
     block = max(1, (1 << 22) // max(n, 1))
-    ex, ey = _edge_points(cx, cy, radius, box)
+    ex, ey = edge_points(cx, cy, radius, box)
     w = k + ex.shape[1]
     val, px, py = np.empty((n, w)), np.empty((n, w)), np.empty((n, w))
     cuts = sorted(set(range(0, k, block)) | {m, k})
     # The lattice and rim lie under the tool already (the rim to rounding: its distance is taken as the
     # radius).  Only a tool over a box edge needs them moved: into the box, which with the axis inside it
-    # keeps them in the disc; with the axis beyond the box, onto the disc too (:func:`_project`).
+    # keeps them in the disc; with the axis beyond the box, onto the disc too (:func:`.region.project`).
     x0, x1, y0, y1 = box
     beyond = (cx < x0) | (cx > x1) | (cy < y0) | (cy > y1)
     edge = np.flatnonzero(~beyond & ((cx - radius < x0) | (cx + radius > x1) | (cy - radius < y0)
@@ -353,11 +281,11 @@ def _candidates(ev, cx, cy, radius, corner, offsets, box, m):
             qx[edge], qy[edge] = ex_, ey_
             d2[edge] = np.minimum((ex_ - cx[edge, None]) ** 2 + (ey_ - cy[edge, None]) ** 2, d2[edge])
         if beyond.size:
-            qx[beyond], qy[beyond], d2[beyond] = _project(qx[beyond], qy[beyond], cx[beyond, None],
+            qx[beyond], qy[beyond], d2[beyond] = project(qx[beyond], qy[beyond], cx[beyond, None],
                                                           cy[beyond, None], radius, box)
         val[:, s:e] = _height(ev, qx, qy, d2, radius, corner)
         px[:, s:e], py[:, s:e] = qx, qy
-    qx, qy, d2 = _project(ex, ey, cx[:, None], cy[:, None], radius, box)
+    qx, qy, d2 = project(ex, ey, cx[:, None], cy[:, None], radius, box)
     val[:, k:], px[:, k:], py[:, k:] = _height(ev, qx, qy, d2, radius, corner), qx, qy
     return val, px, py
 
@@ -410,7 +338,7 @@ def _refine(ev, px, py, val, ccx, ccy, radius, corner, box, step, settle, poll=N
                                er[:, None, :] * _SIGNS, et[:, None, :] * _SIGNS], axis=1)
         qx = px[ia, None] + h[ia, None] * dirs[:, :, 0]
         qy = py[ia, None] + h[ia, None] * dirs[:, :, 1]
-        qx, qy, d2 = _project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
+        qx, qy, d2 = project(qx, qy, ccx[ia, None], ccy[ia, None], radius, box)
         qv = _height(ev, qx, qy, d2, radius, corner)
         j = np.argmax(qv, axis=1)
         bv = qv[np.arange(ia.size), j]
