@@ -24,6 +24,8 @@ The modules, one concern each:
   partial derivatives and the curvature bound (what drop-cutter needs);
 * :mod:`.curve`: :class:`CurveEvaluator`, the 1-D case;
 * :mod:`.bounds`: the rounding-error bound;
+* :mod:`.threads`: large grids and point sets shared among threads, bit for
+  bit the values of one;
 * :mod:`.barycentric`: the Lagrange basis itself, in the barycentric form
   ``L_j(t) = (w_j / (t - t_j)) / sum_k (w_k / (t - t_k))``, for what needs
   the basis values (:func:`basis_matrix`, :func:`lebesgue_constant`);

@@ -22,6 +22,7 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
+from .threads import parts, run_parts
 from .chebyshev import (
     chebyshev_matrix,
     chebyshev_matrix_float64,
@@ -49,8 +50,8 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -
     grid took 2-3 times as long as in blocks); each block here
     (:data:`PRODUCT_BLOCK` multiply-adds, small enough for BLAS to run it in
     one thread) is computed in cache and written to ``out`` once.  Every
-    element is the same dot product as in ``w @ ty``.  Two threads of blocks
-    were tried: on a loaded 2-core machine they were no faster.
+    element is the same dot product as in ``w @ ty``.  A large grid's rows are
+    shared among threads (:mod:`.threads`), each running its own blocks.
     """
     n = w.shape[0]
     out = np.empty((n, ty.shape[1])) if out is None else out
@@ -58,8 +59,12 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -
         out[...] = 0.0
         return out
     rows = max(1, PRODUCT_BLOCK // max(ty.shape[1] * w.shape[1], 1))
-    for r in range(0, n, rows):
-        np.matmul(w[r:r + rows], ty, out=out[r:r + rows])
+
+    def work(lo, hi):
+        for r in range(lo, hi, rows):
+            np.matmul(w[r:min(r + rows, hi)], ty, out=out[r:min(r + rows, hi)])
+
+    run_parts(work, parts(n, ty.shape[1], rows))
     return out
 
 
@@ -205,27 +210,32 @@ class SurfaceEvaluator:
 
         Works in blocks of ``chunk`` points, so memory stays a few megabytes
         above the result whatever the number of points, and a block's basis
-        values stay in cache.  The arithmetic is that of :meth:`grid` (the
+        values stay in cache; many points are shared among threads
+        (:mod:`.threads`).  The arithmetic is that of :meth:`grid` (the
         basis in long double, rounded once), so :meth:`error_bound` holds.
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
         xf, yf = x.ravel(), y.ravel()
-        n, m = self.shape
         out = np.empty(xf.size)
+        run_parts(lambda lo, hi: self._points_into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
+        return out.reshape(shape)
+
+    def _points_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
+        """:meth:`points` of ``xf[start:stop], yf[start:stop]`` into ``out``, in blocks of ``chunk`` from ``start``."""
+        n, m = self.shape
         c = np.ascontiguousarray(self.coefficients.T)  # (m, n)
-        size = min(chunk, xf.size)
+        size = min(chunk, stop - start)
         work = _BasisWork(size, max(n, m))
         tx, ty = np.empty((n, size)), np.empty((m, size))
-        for lo in range(0, xf.size, chunk):
-            hi = min(lo + chunk, xf.size)
+        for lo in range(start, stop, chunk):
+            hi = min(lo + chunk, stop)
             bx = work.basis(xf[lo:hi], self.x_offset, self.x_scale, n, tx)
             by = work.basis(yf[lo:hi], self.y_offset, self.y_scale, m, ty)
             w = c @ bx
             w *= by
             w.sum(axis=0, out=out[lo:hi])
             self._snap_points(out[lo:hi], xf[lo:hi], yf[lo:hi])
-        return out.reshape(shape)
 
     def _snap_points(self, out: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """Set ``out`` to the control height where ``(x, y)`` is a control point exactly; in place."""

@@ -1,0 +1,56 @@
+"""Both cores for a large evaluation: contiguous parts of the points or grid rows, one thread each.
+
+NumPy lets go of the interpreter lock inside its array loops and BLAS calls,
+so threads working on separate parts of one output run side by side.  Each
+part is computed exactly as it would be alone (the same blocks, the same
+arithmetic), so the values are the same bit for bit whatever the threads.
+Below :data:`THREAD_POINTS` values a part the threads would cost more than
+they save, and one thread does all.  The threads end with the call: none is
+left running (a plan forks its worker processes only while no other thread
+runs, :mod:`lagsym.toolpath.workers`).
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+__all__ = ["THREAD_POINTS", "MAX_THREADS", "available_cores", "parts", "run_parts"]
+
+THREAD_POINTS = 1 << 18
+"""Values a thread computes at least: below twice this, one thread does all."""
+
+MAX_THREADS = 4
+"""Threads at most, whatever the cores: beyond a few, memory speed is the limit."""
+
+
+def available_cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on every platform
+        return os.cpu_count() or 1
+
+
+def parts(n: int, per_item: int = 1, align: int = 1) -> list[tuple[int, int]]:
+    """``n`` items (of ``per_item`` values each) cut into contiguous ``(start, stop)`` parts, one per thread.
+
+    A part starts at a multiple of ``align`` (the block size of the work), so
+    every part's blocks are those of the whole.
+    """
+    threads = min(available_cores(), MAX_THREADS, max(1, n * per_item // THREAD_POINTS))
+    if threads < 2:
+        return [(0, n)]
+    size = -(-n // threads)
+    size = -(-size // align) * align
+    return [(lo, min(lo + size, n)) for lo in range(0, n, size)]
+
+
+def run_parts(work, cuts: list[tuple[int, int]]) -> None:
+    """``work(start, stop)`` for every part, each in a thread of its own where there are several."""
+    if len(cuts) == 1:
+        work(*cuts[0])
+        return
+    with ThreadPoolExecutor(len(cuts)) as pool:
+        for f in [pool.submit(work, lo, hi) for lo, hi in cuts]:
+            f.result()

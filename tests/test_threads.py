@@ -1,0 +1,63 @@
+"""Large evaluations shared among threads: every value that of one thread, none left running."""
+
+from fractions import Fraction
+import threading
+
+import numpy as np
+import pytest
+
+from lagsym import lagrange_surface, read_points
+from lagsym.evaluate import surface_evaluator, threads
+from lagsym.evaluate.surface import grid_product
+
+EXAMPLE = "examples/paper-example-4.json"
+
+
+@pytest.mark.parametrize("n, per_item, align", [(10**6, 1, 8192), (2000, 2000, 20), (7, 10**6, 3), (0, 1, 1)])
+def test_the_parts_cover_the_items_once_in_order_on_block_boundaries(monkeypatch, n, per_item, align):
+    monkeypatch.setattr(threads, "available_cores", lambda: 3)
+    cuts = threads.parts(n, per_item, align)
+    assert cuts[0][0] == 0 and cuts[-1][1] == n
+    assert all(a[1] == b[0] for a, b in zip(cuts, cuts[1:]))
+    assert all(lo % align == 0 for lo, _ in cuts)
+    if n * per_item >= 2 * threads.THREAD_POINTS and n >= 2:
+        assert len(cuts) > 1
+
+
+def test_few_values_take_one_thread(monkeypatch):
+    monkeypatch.setattr(threads, "available_cores", lambda: 8)
+    assert threads.parts(threads.THREAD_POINTS, 1, 1) == [(0, threads.THREAD_POINTS)]
+
+
+def _exact(surface, x: float, y: float) -> Fraction:
+    fx, fy = Fraction(x), Fraction(y)
+    return sum(c * fx**i * fy**k for i, row in enumerate(surface.coefficients) for k, c in enumerate(row))
+
+
+def test_threaded_points_are_those_of_one_thread_and_within_the_bound(monkeypatch):
+    surface = lagrange_surface(read_points(EXAMPLE))
+    ev = surface_evaluator(surface)
+    rng = np.random.default_rng(7)
+    x, y = rng.uniform(1, 5, 3 * threads.THREAD_POINTS), rng.uniform(1, 5, 3 * threads.THREAD_POINTS)
+    monkeypatch.setattr(threads, "available_cores", lambda: 3)
+    assert len(threads.parts(x.size, 1, 8192)) == 3
+    before = threading.active_count()
+    shared = ev.points(x, y)
+    assert threading.active_count() == before  # the threads end with the call
+    monkeypatch.setattr(threads, "available_cores", lambda: 1)
+    alone = ev.points(x, y)
+    assert np.array_equal(shared, alone)
+    bound = ev.error_bound()
+    # Independent of both: exact rational evaluation at points of every part.
+    for i in np.linspace(0, x.size - 1, 60).astype(int):
+        assert abs(Fraction(float(shared[i])) - _exact(surface, float(x[i]), float(y[i]))) <= bound
+
+
+def test_a_threaded_grid_product_is_the_matrix_product(monkeypatch):
+    rng = np.random.default_rng(3)
+    w, ty = rng.normal(size=(1500, 5)), rng.normal(size=(5, 1300))
+    monkeypatch.setattr(threads, "available_cores", lambda: 4)
+    assert len(threads.parts(1500, 1300, 30)) == 4
+    out = np.full((1500, 1300), np.nan)
+    grid_product(w, ty, out)
+    assert np.array_equal(out, w @ ty)
