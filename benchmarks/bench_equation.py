@@ -37,6 +37,20 @@ def _run(argv: list[str]) -> tuple[float, str]:
     return time.perf_counter() - t, done.stdout
 
 
+def table(commands: dict[str, list[str]], runs: int, base: str) -> None:
+    """Time each command ``runs`` times in fresh processes, alternating; print min, median and the ratios to ``base``."""
+    times: dict[str, list[float]] = {k: [] for k in commands}
+    for _ in range(runs):
+        for k, cmd in commands.items():
+            times[k].append(_run(cmd)[0])
+    base_min, base_med = min(times[base]), statistics.median(times[base])
+    print(f"| command | min (s) | median (s) | ratio to {base} (min / median) |")
+    print("|---|---:|---:|---:|")
+    for k, ts in times.items():
+        lo, med = min(ts), statistics.median(ts)
+        print(f"| {k} | {lo:.3f} | {med:.3f} | {lo / base_min:.2f}x / {med / base_med:.2f}x |")
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=9)
@@ -50,17 +64,8 @@ def main(argv=None) -> int:
     ours, theirs = _run(commands["lagsym equation"])[1], _run(commands["SymPy route, same text"])[1]
     if ours != theirs:
         raise SystemExit("the two routes printed different text")
-    times: dict[str, list[float]] = {k: [] for k in commands}
-    for _ in range(a.runs):
-        for k, cmd in commands.items():
-            times[k].append(_run(cmd)[0])
-    base_min, base_med = min(times["lagsym equation"]), statistics.median(times["lagsym equation"])
     print(f"## `lagsym equation {a.file}`, fresh processes, {a.runs} runs each (same text checked)\n")
-    print("| command | min (s) | median (s) | ratio to lagsym (min / median) |")
-    print("|---|---:|---:|---:|")
-    for k, ts in times.items():
-        lo, med = min(ts), statistics.median(ts)
-        print(f"| {k} | {lo:.3f} | {med:.3f} | {lo / base_min:.2f}x / {med / base_med:.2f}x |")
+    table(commands, a.runs, "lagsym equation")
     return 0
 
 

@@ -305,3 +305,11 @@ def test_the_planning_benchmark_mesh_comes_within_5_um():
     z = ocl_drop(ocl, stl_surface(ocl, surface, 360, 20.0), 6.0, x * 20, y * 20, -100.0)
     err = np.abs(z - exact).max()
     assert 1e-3 < err <= 5e-3  # mm: a mesh of the surface, within 5 um of it
+
+
+def test_the_sampling_page_quotes_the_threads():
+    from lagsym.evaluate.threads import MAX_THREADS, THREAD_POINTS
+
+    text = page("sampling.md")
+    assert MAX_THREADS == 4 and "shared among up to four threads" in text
+    assert f"contiguous parts of {THREAD_POINTS:,} values or more" in text
