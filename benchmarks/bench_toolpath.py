@@ -10,6 +10,9 @@ printed).  Both run in this process; the times are the minimum and median of
 
     python3 benchmarks/bench_toolpath.py [--quick] [--runs 3] [--mesh 360]
 
+The process first asks glibc's malloc to keep freed memory, as the
+``lagsym`` command does (:func:`lagsym.allocator.keep_freed_memory`).
+
 ``--quick`` plans a side step of 2 mm instead and drops OpenCAMLib's cutter on
 the first ``--ocl-points`` positions only, its time scaled by positions to all
 of them.  Needs ``opencamlib`` (``pip install opencamlib``).
@@ -32,6 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_dropcutter import ocl_drop, stl_surface  # noqa: E402
 
+from lagsym.allocator import keep_freed_memory  # noqa: E402
 from lagsym.evaluate import surface_evaluator  # noqa: E402
 from lagsym.io import read_points  # noqa: E402
 from lagsym.lagrange import lagrange_surface  # noqa: E402
@@ -67,6 +71,8 @@ def main(argv=None) -> int:
     ap.add_argument("--ocl-points", type=int, default=4000, help="with --quick, positions OpenCAMLib drops on")
     args = ap.parse_args(argv)
     import opencamlib as ocl
+
+    keep_freed_memory()
 
     surface = lagrange_surface(read_points(EXAMPLE))
     ev = surface_evaluator(surface)

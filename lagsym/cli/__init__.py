@@ -18,6 +18,7 @@ import threading
 import traceback
 from typing import IO, Sequence
 
+from ..allocator import keep_freed_memory
 from ..errors import ExitStatus, LagsymError, Terminated
 
 __all__ = ["main", "build_parser", "COMMANDS", "command_module"]
@@ -132,6 +133,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
     if not getattr(args, "_run", None):
         parser.print_help(out)
         return ExitStatus.BAD_INPUT
+    keep_freed_memory()  # large temporaries reused rather than faulted in afresh (lagsym.allocator)
     try:
         with _signals_as_interrupts():
             return int(args._run(args, out, err))
