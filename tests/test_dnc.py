@@ -414,3 +414,32 @@ def test_ctrl_c_names_the_block_to_resume_at():
     fault = info.value
     assert fault.start_block == fault.last_block + 1 > 1
     assert f"--start-block {fault.start_block}" in str(fault)
+
+
+@needs_socat
+def test_the_line_end_after_a_closing_percent_read_late_does_not_start_a_program(tmp_path):
+    # A control punches "...%" then "\r\n" and DC4; where those come in a read of their own, after the
+    # program was taken as ended at its closing %, they must not open a program of their own (it ended at
+    # the DC4 with no text, the service closed its port and the next punch was lost).
+    from lagsym.dnc.port import Port
+    from lagsym.dnc.receiver import receive_program
+
+    baud = 19200
+    settings = profile("fanuc", baud=baud)
+    pair = PtyPair()
+    line = Port(pair.near, settings, write_timeout=1.0)
+    try:
+        first = "%\nO2001 (FIRST)\nG0 X1.\nM30\n%"
+        second = "%\nO2002 (SECOND)\nG0 X2.\nM30\n%"
+        punch(pair.far, b"\x12" + first.encode(), baud)
+        assert receive_program(pair.near, settings, start_timeout_s=20, line=line) == first + "\n"
+        punch(pair.far, b"\r\n\x14", baud)
+        time.sleep(0.3)
+        t = threading.Thread(target=punch, args=(pair.far, b"\x12" + second.encode() + b"\r\n\x14", baud),
+                             daemon=True)
+        t.start()
+        assert receive_program(pair.near, settings, start_timeout_s=20, line=line) == second + "\n"
+        t.join(10)
+    finally:
+        line.close()
+        pair.close()

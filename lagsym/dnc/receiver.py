@@ -22,6 +22,7 @@ __all__ = ["receive_program"]
 
 _ETX = 0x03
 _DROPPED = frozenset((0x00, 0x7F, DC1, DC3, DC4, _ETX))
+_BLANKS = frozenset(b" \t\r\n")
 _LINE_CODES = frozenset(b"\r\n\t")
 
 
@@ -128,6 +129,8 @@ def _collect(line, port, settings, start_timeout_s, idle_timeout_s, progress, lo
                 break
             if byte in _DROPPED:
                 continue
+            if not started and byte in _BLANKS:  # the line end after the last program's closing % (and its
+                continue                          # DC4) may come in a later read: it does not start a program
             started = True
             if byte == ord("%"):
                 percents += 1
