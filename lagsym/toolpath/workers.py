@@ -16,9 +16,10 @@ result is the same whichever process computes it.
 from __future__ import annotations
 
 import multiprocessing
-import os
 import signal
 import threading
+
+from ..evaluate.threads import available_cores
 
 __all__ = ["Workers", "MIN_POINTS", "MAX_PROCESSES", "available_cores"]
 
@@ -29,14 +30,6 @@ MAX_PROCESSES = 8
 """Worker processes at most, whatever the cores: each holds its own interpreter and NumPy."""
 
 _EVALUATOR = None  # in a worker process only: the evaluator its initializer received
-
-
-def available_cores() -> int:
-    """The cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on every platform
-        return os.cpu_count() or 1
 
 
 def _start(evaluator) -> None:
