@@ -29,11 +29,6 @@ def test_few_values_take_one_thread(monkeypatch):
     assert threads.parts(threads.THREAD_POINTS, 1, 1) == [(0, threads.THREAD_POINTS)]
 
 
-def _exact(surface, x: float, y: float) -> Fraction:
-    fx, fy = Fraction(x), Fraction(y)
-    return sum(c * fx**i * fy**k for i, row in enumerate(surface.coefficients) for k, c in enumerate(row))
-
-
 def test_threaded_points_are_those_of_one_thread_and_within_the_bound(monkeypatch):
     surface = lagrange_surface(read_points(EXAMPLE))
     ev = surface_evaluator(surface)
@@ -50,7 +45,8 @@ def test_threaded_points_are_those_of_one_thread_and_within_the_bound(monkeypatc
     bound = ev.error_bound()
     # Independent of both: exact rational evaluation at points of every part.
     for i in np.linspace(0, x.size - 1, 60).astype(int):
-        assert abs(Fraction(float(shared[i])) - _exact(surface, float(x[i]), float(y[i]))) <= bound
+        exact = surface.exact_value(Fraction(float(x[i])), Fraction(float(y[i])))
+        assert abs(Fraction(float(shared[i])) - exact) <= bound
 
 
 def test_a_threaded_grid_product_is_the_matrix_product(monkeypatch):
