@@ -50,16 +50,16 @@ def test_a_reintroduced_cycle_or_stray_import_fails(tmp_path, module, line, brok
 def test_import_lagsym_loads_no_heavy_library():
     code = ("import sys, lagsym; from lagsym.cli import main; main(['--help'], open('/dev/null', 'w')); "
             "print(' '.join(sorted(m for m in ('serial', 'pyvista', 'vtkmodules', 'meshio', 'rich', 'sympy', "
-            "'numpy', 'flint', 'scipy') if m in sys.modules)))")
+            "'numpy', 'flint', 'scipy', 'numba') if m in sys.modules)))")
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == ""
 
 
-def test_the_plain_library_does_not_load_serial_or_pictures():
+def test_the_plain_library_does_not_load_serial_pictures_or_numba():
     code = ("import sys; from lagsym import lagrange_surface, read_points, sample, plan_toolpath, macro_program, "
             "simulate, parse_program, LineSettings; "
-            "print(' '.join(sorted(m for m in ('serial', 'pyvista', 'vtkmodules', 'meshio', 'rich') "
+            "print(' '.join(sorted(m for m in ('serial', 'pyvista', 'vtkmodules', 'meshio', 'rich', 'numba') "
             "if m in sys.modules)))")
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr

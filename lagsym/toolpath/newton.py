@@ -23,15 +23,14 @@ import numpy as np
 from ..evaluate import SurfaceEvaluator
 from ..evaluate.chebyshev import chebyshev_matrix_float64
 
-__all__ = ["newton_ball", "surface_jet"]
+__all__ = ["newton_ball", "surface_jet", "jet_coefficients"]
 
-_ROUNDS = 12  # Newton steps at most; from a lattice peak it converges in three to five
 _BLOCK = 1 << 12  # points per block of the jet: its basis and partial sums stay in cache
 
 _JETS: weakref.WeakKeyDictionary[SurfaceEvaluator, np.ndarray] = weakref.WeakKeyDictionary()
 
 
-def _jet_coefficients(ev: SurfaceEvaluator) -> np.ndarray:
+def jet_coefficients(ev: SurfaceEvaluator) -> np.ndarray:
     """The Chebyshev coefficients of ``F, F_x, F_y, F_xx, F_xy, F_yy``, padded to one shape, stacked ``(6 m, n)``."""
     found = _JETS.get(ev)
     if found is None:
@@ -53,7 +52,7 @@ def surface_jet(ev: SurfaceEvaluator, x, y) -> np.ndarray:
     the float64 arithmetic of :meth:`~lagsym.evaluate.SurfaceEvaluator.fast_points`.
     """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    coef = _jet_coefficients(ev)
+    coef = jet_coefficients(ev)
     n, m = ev.shape
     s = (x - ev.x_offset) / ev.x_scale
     t = (y - ev.y_offset) / ev.y_scale
@@ -73,61 +72,6 @@ def surface_jet(ev: SurfaceEvaluator, x, y) -> np.ndarray:
     return out
 
 
-def _newton_step(jet, px, py, cx, cy, radius, box):
-    """The projected Newton step of ``g`` at each point.
-
-    A coordinate at a box edge with the gradient pointing out of the box is
-    held there (the step runs along the edge; at a corner there is none).
-    Returns the step, whether it is one (the Hessian of the free coordinates
-    negative definite), that Hessian's eigenvalue nearest 0 (at a corner, the
-    ball's own curvature) and the rise the quadratic model promises (half the
-    Newton decrement).
-    """
-    f, fx, fy, fxx, fxy, fyy = jet
-    x0, x1, y0, y1 = box
-    dx, dy = px - cx, py - cy
-    s = np.sqrt(np.maximum(radius * radius - dx * dx - dy * dy, 1e-300))
-    s3 = s * s * s
-    gx, gy = fx - dx / s, fy - dy / s
-    hxx, hxy, hyy = fxx - 1.0 / s - dx * dx / s3, fxy - dx * dy / s3, fyy - 1.0 / s - dy * dy / s3
-    hold_x = ((px <= x0) & (gx < 0)) | ((px >= x1) & (gx > 0))
-    hold_y = ((py <= y0) & (gy < 0)) | ((py >= y1) & (gy > 0))
-    det = hxx * hyy - hxy * hxy
-    ok = np.where(hold_x, hyy < 0, np.where(hold_y, hxx < 0, (det > 0) & (hxx < 0))) | (hold_x & hold_y)
-    det = np.where(ok & ~hold_x & ~hold_y, det, 1.0)
-    sx, sy = -(hyy * gx - hxy * gy) / det, -(hxx * gy - hxy * gx) / det
-    one_x, one_y = -gx / np.where(hxx < 0, hxx, -1.0), -gy / np.where(hyy < 0, hyy, -1.0)
-    sx = np.where(hold_x, 0.0, np.where(hold_y, one_x, sx))
-    sy = np.where(hold_y, 0.0, np.where(hold_x, one_y, sy))
-    half = 0.5 * (hxx + hyy)
-    flat = np.abs(half + np.sqrt(np.maximum(half * half - det, 0.0)))
-    flat = np.where(hold_x, np.abs(hyy), np.where(hold_y, np.abs(hxx), flat))
-    flat = np.where(hold_x & hold_y, 1.0 / s, flat)
-    return sx, sy, ok, flat, 0.5 * (gx * sx + gy * sy)
-
-
-def _contact(ev, qx, qy, cx, cy, radius):
-    """The jet of the surface at ``q`` and the ball's tip height in contact there."""
-    jet = surface_jet(ev, qx, qy)
-    d2 = (qx - cx) ** 2 + (qy - cy) ** 2
-    return jet, jet[0] + np.sqrt(np.maximum(radius * radius - d2, 0.0)) - radius
-
-
-def _off_rim(ev, px, py, val, cx, cy, radius, box, spacing, r2):
-    """Starts on the ball's rim moved a quarter of ``spacing`` towards the axis (into the box) where that is higher; in place."""
-    on = np.flatnonzero((px - cx) ** 2 + (py - cy) ** 2 >= r2)
-    if not on.size:
-        return
-    x0, x1, y0, y1 = box
-    f = 1.0 - min(0.25 * spacing / radius, 0.5)
-    qx = np.clip(cx[on] + f * (px[on] - cx[on]), x0, x1)
-    qy = np.clip(cy[on] + f * (py[on] - cy[on]), y0, y1)
-    _, qv = _contact(ev, qx, qy, cx[on], cy[on], radius)
-    up = ((qx - cx[on]) ** 2 + (qy - cy[on]) ** 2 < r2) & (qv > val[on])
-    on = on[up]
-    px[on], py[on], val[on] = qx[up], qy[up], qv[up]
-
-
 def newton_ball(ev, px, py, val, cx, cy, radius, box, spacing, settle):
     """Move each start towards the local maximum of the ball's contact height; in place.
 
@@ -140,32 +84,13 @@ def newton_ball(ev, px, py, val, cx, cy, radius, box, spacing, settle):
     each point: ``spacing`` where Newton did not converge (a saddle, a valley
     tighter than the ball), else the step over which the flattest direction
     at the point changes the height by eight times ``settle``, so the search
-    does not settle before it has looked, and no more than ``spacing``.
+    does not settle before it has looked, and no more than ``spacing``; and
+    whether Newton converged.  The steps are compiled (:func:`.kernel.newton_starts`).
     """
-    x0, x1, y0, y1 = box
-    r2 = radius * radius * (1.0 - 1e-6)
-    h = np.full(px.size, spacing)
-    done = np.zeros(px.size, dtype=bool)
-    _off_rim(ev, px, py, val, cx, cy, radius, box, spacing, r2)
-    live = np.flatnonzero((px - cx) ** 2 + (py - cy) ** 2 < r2)
-    jet, _ = _contact(ev, px[live], py[live], cx[live], cy[live], radius)
-    damp = np.ones(live.size)
-    for _ in range(_ROUNDS):
-        if not live.size:
-            break
-        sx, sy, ok, flat, gain = _newton_step(jet, px[live], py[live], cx[live], cy[live], radius, box)
-        converged = ok & (gain <= 0.01 * settle)
-        done[live[converged]] = True
-        h[live[converged]] = np.minimum(spacing, np.sqrt(16.0 * settle / np.maximum(flat[converged], 1e-300)))
-        keep = ok & ~converged & (damp > 1e-3)
-        live, sx, sy, jet, damp = live[keep], sx[keep], sy[keep], jet[:, keep], damp[keep]
-        length = np.hypot(sx, sy)
-        f = damp * np.where(length > spacing, spacing / np.where(length > 0, length, 1.0), 1.0)
-        qx, qy = np.clip(px[live] + f * sx, x0, x1), np.clip(py[live] + f * sy, y0, y1)
-        qjet, qv = _contact(ev, qx, qy, cx[live], cy[live], radius)
-        # A step out of the disc or down (clipped to the box, the step can overshoot) is retried shorter.
-        up = (qv >= val[live]) & ((qx - cx[live]) ** 2 + (qy - cy[live]) ** 2 < r2)
-        px[live[up]], py[live[up]], val[live[up]] = qx[up], qy[up], qv[up]
-        jet[:, up] = qjet[:, up]
-        damp = np.where(up, 1.0, 0.25 * damp)
+    from .kernel import newton_starts
+
+    geo = np.array([ev.x_offset, ev.x_scale, ev.y_offset, ev.y_scale, *box, radius, radius, spacing, settle], dtype=float)
+    h, done = np.empty(px.size), np.zeros(px.size, dtype=bool)
+    cx, cy = (np.ascontiguousarray(np.broadcast_to(v, px.shape), dtype=float) for v in (cx, cy))
+    newton_starts(jet_coefficients(ev), ev.shape[1], geo, px, py, val, cx, cy, h, done)
     return h, done

@@ -155,6 +155,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     if scallop is None and tool.shape == "ball" and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     kappa = ev.curvature_bound() / mm_per_unit
+    # Drop-cutter's compiled kernel loaded here (the first time, compiled), before the workers fork: they share it.
+    cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
     # Worker processes on the other cores, where the plan is large enough to pay for starting them.
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
         cl = replace(cl, workers=workers)
