@@ -221,13 +221,14 @@ class _Lattice(NamedTuple):
 
 
 def _geometry(ev: SurfaceEvaluator, radius: float, corner: float, spacing: float, settle: float) -> np.ndarray:
-    """The kernel's geometry array (:data:`.kernel.GEO_FIELDS`)."""
+    """The kernel's geometry array, in the order :mod:`.kernel` states."""
     return np.array([ev.x_offset, ev.x_scale, ev.y_offset, ev.y_scale, *ev.bounds, radius, corner, spacing, settle],
                     dtype=float)
 
 
 def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):
-    """Drop-cutter over one chunk of positions: dense candidates, then a local search from the best of each basin."""
+    """Drop-cutter over one chunk of positions (no margin), in the compiled kernel; numba is imported here, on
+    first use, so that importing lagsym loads no compiler."""
     from .kernel import drop_chunk
 
     ball = corner == radius
