@@ -49,11 +49,20 @@ def test_threaded_points_are_those_of_one_thread_and_within_the_bound(monkeypatc
         assert abs(Fraction(float(shared[i])) - exact) <= bound
 
 
-def test_a_threaded_grid_product_is_the_matrix_product(monkeypatch):
+def test_a_threaded_grid_product_is_that_of_one_thread_and_the_matrix_product(monkeypatch):
     rng = np.random.default_rng(3)
     w, ty = rng.normal(size=(1500, 5)), rng.normal(size=(5, 1300))
     monkeypatch.setattr(threads, "available_cores", lambda: 4)
     assert len(threads.parts(1500, 1300, 30)) == 4
     out = np.full((1500, 1300), np.nan)
     grid_product(w, ty, out)
-    assert np.array_equal(out, w @ ty)
+    monkeypatch.setattr(threads, "available_cores", lambda: 1)
+    assert np.array_equal(out, grid_product(w, ty))
+    # Every element the dot product of its row and column, to the rounding of a 5-term sum (BLAS may add the
+    # terms in another order for a block than for the whole product): against exact rational sums, sampled.
+    scale = np.abs(w) @ np.abs(ty)
+    gamma = 5 * np.finfo(float).eps / (1 - 5 * np.finfo(float).eps)
+    assert np.all(np.abs(out - w @ ty) <= 2 * gamma * scale)
+    for i, j in zip(rng.integers(0, 1500, 300), rng.integers(0, 1300, 300)):
+        exact = sum(Fraction(float(a)) * Fraction(float(b)) for a, b in zip(w[i], ty[:, j]))
+        assert abs(Fraction(float(out[i, j])) - exact) <= Fraction(float(gamma * scale[i, j]))

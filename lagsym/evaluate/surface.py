@@ -50,8 +50,11 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -
     grid took 2-3 times as long as in blocks); each block here
     (:data:`PRODUCT_BLOCK` multiply-adds, small enough for BLAS to run it in
     one thread) is computed in cache and written to ``out`` once.  Every
-    element is the same dot product as in ``w @ ty``.  A large grid's rows are
-    shared among threads (:mod:`.threads`), each running its own blocks.
+    element is the dot product of its row and column, within the rounding of
+    that sum; BLAS may add its terms in another order than one ``w @ ty``
+    does (OpenBLAS's AVX-512 kernels do, by the last bit).  A large grid's
+    rows are shared among threads (:mod:`.threads`), each running the blocks
+    one thread would, so the values are the same whatever the threads.
     """
     n = w.shape[0]
     out = np.empty((n, ty.shape[1])) if out is None else out
