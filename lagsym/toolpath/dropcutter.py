@@ -42,7 +42,7 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import TOOL_SHAPES
 from ..values import choice, positive
-from .newton import jet_coefficients
+from .newton import jet_coefficients, kernel_geometry
 from .workers import Workers
 
 __all__ = ["CL_MARGIN", "drop_cutter"]
@@ -220,12 +220,6 @@ class _Lattice(NamedTuple):
     nearest: np.ndarray
 
 
-def _geometry(ev: SurfaceEvaluator, radius: float, corner: float, spacing: float, settle: float) -> np.ndarray:
-    """The kernel's geometry array, in the order :mod:`.kernel` states."""
-    return np.array([ev.x_offset, ev.x_scale, ev.y_offset, ev.y_scale, *ev.bounds, radius, corner, spacing, settle],
-                    dtype=float)
-
-
 def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):
     """Drop-cutter over one chunk of positions (no margin), in the compiled kernel; numba is imported here, on
     first use, so that importing lagsym loads no compiler."""
@@ -234,6 +228,6 @@ def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):
     ball = corner == radius
     c = np.ascontiguousarray(ev.coefficients, dtype=float)
     jet = jet_coefficients(ev) if ball else np.zeros((6 * c.shape[1], c.shape[0]))
-    geo = _geometry(ev, radius, corner, spacing, settle)
+    geo = kernel_geometry(ev, ev.bounds, radius, corner, spacing, settle)
     return drop_chunk(c, jet, geo, np.ascontiguousarray(cx, dtype=float), np.ascontiguousarray(cy, dtype=float),
                       *lattice, int(starts), ball)

@@ -23,7 +23,7 @@ import numpy as np
 from ..evaluate import SurfaceEvaluator
 from ..evaluate.chebyshev import chebyshev_matrix_float64
 
-__all__ = ["newton_ball", "surface_jet", "jet_coefficients"]
+__all__ = ["newton_ball", "surface_jet", "jet_coefficients", "kernel_geometry"]
 
 _BLOCK = 1 << 12  # points per block of the jet: its basis and partial sums stay in cache
 
@@ -43,6 +43,12 @@ def jet_coefficients(ev: SurfaceEvaluator) -> np.ndarray:
             parts.append(pad.T)
         found = _JETS[ev] = np.ascontiguousarray(np.concatenate(parts, axis=0))
     return found
+
+
+def kernel_geometry(ev: SurfaceEvaluator, box, radius: float, corner: float, spacing: float,
+                    settle: float) -> np.ndarray:
+    """The compiled kernel's geometry array for the evaluator ``ev``, the ``box`` and the tool (:mod:`.kernel`)."""
+    return np.array([ev.x_offset, ev.x_scale, ev.y_offset, ev.y_scale, *box, radius, corner, spacing, settle], float)
 
 
 def surface_jet(ev: SurfaceEvaluator, x, y) -> np.ndarray:
@@ -89,7 +95,7 @@ def newton_ball(ev, px, py, val, cx, cy, radius, box, spacing, settle):
     """
     from .kernel import newton_starts
 
-    geo = np.array([ev.x_offset, ev.x_scale, ev.y_offset, ev.y_scale, *box, radius, radius, spacing, settle], dtype=float)
+    geo = kernel_geometry(ev, box, radius, radius, spacing, settle)
     h, done = np.empty(px.size), np.zeros(px.size, dtype=bool)
     cx, cy = (np.ascontiguousarray(np.broadcast_to(v, px.shape), dtype=float) for v in (cx, cy))
     newton_starts(jet_coefficients(ev), ev.shape[1], geo, px, py, val, cx, cy, h, done)
