@@ -66,3 +66,20 @@ def test_a_threaded_grid_product_is_that_of_one_thread_and_the_matrix_product(mo
     for i, j in zip(rng.integers(0, 1500, 300), rng.integers(0, 1300, 300)):
         exact = sum(Fraction(float(a)) * Fraction(float(b)) for a, b in zip(w[i], ty[:, j]))
         assert abs(Fraction(float(out[i, j])) - exact) <= Fraction(float(gamma * scale[i, j]))
+
+
+@pytest.mark.parametrize("failing", [0, 2])
+def test_an_error_in_any_part_is_raised_after_every_part_has_ended(failing):
+    before = threading.active_count()
+    ran = []
+
+    def work(lo, hi):
+        if lo == failing:
+            raise ValueError(f"part {lo}")
+        threading.Event().wait(0.05)  # the other parts still running when the failing one stops
+        ran.append(lo)
+
+    with pytest.raises(ValueError, match=f"part {failing}"):
+        threads.run_parts(work, [(0, 1), (1, 2), (2, 3)])
+    assert sorted(ran) == [p for p in (0, 1, 2) if p != failing]
+    assert threading.active_count() == before

@@ -13,7 +13,7 @@ runs, :mod:`lagsym.toolpath.workers`).
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+import threading
 
 __all__ = ["THREAD_POINTS", "MAX_THREADS", "available_cores", "parts", "run_parts"]
 
@@ -47,10 +47,31 @@ def parts(n: int, per_item: int = 1, align: int = 1) -> list[tuple[int, int]]:
 
 
 def run_parts(work, cuts: list[tuple[int, int]]) -> None:
-    """``work(start, stop)`` for every part, each in a thread of its own where there are several."""
+    """``work(start, stop)`` for every part, the first in the calling thread and each other in a thread of its own.
+
+    Plain threads, started and joined here: a pool's set-up cost about a
+    third of a millisecond on the development machine, a sixth of a
+    2000 x 2000 sample.  The first error raised in any part is raised again
+    once all have ended.
+    """
     if len(cuts) == 1:
         work(*cuts[0])
         return
-    with ThreadPoolExecutor(len(cuts)) as pool:
-        for f in [pool.submit(work, lo, hi) for lo, hi in cuts]:
-            f.result()
+    errors: list[BaseException] = []
+
+    def run(lo, hi):
+        try:
+            work(lo, hi)
+        except BaseException as e:  # raised again in the calling thread
+            errors.append(e)
+
+    threads = [threading.Thread(target=run, args=cut, daemon=True) for cut in cuts[1:]]
+    for t in threads:
+        t.start()
+    try:
+        work(*cuts[0])
+    finally:
+        for t in threads:
+            t.join()
+    if errors:
+        raise errors[0]
