@@ -31,9 +31,10 @@ _STEPS = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0), 
           (0.0, 0.0, 1.0), (0.0, 0.0, -1.0))  # a pattern-search round: axis steps, then signs along and across
 _ROUNDS = 12  # Newton steps at most
 _EDGE_POINTS = 16  # four box corners, and three points on each of the four edges
+_compiled = njit(cache=True, error_model="numpy")  # no zero check before each division: no divisor here is 0
 
 
-@njit(cache=True)
+@_compiled
 def _values(c, geo, xs, ys, count, out, work):
     """``F`` at the first ``count`` points ``xs, ys`` into ``out``, summed in the order of
     :meth:`~lagsym.evaluate.SurfaceEvaluator.fast_points`; ``work``: ``n + m + 1`` rows of scratch."""
@@ -54,7 +55,7 @@ def _values(c, geo, xs, ys, count, out, work):
             out[k] += w[k] * by[j, k]
 
 
-@njit(cache=True)
+@_compiled
 def _basis(rows, vs, offset, scale, count):
     """Chebyshev polynomials at the first ``count`` points ``vs`` (then normalized), a row each, by their recurrence."""
     for k in range(count):
@@ -67,7 +68,7 @@ def _basis(rows, vs, offset, scale, count):
             rows[i, k] = 2.0 * rows[1, k] * rows[i - 1, k] - rows[i - 2, k]
 
 
-@njit(cache=True)
+@_compiled
 def _jet(jt, m, geo, x, y, acc, out):
     """``F, F_x, F_y, F_xx, F_xy, F_yy`` at ``(x, y)`` into ``out`` (``jt`` the stacked coefficients transposed,
     ``(n, 6 m)``)."""
@@ -93,41 +94,38 @@ def _jet(jt, m, geo, x, y, acc, out):
             out[q] += acc[q * m + k] * tk
 
 
-@njit(cache=True)
+@_compiled
 def _clip(v, lo, hi):
     return min(max(v, lo), hi)
 
 
-@njit(cache=True)
+@_compiled
 def _project(px, py, cx, cy, geo):
     """A candidate moved into the box, then into the disc: towards the axis where the box holds it, else along
-    the line to the box point nearest the axis; ``(x, y, d2)``, ``d2`` the squared distance from the axis."""
+    the line to the box point nearest the axis; ``(x, y, d2)``, ``d2`` the squared distance from the axis.
+    Both ways are computed and one kept: with no branch, a loop of projections runs a SIMD lane a point."""
     x0, x1, y0, y1, radius = geo[4], geo[5], geo[6], geo[7], geo[8]
-    px, py = _clip(px, x0, x1), _clip(py, y0, y1)
-    dx, dy = px - cx, py - cy
+    qx, qy = _clip(px, x0, x1), _clip(py, y0, y1)
+    dx, dy = qx - cx, qy - cy
     d2 = dx * dx + dy * dy
     r2 = radius * radius
-    if d2 <= r2:
-        return px, py, d2
-    if (cx < geo[4] or cx > geo[5] or cy < geo[6] or cy > geo[7]):
-        ax, ay = _clip(cx, x0, x1), _clip(cy, y0, y1)
-        wx, wy = ax - cx, ay - cy
-        ex, ey = px - ax, py - ay
-        ee = ex * ex + ey * ey
-        if not ee > 0.0:
-            ee = 1.0
-        we = wx * ex + wy * ey
-        t = (-we + math.sqrt(max(we * we - ee * (wx * wx + wy * wy - r2), 0.0))) / ee
-        t = _clip(t, 0.0, 1.0)
-        px, py = ax + t * ex, ay + t * ey
-    else:
-        f = radius / math.sqrt(d2)
-        px, py = cx + dx * f, cy + dy * f
-    dx, dy = px - cx, py - cy
-    return px, py, min(dx * dx + dy * dy, r2)
+    ax, ay = _clip(cx, x0, x1), _clip(cy, y0, y1)  # the axis itself where it is over the box
+    wx, wy = ax - cx, ay - cy
+    ex, ey = qx - ax, qy - ay
+    ee = ex * ex + ey * ey
+    ee = ee if ee > 0.0 else 1.0
+    we = wx * ex + wy * ey
+    t = _clip((-we + math.sqrt(max(we * we - ee * (wx * wx + wy * wy - r2), 0.0))) / ee, 0.0, 1.0)
+    f = radius / math.sqrt(max(d2, 1e-300))  # kept only where d2 > r2
+    beyond = ax != cx or ay != cy
+    rx, ry = (ax + t * ex, ay + t * ey) if beyond else (cx + dx * f, cy + dy * f)
+    inside = d2 <= r2
+    rx, ry = (qx, qy) if inside else (rx, ry)
+    dx, dy = rx - cx, ry - cy
+    return rx, ry, (d2 if inside else min(dx * dx + dy * dy, r2))
 
 
-@njit(cache=True)
+@_compiled
 def _edge_point(e, cx, cy, geo):
     """Corner ``e`` of the region under the tool, unprojected: a box corner, an axis's foot or a rim crossing."""
     x0, x1, y0, y1, radius = geo[4], geo[5], geo[6], geo[7], geo[8]
@@ -145,7 +143,7 @@ def _edge_point(e, cx, cy, geo):
     return cx + off * w, b
 
 
-@njit(cache=True)
+@_compiled
 def _candidates(c, geo, cx, cy, offsets, reach2, val, px, py, d2, moved, work):
     """Heights, contact points, squared distances from the axis and whether the box moved each, for the lattice
     and rim (``offsets``, ``reach2`` their squared distances) and the region's corners under the tool at
@@ -154,11 +152,12 @@ def _candidates(c, geo, cx, cy, offsets, reach2, val, px, py, d2, moved, work):
     beyond = (cx < geo[4] or cx > geo[5] or cy < geo[6] or cy > geo[7])
     edge = not beyond and (cx - radius < x0 or cx + radius > x1 or cy - radius < y0 or cy + radius > y1)
     k_all = offsets.shape[0]
-    for k in range(k_all):
+    for k in range(k_all if beyond else 0):  # a loop of its own: a SIMD lane a point
+        px[k], py[k], d2[k] = _project(cx + offsets[k, 0], cy + offsets[k, 1], cx, cy, geo)
+        moved[k] = px[k] != cx + offsets[k, 0] or py[k] != cy + offsets[k, 1]
+    for k in range(k_all if beyond else 0, k_all):
         ox, oy = cx + offsets[k, 0], cy + offsets[k, 1]
-        if beyond:
-            qx, qy, q2 = _project(ox, oy, cx, cy, geo)
-        elif edge:
+        if edge:
             qx, qy = _clip(ox, x0, x1), _clip(oy, y0, y1)
             q2 = min((qx - cx) ** 2 + (qy - cy) ** 2, reach2[k])
         else:
@@ -173,7 +172,7 @@ def _candidates(c, geo, cx, cy, offsets, reach2, val, px, py, d2, moved, work):
     _heights(c, geo, px, py, d2, k_all + _EDGE_POINTS, val, work)
 
 
-@njit(cache=True)
+@_compiled
 def _heights(c, geo, xs, ys, d2, count, out, work):
     """Tip heights of the tool in contact at the first ``count`` points, ``d2`` their squared distances from the
     axis; into ``out``."""
@@ -191,7 +190,7 @@ def _heights(c, geo, xs, ys, d2, count, out, work):
             out[k] = out[k] - (corner - math.sqrt(max(corner * corner - o * o, 0.0)))
 
 
-@njit(cache=True)
+@_compiled
 def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, rank, top, far, chosen):
     """The candidates the search starts from, into ``chosen``: the best of all, then the best of distinct basins.
 
@@ -230,7 +229,7 @@ def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, rank, top, far
         chosen[s] = top[pick]
 
 
-@njit(cache=True)
+@_compiled
 def _ranked(val, moved, nb, nearest, nlat, rank, top, many):
     """Rank each candidate and put the basins' heads in order into ``top``; how many were put.
 
@@ -266,7 +265,7 @@ def _ranked(val, moved, nb, nearest, nlat, rank, top, many):
     return count
 
 
-@njit(cache=True)
+@_compiled
 def _ranked_rest(val, rank, top, count, many):
     """After the ``count`` basins' heads in ``top``, the other candidates, up to ``many`` in all; how many now."""
     first = count
@@ -276,7 +275,7 @@ def _ranked_rest(val, rank, top, count, many):
     return count
 
 
-@njit(cache=True)
+@_compiled
 def _insert(val, top, first, count, many, k):
     """Candidate ``k`` into ``top[first:count]``, kept best first (the earlier of equals first) and ``many`` long
     at most; the new ``count``."""
@@ -292,7 +291,7 @@ def _insert(val, top, first, count, many, k):
     return count + 1
 
 
-@njit(cache=True)
+@_compiled
 def _newton_step(jet, px, py, cx, cy, geo):
     """The Newton step of the contact height at ``p``, a coordinate held at a box edge the gradient points out of:
     ``(sx, sy, ok, flat, gain)``, ``ok`` the Hessian negative definite, ``flat`` its eigenvalue nearest 0."""
@@ -320,7 +319,7 @@ def _newton_step(jet, px, py, cx, cy, geo):
     return sx, sy, ok, flat, 0.5 * (gx * sx + gy * sy)
 
 
-@njit(cache=True)
+@_compiled
 def _contact(jt, m, geo, qx, qy, cx, cy, acc, out):
     """The jet at ``q`` into ``out`` and the ball's tip height in contact there."""
     _jet(jt, m, geo, qx, qy, acc, out)
@@ -329,7 +328,7 @@ def _contact(jt, m, geo, qx, qy, cx, cy, acc, out):
     return out[0] + math.sqrt(max(radius * radius - d2, 0.0)) - radius
 
 
-@njit(cache=True)
+@_compiled
 def _newton(jt, m, geo, px, py, val, cx, cy, acc, jet, qjet):
     """One start's Newton climb (:func:`.newton.newton_ball`): ``(px, py, val, h, done)``, ``h`` the step the
     pattern search starts from."""
@@ -365,7 +364,7 @@ def _newton(jt, m, geo, px, py, val, cx, cy, acc, jet, qjet):
     return px, py, val, spacing, False
 
 
-@njit(cache=True)
+@_compiled
 def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
     """Pattern search from one start: the best contact height found.
 
@@ -384,8 +383,9 @@ def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
         erx, ery = (_HALF, _HALF) if norm <= stop else (ox / norm, oy / norm)
         for d in range(8):  # along +x, -x, +y, -y, then along and against the radius, then across it
             a, b, sign = _STEPS[d]
-            ux, uy = (a, b) if d < 4 else ((erx * sign, ery * sign) if d < 6 else (-ery * sign, erx * sign))
-            qx[d], qy[d], q2[d] = _project(px + h * ux, py + h * uy, cx, cy, geo)
+            qx[d], qy[d] = (a, b) if d < 4 else ((erx * sign, ery * sign) if d < 6 else (-ery * sign, erx * sign))
+        for d in range(8):  # the steps' projections in a loop of their own: a SIMD lane each
+            qx[d], qy[d], q2[d] = _project(px + h * qx[d], py + h * qy[d], cx, cy, geo)
         _heights(c, geo, qx, qy, q2, 8, qv, work)
         j, worst = 0, 0.0
         for d in range(8):
@@ -405,7 +405,7 @@ def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
     return val
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton):
     """Drop-cutter values (tip heights, no margin) at the tool positions ``cx, cy``.
 
@@ -441,7 +441,7 @@ def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton)
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def newton_starts(jc, m, geo, px, py, val, cx, cy, h, done):
     """:func:`_newton` from each start, in place; the search's steps and whether Newton converged into ``h, done``."""
     acc, jet, qjet = np.empty(6 * m), np.empty(6), np.empty(6)
