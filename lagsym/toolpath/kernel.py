@@ -250,7 +250,7 @@ def _ranked(val, moved, nb, nearest, nlat, rank, top, many):
         rank[k] = 2 if higher > val[k] else (1 if moved[k] else 0)
     for r in range(nrim):
         k = nlat + r
-        peak = val[k] >= val[nlat + (r - 1) % nrim] and val[k] >= val[nlat + (r + 1) % nrim] \
+        peak = val[k] >= val[k - 1 if r > 0 else k + nrim - 1] and val[k] >= val[k + 1 if r + 1 < nrim else nlat] \
             and val[k] >= val[nearest[r]]
         rank[k] = 2 if not peak else (1 if moved[k] else 0)
     for k in range(nlat + nrim, w):
