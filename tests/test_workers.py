@@ -117,3 +117,26 @@ def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
         "            z = drop_cutter(s, [2.0] * 600, [3.0] * 600, 0.15, evaluator=ev, workers=w)\n"
         "print(w.processes)\n", tmp_path, stderr=True)
     assert out.split() == ["2"] and err == "", err[-2000:]
+
+
+def test_a_chunk_reaches_the_kernel_as_a_worker_receives_it(monkeypatch):
+    # Numba compiles one version of the kernel per kind of argument (a read-only array is another kind):
+    # the arguments of a chunk computed here must be of the kinds a worker unpickles, or the workers compile
+    # a version of their own in every plan after an install.
+    import pickle
+
+    import numba
+
+    from lagsym.toolpath import drop_cutter, kernel
+
+    seen = []
+    monkeypatch.setattr(kernel, "drop_chunk", lambda *args: seen.append(args) or np.zeros(len(args[3])))
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    for shape, corner in (("ball", None), ("flat", None), ("bull", 0.05)):
+        drop_cutter(surface, np.linspace(1, 5, 9), 3.0, 0.15, shape, corner=corner)
+    assert len(seen) == 3
+    for args in seen:
+        here = [numba.typeof(a) for a in args]
+        # What a worker receives is a pickled task; the evaluator's coefficients it inherits by the fork.
+        there = here[:1] + [numba.typeof(pickle.loads(pickle.dumps(a))) for a in args[1:]]
+        assert here == there

@@ -229,5 +229,8 @@ def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):
     c = np.ascontiguousarray(ev.coefficients, dtype=float)
     jet = jet_coefficients(ev) if ball else np.zeros((6 * c.shape[1], c.shape[0]))
     geo = kernel_geometry(ev, ev.bounds, radius, corner, spacing, settle)
-    return drop_chunk(c, jet, geo, np.ascontiguousarray(cx, dtype=float), np.ascontiguousarray(cy, dtype=float),
-                      *lattice, int(starts), ball)
+    # Writable arrays everywhere, as a worker process receives them: Numba compiles one version per kind of array,
+    # and a read-only lattice here would leave the workers to compile their own.
+    lattice = [np.require(a, requirements="W") for a in lattice]
+    cx, cy = np.require(cx, float, "CW"), np.require(cy, float, "CW")
+    return drop_chunk(c, jet, geo, cx, cy, *lattice, int(starts), ball)

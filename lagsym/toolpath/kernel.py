@@ -32,9 +32,10 @@ _STEPS = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0), 
 _ROUNDS = 12  # Newton steps at most
 _EDGE_POINTS = 16  # four box corners, and three points on each of the four edges
 _compiled = njit(cache=True, error_model="numpy")  # no zero check before each division: no divisor here is 0
+_inline = njit(cache=True, error_model="numpy", inline="always")  # copied into each caller: constants propagate
 
 
-@_compiled
+@_inline
 def _values(c, geo, xs, ys, count, out, work):
     """``F`` at the first ``count`` points ``xs, ys`` into ``out``, summed in the order of
     :meth:`~lagsym.evaluate.SurfaceEvaluator.fast_points`; ``work``: ``n + m + 1`` rows of scratch."""
@@ -55,7 +56,7 @@ def _values(c, geo, xs, ys, count, out, work):
             out[k] += w[k] * by[j, k]
 
 
-@_compiled
+@_inline
 def _basis(rows, vs, offset, scale, count):
     """Chebyshev polynomials at the first ``count`` points ``vs`` (then normalized), a row each, by their recurrence."""
     for k in range(count):
@@ -68,7 +69,7 @@ def _basis(rows, vs, offset, scale, count):
             rows[i, k] = 2.0 * rows[1, k] * rows[i - 1, k] - rows[i - 2, k]
 
 
-@_compiled
+@_inline
 def _jet(jt, m, geo, x, y, acc, out):
     """``F, F_x, F_y, F_xx, F_xy, F_yy`` at ``(x, y)`` into ``out`` (``jt`` the stacked coefficients transposed,
     ``(n, 6 m)``)."""
@@ -94,12 +95,12 @@ def _jet(jt, m, geo, x, y, acc, out):
             out[q] += acc[q * m + k] * tk
 
 
-@_compiled
+@_inline
 def _clip(v, lo, hi):
     return min(max(v, lo), hi)
 
 
-@_compiled
+@_inline
 def _project(px, py, cx, cy, geo):
     """A candidate moved into the box, then into the disc: towards the axis where the box holds it, else along
     the line to the box point nearest the axis; ``(x, y, d2)``, ``d2`` the squared distance from the axis.
@@ -172,10 +173,9 @@ def _candidates(c, geo, cx, cy, offsets, reach2, val, px, py, d2, moved, work):
     _heights(c, geo, px, py, d2, k_all + _EDGE_POINTS, val, work)
 
 
-@_compiled
+@_inline
 def _heights(c, geo, xs, ys, d2, count, out, work):
-    """Tip heights of the tool in contact at the first ``count`` points, ``d2`` their squared distances from the
-    axis; into ``out``."""
+    """Tip heights of the tool in contact at the first ``count`` points (``d2``: squared distances from the axis)."""
     _values(c, geo, xs, ys, count, out, work)
     radius, corner = geo[8], geo[9]
     if corner <= 0.0:
@@ -291,7 +291,7 @@ def _insert(val, top, first, count, many, k):
     return count + 1
 
 
-@_compiled
+@_inline
 def _newton_step(jet, px, py, cx, cy, geo):
     """The Newton step of the contact height at ``p``, a coordinate held at a box edge the gradient points out of:
     ``(sx, sy, ok, flat, gain)``, ``ok`` the Hessian negative definite, ``flat`` its eigenvalue nearest 0."""
@@ -319,7 +319,7 @@ def _newton_step(jet, px, py, cx, cy, geo):
     return sx, sy, ok, flat, 0.5 * (gx * sx + gy * sy)
 
 
-@_compiled
+@_inline
 def _contact(jt, m, geo, qx, qy, cx, cy, acc, out):
     """The jet at ``q`` into ``out`` and the ball's tip height in contact there."""
     _jet(jt, m, geo, qx, qy, acc, out)
