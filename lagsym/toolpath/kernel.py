@@ -43,17 +43,13 @@ def _values(c, geo, xs, ys, count, out, work):
     bx, by, w = work[:n], work[n:n + m], work[n + m]
     _basis(bx, xs, geo[0], geo[1], count)
     _basis(by, ys, geo[2], geo[3], count)
-    for k in range(count):
-        out[k] = 0.0
-    for j in range(m):
-        for k in range(count):
-            w[k] = 0.0
+    for j in range(m):  # the sums start from 0.0 (not from their first term: -0.0 + 0.0 is 0.0) in no pass of their own
         for i in range(n):
             cij = c[i, j]
             for k in range(count):
-                w[k] += cij * bx[i, k]
+                w[k] = (w[k] if i else 0.0) + cij * bx[i, k]
         for k in range(count):
-            out[k] += w[k] * by[j, k]
+            out[k] = (out[k] if j else 0.0) + w[k] * by[j, k]
 
 
 @_inline
