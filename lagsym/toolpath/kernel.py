@@ -367,7 +367,8 @@ def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
     Eight steps a round from ``h``, halved where none climbs or the projection
     shortened the climb to a creep, down to ``1e-9`` of the radius or until no
     neighbour differs by the settling threshold; with ``poll`` (Newton
-    converged) until a first round does not climb.
+    converged) until a first round does not climb or a creep gains less than a
+    hundredth of that threshold.
     """
     settle = geo[11]
     stop = geo[8] * 1e-9
@@ -390,10 +391,10 @@ def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
             if math.isfinite(qv[d]):
                 worst = max(worst, abs(qv[d] - val))
         if qv[j] > val:
-            creep = math.hypot(qx[j] - px, qy[j] - py) < 0.25 * h
+            creep, gain = math.hypot(qx[j] - px, qy[j] - py) < 0.25 * h, qv[j] - val
             px, py, val = qx[j], qy[j], qv[j]
-            if creep:
-                h *= 0.5
+            if creep:  # the box or the rim cut the step short: after Newton, settled where it gained next to nothing
+                h = 0.5 * h if gain >= 0.01 * settle or not poll else 0.0
         else:
             h *= 0.5
             if worst < settle or (rnd == 0 and poll):
