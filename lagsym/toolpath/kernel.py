@@ -43,7 +43,7 @@ def _values(c, geo, xs, ys, count, out, work):
     bx, by, w = work[:n], work[n:n + m], work[n + m]
     _basis(bx, xs, geo[0], geo[1], count)
     _basis(by, ys, geo[2], geo[3], count)
-    for j in range(m):  # the sums start from 0.0 (not from their first term: -0.0 + 0.0 is 0.0) in no pass of their own
+    for j in range(m):  # each sum starts from 0.0 (0.0 + -0.0 is 0.0), within its first term's pass
         for i in range(n):
             cij = c[i, j]
             for k in range(count):
