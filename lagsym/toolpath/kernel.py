@@ -33,6 +33,7 @@ _ROUNDS = 12  # Newton steps at most
 _EDGE_POINTS = 16  # four box corners, and three points on each of the four edges
 _compiled = njit(cache=True, error_model="numpy")  # no zero check before each division: no divisor here is 0
 _inline = njit(cache=True, error_model="numpy", inline="always")  # copied into each caller: constants propagate
+_entry = njit(cache=True, nogil=True, error_model="numpy")  # called from Python: threads may run it side by side
 
 
 @_inline
@@ -150,8 +151,9 @@ def _candidates(c, geo, cx, cy, offsets, reach2, val, px, py, d2, moved, work):
     edge = not beyond and (cx - radius < x0 or cx + radius > x1 or cy - radius < y0 or cy + radius > y1)
     k_all = offsets.shape[0]
     for k in range(k_all if beyond else 0):  # a loop of its own: a SIMD lane a point
-        px[k], py[k], d2[k] = _project(cx + offsets[k, 0], cy + offsets[k, 1], cx, cy, geo)
-        moved[k] = px[k] != cx + offsets[k, 0] or py[k] != cy + offsets[k, 1]
+        ox, oy = cx + offsets[k, 0], cy + offsets[k, 1]
+        px[k], py[k], d2[k] = _project(ox, oy, cx, cy, geo)
+        moved[k] = px[k] != ox or py[k] != oy
     for k in range(k_all if beyond else 0, k_all):
         ox, oy = cx + offsets[k, 0], cy + offsets[k, 1]
         if edge:
@@ -402,7 +404,7 @@ def _refine(c, geo, px, py, val, cx, cy, h, poll, work, qx, qy, q2, qv):
     return val
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@_entry
 def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton):
     """Drop-cutter values (tip heights, no margin) at the tool positions ``cx, cy``.
 
@@ -438,7 +440,7 @@ def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton)
     return out
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@_entry
 def newton_starts(jc, m, geo, px, py, val, cx, cy, h, done):
     """:func:`_newton` from each start, in place; the search's steps and whether Newton converged into ``h, done``."""
     acc, jet, qjet = np.empty(6 * m), np.empty(6), np.empty(6)
