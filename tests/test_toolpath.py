@@ -64,6 +64,8 @@ def test_point_tool_path_lies_on_the_surface(example4):
 @given(surfaces(), st.floats(0.5, 8.0), st.sampled_from(["ball", "flat"]), st.floats(0.005, 0.2),
        st.sampled_from(["x", "y"]))
 @example(big_ball_surface(), 7.375, "ball", 0.125, "x")
+@example(lagrange_surface(grid_from_table([0, 2, 4], [0, Fraction(3, 2)], [[0, 0], [0, -1], [0, 1]])), 5.25, "flat",
+         0.005859375, "y")  # the rim leaves the corner (20, 7.5) mm from an axis beyond the box in y only
 def test_planned_points_between_exact_value_and_tolerance_above(surf, diameter, shape, tol, direction):
     tp = plan(surf, tool=Tool(shape, diameter), raster=RasterSpec(direction, 3.0, None, None, tol), scale=5.0)
     p = tp.points_mm
@@ -75,11 +77,13 @@ def test_planned_points_between_exact_value_and_tolerance_above(surf, diameter, 
     beyond_x = np.maximum(np.maximum(x0 - p[:, 0], p[:, 0] - x1), 0)
     beyond_y = np.maximum(np.maximum(y0 - p[:, 1], p[:, 1] - y1), 0)
     assert np.all(np.hypot(beyond_x, beyond_y) <= diameter / 2 + 1e-9)
-    # More than the tolerance above only where the page says: a flat end beyond a box corner, whose rim leaves
-    # the corner and whose height falls by more than the tolerance within one unit of the last decimal, so
-    # that the move cannot be split further; there the point is lifted by the dip found, and no more.
+    # More than the tolerance above only where the page says: a flat end beyond the box whose rim leaves a box
+    # corner, so that its height falls by more than the tolerance within one unit of the last decimal and the
+    # move cannot be split further; there the point is lifted by the dip found, and no more.
     assert not over.any() or shape == "flat"
-    assert np.all((beyond_x[over] > 0) & (beyond_y[over] > 0))
+    corner = np.min([np.hypot(p[over, 0] - cx, p[over, 1] - cy) for cx in (x0, x1) for cy in (y0, y1)], axis=0)
+    assert np.all(np.maximum(beyond_x[over], beyond_y[over]) > 0)
+    assert np.all(np.abs(corner - diameter / 2) <= 0.01)  # the rim at the corner, within ten units of 0.001 mm
     assert np.all(p[over, 2] <= exact[over] + tp.lift_mm[over] + 1e-4)
 
 
