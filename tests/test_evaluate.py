@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
+import sys
 from fractions import Fraction
 
 import numpy as np
@@ -14,6 +16,8 @@ from hypothesis import strategies as st
 from conftest import EXAMPLES
 from lagsym.conditioning import check_surface, float_error_bound
 from lagsym.evaluate import (
+    COMPILED_POINTS,
+    chebyshev_basis,
     chebyshev_matrix,
     chebyshev_transform,
     evaluate_curve,
@@ -190,6 +194,61 @@ def test_scattered_points_in_chunks_match_one_block():
     rng = np.random.default_rng(0)
     x, y = rng.uniform(1, 5, 1000), rng.uniform(1, 5, 1000)
     assert np.array_equal(ev.points(x, y, chunk=64), ev.points(x, y, chunk=4096))
+
+
+@pytest.mark.parametrize("offset, scale, lo, hi", [
+    (3.0, 2.0, 1.0, 5.0), (3.0, 3.0, -1.0, 7.0), (0.7, 1.3, -0.6, 2.0), (12.345, 0.1, 12.2, 12.5), (-40.0, 7.0, -48, -30),
+])
+def test_the_compensated_basis_is_the_exact_value_rounded_once(offset, scale, lo, hi):
+    x = np.random.default_rng(7).uniform(lo, hi, 300)
+    x[:3] = lo, hi, offset
+    got = chebyshev_basis(x, offset, scale, 12)
+    wrong = 0
+    for i, v in enumerate(x.tolist()):
+        s = (Fraction(v) - Fraction(offset)) / Fraction(scale)
+        t = [Fraction(1), s]
+        for _ in range(10):
+            t.append(2 * s * t[-1] - t[-2])
+        wrong += sum(got[k, i] != float(t[k]) for k in range(12))  # float(Fraction) rounds correctly
+    assert wrong == 0
+
+
+@pytest.mark.parametrize("shape, spread", [((5, 5), 0.25), ((7, 3), 1.5), ((2, 9), 0.0), ((14, 11), 0.1)])
+def test_a_large_batch_runs_compiled_with_the_bits_of_small_ones(shape, spread):
+    rng = np.random.default_rng(shape[0])
+    n, m = shape
+    xs = np.cumsum(rng.uniform(0.5, 2.0, n)) - 3.3
+    ys = np.cumsum(rng.uniform(0.2, 1.0, m)) + 17.1
+    zs = rng.normal(size=(n, m)).round(3)
+    surface = lagrange_surface(grid_from_table([Fraction(v).limit_denominator(1000) for v in xs],
+                                               [Fraction(v).limit_denominator(1000) for v in ys],
+                                               [[Fraction(v).limit_denominator(1000) for v in row] for row in zs]))
+    ev = surface_evaluator(surface)
+    x0, x1, y0, y1 = ev.bounds
+    k = COMPILED_POINTS + 1001  # the kernel, in two threads where there are two cores
+    x = rng.uniform(x0 - spread * (x1 - x0), x1 + spread * (x1 - x0), k)
+    y = rng.uniform(y0 - spread * (y1 - y0), y1 + spread * (y1 - y0), k)
+    x[:200], y[:200] = rng.choice(ev.x_nodes, 200), rng.choice(ev.y_nodes, 200)  # control points: snapped
+    x[200] = y[201] = np.nan
+    whole = ev.points(x, y)
+    pieces = np.concatenate([ev.points(x[i:i + 50_000], y[i:i + 50_000]) for i in range(0, k, 50_000)])
+    assert np.array_equal(whole, pieces, equal_nan=True)
+    assert np.isnan(whole[200:202]).all() and not np.isnan(whole[202:]).any()
+    exact_nodes = (ev.x_exact[np.searchsorted(ev.x_nodes, x[:200])] & ev.y_exact[np.searchsorted(ev.y_nodes, y[:200])])
+    hits = np.flatnonzero(exact_nodes)
+    assert whole[hits].tolist() == ev.node_values[np.searchsorted(ev.x_nodes, x[hits]),
+                                                  np.searchsorted(ev.y_nodes, y[hits])].tolist()
+    box = (min(x0, x[202:].min()), max(x1, x[202:].max()), min(y0, y[202:].min()), max(y1, y[202:].max()))
+    assert _error(surface, x[202:1202], y[202:1202], whole[202:1202]) <= ev.error_bound(box)
+
+
+def test_a_small_batch_does_not_load_the_compiler():
+    code = ("import sys, numpy as np; from lagsym import lagrange_surface, read_points, evaluate_points; "
+            f"s = lagrange_surface(read_points({str(EXAMPLES / 'paper-example-4.json')!r})); "
+            "evaluate_points(s, np.linspace(1, 5, 100_000), 2.5); print('numba' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
 
 
 def test_curves_agree_with_exact_evaluation():

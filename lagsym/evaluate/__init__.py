@@ -1,4 +1,4 @@
-"""Fast, numerically stable evaluation of Lagrange curves and surfaces (pure NumPy).
+"""Fast, numerically stable evaluation of Lagrange curves and surfaces (NumPy; a compiled kernel for large batches).
 
 Nothing here evaluates the expanded power-basis polynomial: with many nodes
 that loses digits (about 1e-3 absolute at 10x10 nodes over a 0-100 mm box).
@@ -19,7 +19,10 @@ bound for a given box.
 
 The modules, one concern each:
 
-* :mod:`.chebyshev`: the exact change of basis and the basis values;
+* :mod:`.chebyshev`: the exact change of basis and the basis values (the
+  compensated recurrence, each value rounded once);
+* :mod:`.compiled`: the same arithmetic for a large batch of scattered points,
+  compiled (Numba), loaded only for such a batch;
 * :mod:`.surface`: :class:`SurfaceEvaluator`, values on grids and at points,
   partial derivatives and the curvature bound (what drop-cutter needs);
 * :mod:`.curve`: :class:`CurveEvaluator`, the 1-D case;
@@ -37,11 +40,12 @@ from __future__ import annotations
 
 from .barycentric import barycentric_weights, basis_matrix, lebesgue_constant, normalize
 from .bounds import EPS, EPS_BASIS
-from .chebyshev import chebyshev_matrix, chebyshev_matrix_float64, chebyshev_transform
+from .chebyshev import chebyshev_basis, chebyshev_matrix, chebyshev_matrix_float64, chebyshev_transform
 from .curve import CurveEvaluator, curve_evaluator, evaluate_curve
 from .power import PARTIALS, lambdify_surface, power_partials
 from .surface import (
     CHUNK_POINTS,
+    COMPILED_POINTS,
     FAST_CHUNK_POINTS,
     SurfaceEvaluator,
     evaluate_grid,
@@ -51,6 +55,7 @@ from .surface import (
 
 __all__ = [
     "CHUNK_POINTS",
+    "COMPILED_POINTS",
     "FAST_CHUNK_POINTS",
     "EPS",
     "EPS_BASIS",
@@ -59,6 +64,7 @@ __all__ = [
     "CurveEvaluator",
     "surface_evaluator",
     "curve_evaluator",
+    "chebyshev_basis",
     "chebyshev_matrix",
     "chebyshev_matrix_float64",
     "chebyshev_transform",

@@ -15,7 +15,12 @@ from .chebyshev import chebyshev_matrix
 __all__ = ["EPS", "EPS_BASIS", "chebyshev_error_bound"]
 
 EPS = float(np.finfo(float).eps)
-EPS_BASIS = float(np.finfo(np.longdouble).eps)  # the basis recurrence runs in longdouble
+EPS_BASIS = 2.0**-63
+"""The unit the basis's own rounding is counted in.  The compensated recurrence
+(:class:`.chebyshev.CompensatedBasis`) carries its rounding errors, so before
+its one rounding to float64 a value is within a few units of ``2**-100`` of
+the exact one; counting ``2**-63`` (x86's ``longdouble``, which the basis once
+ran in) leaves a margin of some ten orders of magnitude."""
 
 
 def _cheb_growth(n: int, smax: float) -> np.ndarray:
@@ -24,7 +29,7 @@ def _cheb_growth(n: int, smax: float) -> np.ndarray:
 
 
 def _axis_error(n: int, smax: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per-degree size ``|T_k|`` and rounding weight (in units of ``longdouble`` rounding) for one axis.
+    """Per-degree size ``|T_k|`` and rounding weight (in units of :data:`EPS_BASIS`) for one axis.
 
     The weight counts the recurrence (at most ``k**2`` units) and the
     rounding of ``s`` itself (``|ds| <= 2 u |s|``) carried through the slope
@@ -40,8 +45,8 @@ def chebyshev_error_bound(coefficients: np.ndarray, sx: float, sy: float) -> flo
 
     ``sum |C[a, b]| |T_a| |T_b|`` times ``n + m + 2`` units of float64
     rounding (the coefficients, the basis values and the two matrix
-    products) plus ``a**2 + b**2`` units of the basis's ``longdouble``
-    rounding (recurrence and normalization).
+    products) plus ``a**2 + b**2`` units of :data:`EPS_BASIS` for the basis's
+    own rounding (recurrence and normalization).
     """
     n, m = coefficients.shape
     gx, wx = _axis_error(n, sx)

@@ -2,9 +2,10 @@
 
 An axis is mapped affinely onto ``s`` in about ``[-1, 1]`` and the exact
 power-basis polynomial is re-expressed, exactly, in the Chebyshev polynomials
-``T_k(s)``; only the result is rounded.  :func:`chebyshev_matrix` (long
-double, for sampling) and :func:`chebyshev_matrix_float64` (for the many small
-evaluations of a search) give the basis values at points.
+``T_k(s)``; only the result is rounded.  :func:`chebyshev_basis` (compensated,
+each value rounded once, for sampling) and :func:`chebyshev_matrix_float64`
+(the plain recurrence, for the many small evaluations of a search) give the
+basis values at points.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from math import comb
 import flint
 import numpy as np
 
-__all__ = ["chebyshev_transform", "chebyshev_matrix", "chebyshev_matrix_float64", "data_range"]
+__all__ = ["SPLIT", "CompensatedBasis", "chebyshev_transform", "chebyshev_basis", "chebyshev_matrix",
+           "chebyshev_matrix_float64", "data_range", "split"]
 
 
 def fmpq(v: Fraction) -> flint.fmpq:
@@ -69,34 +71,143 @@ def chebyshev_transform(nodes) -> tuple[float, float, flint.fmpq_mat]:
     return offset, scale, cheb.solve(shift)
 
 
-def chebyshev_matrix(s, n: int, out: np.ndarray | None = None) -> np.ndarray:
-    """``T_k(s)`` for ``k < n`` by the three-term recurrence, as an ``(n, len(s))`` float array.
+SPLIT = 134217729.0
+"""``2**27 + 1``: Veltkamp's constant, which splits a float64 into two halves of 26 bits whose products are exact."""
 
-    The recurrence runs in ``numpy.longdouble`` (64-bit mantissa on x86)
-    and is rounded once to float64, so the basis values carry half a unit
-    of rounding; where ``longdouble`` is plain float64 the bound of
-    :meth:`SurfaceEvaluator.error_bound` accounts for it.
+
+def split(v: float) -> tuple[float, float]:
+    """``v = hi + lo`` with ``hi`` holding the upper 26 bits of ``v`` (Veltkamp's split of a scalar)."""
+    c = SPLIT * v
+    hi = c - (c - v)
+    return hi, v - hi
+
+
+class CompensatedBasis:
+    """The Chebyshev basis at many points, compensated, with its scratch space reused from block to block.
+
+    ``T_k((x - offset) / scale)`` for ``k < n``: ``s`` is formed as an
+    unevaluated sum ``sh + sl`` (the subtraction's and the division's rounding
+    errors recovered exactly), and the three-term recurrence ``T_k = 2 s T_{k-1}
+    - T_{k-2}`` runs in float64 while the rounding error of every product and
+    sum is recovered exactly (Dekker's product by Veltkamp's split, Knuth's
+    sum) and carried in a second recurrence.  Each value is then rounded once:
+    the result is as if the recurrence had run in about twice float64's
+    precision (Ogita, Rump and Oishi's compensated algorithms).  Every
+    operation is an elementwise float64 one, vectorized by NumPy, in the order
+    :mod:`.compiled` runs it, so both give the same bits.
+    """
+
+    def __init__(self, size: int, degree: int):
+        self.w = np.empty((10, size))
+        self.u = np.empty((max(degree, 2), size))
+        self.e = np.empty((max(degree, 2), size))
+
+    def basis(self, x: np.ndarray, offset: float, scale: float, n: int, out: np.ndarray) -> np.ndarray:
+        """``T_k((x - offset) / scale)`` for ``k < n`` into ``out[:, :len(x)]``; ``x`` is float64."""
+        k = x.size
+        d, b, dl, sh, shi, slo, p, pe, t1, t2 = self.w[:, :k]
+        out = out[:, :k]
+        o, h = float(offset), float(scale)
+        hhi, hlo = split(h)
+        # s = sh + sl: x - offset by Knuth's two-sum, then the division's remainder by Dekker's product
+        np.subtract(x, o, out=d)
+        np.subtract(d, x, out=b)
+        np.subtract(d, b, out=t1)
+        np.subtract(x, t1, out=t1)
+        np.subtract(-o, b, out=dl)
+        dl += t1
+        np.divide(d, h, out=sh)
+        self._split(sh, shi, slo, t1)
+        np.multiply(sh, h, out=p)
+        self._product_error(shi, slo, hhi, hlo, p, pe, t1)
+        sl = self.e[1, :k]
+        np.subtract(d, p, out=sl)
+        sl -= pe
+        sl += dl
+        sl /= h
+        out[0] = 1.0
+        if n < 2:
+            return out
+        np.add(sh, sl, out=out[1])
+        u, e = self.u[:, :k], self.e[:, :k]
+        u[0], e[0], u[1] = 1.0, 0.0, sh
+        for j in range(2, n):
+            # p + pe = sh * u[j-1] exactly
+            np.multiply(u[j - 1], sh, out=p)
+            self._split(u[j - 1], d, b, t1)
+            self._product_error(shi, slo, d, b, p, pe, t1)
+            # u[j] + sigma = 2 p - u[j-2] exactly (p + p is exact)
+            np.add(p, p, out=d)
+            np.subtract(d, u[j - 2], out=u[j])
+            np.subtract(u[j], d, out=b)
+            np.subtract(u[j], b, out=t1)
+            np.subtract(d, t1, out=t1)
+            np.add(u[j - 2], b, out=t2)
+            np.subtract(t1, t2, out=e[j])
+            # e[j] = sigma + (2 (sh e[j-1] + sl u[j-1] + pe) - e[j-2])
+            np.multiply(sh, e[j - 1], out=t1)
+            np.multiply(sl, u[j - 1], out=t2)
+            t1 += t2
+            t1 += pe
+            t1 += t1
+            t1 -= e[j - 2]
+            e[j] += t1
+            np.add(u[j], e[j], out=out[j])
+        return out
+
+    @staticmethod
+    def _split(v, hi, lo, c) -> None:
+        """``v = hi + lo`` elementwise, Veltkamp's split."""
+        np.multiply(v, SPLIT, out=c)
+        np.subtract(c, v, out=hi)
+        np.subtract(c, hi, out=hi)
+        np.subtract(v, hi, out=lo)
+
+    @staticmethod
+    def _product_error(ahi, alo, bhi, blo, p, out, t) -> None:
+        """``out = a b - p`` exactly for ``p = fl(a b)``: Dekker's product from the two splits."""
+        np.multiply(ahi, bhi, out=out)
+        out -= p
+        np.multiply(ahi, blo, out=t)
+        out += t
+        np.multiply(alo, bhi, out=t)
+        out += t
+        np.multiply(alo, blo, out=t)
+        out += t
+
+
+def chebyshev_basis(x, offset: float, scale: float, n: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``T_k((x - offset) / scale)`` for ``k < n``, as an ``(n, len(x))`` float64 array, each value rounded once.
+
+    The compensated recurrence of :class:`CompensatedBasis`: the normalization
+    and the recurrence carry their rounding errors exactly, so each value is
+    the exact ``T_k`` of the exact ``(x - offset) / scale`` within a few units of
+    ``2**-100`` before its one rounding to float64 (in practice rounded
+    correctly).  The same in float64 on every platform; no ``longdouble``.
+
+    Examples
+    --------
+    >>> chebyshev_basis(np.array([2.0, 3.0]), 2.0, 2.0, 3).tolist()
+    [[1.0, 1.0], [0.0, 0.5], [-1.0, -0.5]]
+    """
+    x = np.asarray(x, dtype=float).ravel()
+    out = np.empty((n, x.size)) if out is None else out
+    if x.size:
+        CompensatedBasis(x.size, n).basis(x, offset, scale, n, out)
+    return out[:, : x.size]
+
+
+def chebyshev_matrix(s, n: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``T_k(s)`` for ``k < n`` by the compensated three-term recurrence, as an ``(n, len(s))`` float array.
+
+    :func:`chebyshev_basis` with ``s`` already normalized.
 
     Examples
     --------
     >>> chebyshev_matrix(np.array([0.5, 1.0]), 3).tolist()
     [[1.0, 1.0], [0.5, 1.0], [-0.5, 1.0]]
     """
-    s = np.asarray(s).ravel().astype(np.longdouble, copy=False)
-    v = np.empty((n, s.size), dtype=np.longdouble)
-    v[0] = 1.0
-    if n > 1:
-        v[1] = s
-    if n > 2:
-        s2 = 2.0 * s
-        for k in range(2, n):
-            np.multiply(s2, v[k - 1], out=v[k])
-            v[k] -= v[k - 2]
-    if out is None:
-        return v.astype(float)
-    out = out[:, : s.size]
-    out[...] = v
-    return out
+    return chebyshev_basis(s, 0.0, 1.0, n, out)
 
 
 def chebyshev_matrix_float64(s, n: int) -> np.ndarray:

@@ -9,7 +9,7 @@ import flint
 import numpy as np
 
 from .._arrays import readonly as _readonly
-from .chebyshev import chebyshev_matrix, chebyshev_transform, data_range, fmpq, fraction
+from .chebyshev import chebyshev_basis, chebyshev_transform, data_range, fmpq, fraction
 
 __all__ = ["CurveEvaluator", "curve_evaluator", "evaluate_curve"]
 
@@ -26,8 +26,8 @@ class CurveEvaluator:
     def __call__(self, x) -> np.ndarray:
         """``F(x)`` for ``x`` of any shape."""
         x = np.asarray(x, dtype=float)
-        s = (x.astype(np.longdouble) - self.offset) / np.longdouble(self.scale)
-        return (self.coefficients @ chebyshev_matrix(s, len(self.coefficients))).reshape(x.shape)
+        basis = chebyshev_basis(x, self.offset, self.scale, len(self.coefficients))
+        return (self.coefficients @ basis).reshape(x.shape)
 
 
 _CURVES: dict[int, CurveEvaluator] = {}

@@ -4,8 +4,10 @@
 the control box onto ``[-1, 1]**2``.  On a grid this is the tensor product
 ``Z = Tx.T @ C @ Ty`` of two small Chebyshev basis matrices; at scattered
 points it is a row-wise contraction.  Sampling (:meth:`SurfaceEvaluator.grid`,
-:meth:`SurfaceEvaluator.points`) runs the basis recurrence in long double and
-passes through the control points exactly; a search that evaluates many small
+:meth:`SurfaceEvaluator.points`) runs the compensated basis recurrence, each
+value rounded once, and passes through the control points exactly; a large
+batch of scattered points runs it compiled (:mod:`.compiled`), with the same
+bits; a search that evaluates many small
 batches (drop-cutter) uses :meth:`SurfaceEvaluator.fast_points`, float64
 throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
 """
@@ -24,24 +26,34 @@ from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
 from .threads import parts, run_parts
 from .chebyshev import (
-    chebyshev_matrix,
+    CompensatedBasis,
+    chebyshev_basis,
     chebyshev_matrix_float64,
     chebyshev_transform,
     data_range,
     fmpq,
     fraction,
+    split,
 )
 
-__all__ = ["CHUNK_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
+__all__ = ["CHUNK_POINTS", "COMPILED_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
            "evaluate_grid"]
 
-CHUNK_POINTS = 1 << 13  # scattered points are evaluated in blocks of this many: their long-double basis stays in cache
+CHUNK_POINTS = 1 << 13  # NumPy evaluates scattered points in blocks of this many: their scratch stays in cache
+COMPILED_POINTS = 1 << 18  # from this many scattered points on, the compiled kernel (whose loading costs ~0.4 s once)
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
 # Multiply-adds in one block of a grid product: its rows are computed in cache and written once, and it
 # is the largest size OpenBLAS runs in one thread (65536 * 4 = 262144; above it, it splits the product
 # between threads).  Each BLAS call costs a few microseconds however small: blocks of 20 rows of a
 # 2000-point grid took 3-4 % longer than blocks of 26 (min of 61 runs).
 PRODUCT_BLOCK = 262_144
+
+
+def _readonly_view(a: np.ndarray) -> np.ndarray:
+    """``a`` seen read-only, so the compiled kernel has one version whatever the caller's arrays."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
 
 def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -71,43 +83,6 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -
 
     run_parts(work, parts(n, ty.shape[1], rows))
     return out
-
-
-class _BasisWork:
-    """Long-double scratch space for :meth:`SurfaceEvaluator.points`, reused from block to block."""
-
-    def __init__(self, size: int, degree: int):
-        self.s = np.empty(size, dtype=np.longdouble)
-        self.s2 = np.empty(size, dtype=np.longdouble)
-        self.v = np.empty((max(degree, 3), size), dtype=np.longdouble)
-
-    def basis(self, x: np.ndarray, offset: float, scale: float, n: int, out: np.ndarray) -> np.ndarray:
-        """``T_k((x - offset) / scale)`` for ``k < n`` into ``out[:, :len(x)]``: :func:`chebyshev_matrix`'s arithmetic.
-
-        Long-double operations are the cost here (NumPy does not vectorize them), so
-        ``T_0 = 1`` and ``T_1 = s`` are not copied and the recurrence starts from them.
-        """
-        k = x.size
-        s, v = self.s[:k], self.v[:, :k]
-        out = out[:, :k]
-        np.subtract(x, np.longdouble(offset), out=s)
-        np.divide(s, np.longdouble(scale), out=s)
-        out[0] = 1.0
-        if n > 1:
-            out[1] = s
-        if n > 2:
-            s2 = self.s2[:k]
-            np.multiply(2.0, s, out=s2)
-            np.multiply(s2, s, out=v[2])
-            v[2] -= 1.0
-            if n > 3:
-                np.multiply(s2, v[2], out=v[3])
-                v[3] -= s
-            for j in range(4, n):
-                np.multiply(s2, v[j - 1], out=v[j])
-                v[j] -= v[j - 2]
-            out[2:] = v[2:n]
-        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,14 +131,6 @@ class SurfaceEvaluator:
         """Number of coefficients in x and in y (nodes of the control grid)."""
         return self.coefficients.shape
 
-    def _s(self, x) -> np.ndarray:
-        x = np.asarray(x, dtype=float).astype(np.longdouble)
-        return (x - self.x_offset) / np.longdouble(self.x_scale)
-
-    def _t(self, y) -> np.ndarray:
-        y = np.asarray(y, dtype=float).astype(np.longdouble)
-        return (y - self.y_offset) / np.longdouble(self.y_scale)
-
     def x_factor(self, xs) -> np.ndarray:
         """``W = Tx.T @ C`` for the grid lines ``xs``: shape ``(len(xs), m)``.
 
@@ -171,11 +138,11 @@ class SurfaceEvaluator:
         lets a sampler compute the small factor once and stream blocks of rows.
         """
         n = self.shape[0]
-        return chebyshev_matrix(self._s(xs), n).T @ self.coefficients
+        return chebyshev_basis(xs, self.x_offset, self.x_scale, n).T @ self.coefficients
 
     def y_basis(self, ys) -> np.ndarray:
         """``Ty``: the Chebyshev basis of the grid lines ``ys``, shape ``(m, len(ys))``."""
-        return chebyshev_matrix(self._t(ys), self.shape[1])
+        return chebyshev_basis(ys, self.y_offset, self.y_scale, self.shape[1])
 
     def grid(self, xs, ys) -> np.ndarray:
         """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``.
@@ -213,34 +180,68 @@ class SurfaceEvaluator:
     def points(self, x, y, chunk: int = CHUNK_POINTS) -> np.ndarray:
         """``F(x, y)`` at scattered points; ``x`` and ``y`` broadcast together.
 
-        Works in blocks of ``chunk`` points, so memory stays a few megabytes
-        above the result whatever the number of points, and a block's basis
-        values stay in cache; many points are shared among threads
-        (:mod:`.threads`).  The arithmetic is that of :meth:`grid` (the
-        basis in long double, rounded once), so :meth:`error_bound` holds.
+        Each point's basis values come from the compensated recurrence of
+        :func:`.chebyshev.chebyshev_basis`, rounded once, and the contraction
+        ``sum_b (sum_a C[a, b] Tx[a]) Ty[b]`` adds its terms left to right, so
+        :meth:`error_bound` holds; where ``(x, y)`` is a control point exactly
+        its height is returned exactly.  A batch of :data:`COMPILED_POINTS` or
+        more runs the compiled kernel of :mod:`.compiled` (loaded on the first
+        such batch, about 0.4 s once per process); a smaller one runs the same
+        operations in NumPy, in blocks of ``chunk`` points whose scratch stays
+        in cache.  The two give the same bits, and many points are shared
+        among threads (:mod:`.threads`), so the values do not depend on the
+        batch, the block or the threads.
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
-        xf, yf = x.ravel(), y.ravel()
+        xf, yf = np.ascontiguousarray(x.ravel()), np.ascontiguousarray(y.ravel())
         out = np.empty(xf.size)
-        run_parts(lambda lo, hi: self._points_into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
+        into = self._compiled_into if xf.size >= COMPILED_POINTS else self._numpy_into
+        run_parts(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
         return out.reshape(shape)
 
-    def _points_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
-        """:meth:`points` of ``xf[start:stop], yf[start:stop]`` into ``out``, in blocks of ``chunk`` from ``start``."""
+    def _axes(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """Each axis's ``(offset, scale, scale's high half, its low half)``, as the kernels take them."""
+        return ((self.x_offset, self.x_scale, *split(self.x_scale)),
+                (self.y_offset, self.y_scale, *split(self.y_scale)))
+
+    def _compiled_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
+        """:meth:`points` of ``xf[start:stop], yf[start:stop]`` into ``out`` by the compiled kernel."""
+        from .compiled import points_kernel  # Numba loads with the first large batch, not with lagsym
+
+        xa, ya = (np.array(a) for a in self._axes())
+        points_kernel(_readonly_view(xf), _readonly_view(yf), start, stop, self.coefficients, xa, ya, out)
+        self._snap_points(out[start:stop], xf[start:stop], yf[start:stop])
+
+    def _numpy_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
+        """:meth:`points` of ``xf[start:stop], yf[start:stop]`` into ``out``, in blocks of ``chunk`` from ``start``.
+
+        The operations of :func:`.compiled.points_kernel`, a block at a time.
+        """
         n, m = self.shape
-        c = np.ascontiguousarray(self.coefficients.T)  # (m, n)
+        c = self.coefficients
         size = min(chunk, stop - start)
-        work = _BasisWork(size, max(n, m))
+        work = CompensatedBasis(size, max(n, m))
         tx, ty = np.empty((n, size)), np.empty((m, size))
+        wb, term = np.empty(size), np.empty(size)
+        (xo, xh, _, _), (yo, yh, _, _) = self._axes()
         for lo in range(start, stop, chunk):
             hi = min(lo + chunk, stop)
-            bx = work.basis(xf[lo:hi], self.x_offset, self.x_scale, n, tx)
-            by = work.basis(yf[lo:hi], self.y_offset, self.y_scale, m, ty)
-            w = c @ bx
-            w *= by
-            w.sum(axis=0, out=out[lo:hi])
-            self._snap_points(out[lo:hi], xf[lo:hi], yf[lo:hi])
+            k = hi - lo
+            bx = work.basis(xf[lo:hi], xo, xh, n, tx)
+            by = work.basis(yf[lo:hi], yo, yh, m, ty)
+            z, w, t = out[lo:hi], wb[:k], term[:k]
+            for b in range(m):
+                np.multiply(bx[0], c[0, b], out=w)
+                for a in range(1, n):
+                    np.multiply(bx[a], c[a, b], out=t)
+                    w += t
+                if b == 0:
+                    np.multiply(w, by[0], out=z)
+                else:
+                    np.multiply(w, by[b], out=t)
+                    z += t
+            self._snap_points(z, xf[lo:hi], yf[lo:hi])
 
     def _snap_points(self, out: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """Set ``out`` to the control height where ``(x, y)`` is a control point exactly; in place."""
@@ -328,8 +329,10 @@ class SurfaceEvaluator:
             Against the exact value of the polynomial at the given float
             coordinates: ``sum |C[a, b]| |T_a| |T_b|`` times ``n + m + 2``
             units of float64 rounding (the coefficients, the basis values and
-            the two matrix products) plus ``a**2 + b**2`` units of the
-            basis's ``longdouble`` rounding (recurrence and normalization).
+            the two matrix products) plus ``a**2 + b**2`` units of
+            :data:`.bounds.EPS_BASIS` for the basis's own rounding (recurrence
+            and normalization), which the compensated recurrence keeps far
+            below that.
         """
         x0, x1, y0, y1 = self.bounds if box is None else box
         sx = max(abs((x0 - self.x_offset) / self.x_scale), abs((x1 - self.x_offset) / self.x_scale))
