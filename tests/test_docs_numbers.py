@@ -313,3 +313,12 @@ def test_the_sampling_page_quotes_the_threads():
     text = page("sampling.md")
     assert MAX_THREADS == 4 and "shared among up to four threads" in text
     assert f"contiguous parts of {THREAD_POINTS:,} values or more" in text
+
+
+def test_the_pages_quote_the_compiled_threshold():
+    from lagsym.evaluate import COMPILED_POINTS
+
+    assert f"A batch of {COMPILED_POINTS:,} scattered points or more (`COMPILED_POINTS`)" in page("sampling.md")
+    assert f"a batch of {COMPILED_POINTS:,} scattered points or more" in page("architecture.md")
+    assert f"a batch of {COMPILED_POINTS:,} points or more runs it compiled" in " ".join(
+        (ROOT / "README.md").read_text().split())

@@ -1,14 +1,14 @@
 """Scattered points compiled: the arithmetic of :class:`.chebyshev.CompensatedBasis` and the contraction, fused.
 
-NumPy runs the compensated basis as some fifty passes over a block of points
-per axis, each reading and writing memory; here every point's basis and sum
+NumPy runs the compensated basis as about a hundred passes over a block of
+points per axis (at 5 nodes), each reading and writing memory; here every point's basis and sum
 stay in registers, a block of :data:`BLOCK` points at a time, in loops the
 compiler vectorizes across points.  The operations on each point are those of
 the NumPy engine in :meth:`.surface.SurfaceEvaluator.points`, one for one and
 in the same order (no fused multiply-add, no reassociation: Numba's default
 without ``fastmath``), so the two give the same bits; ``tests/test_evaluate.py``
 checks it.  This module is loaded only for a large batch (Numba's import and
-the cached kernel take about 0.4 s, once per process).
+the cached kernel take about 0.5 s, once per process).
 """
 
 from __future__ import annotations

@@ -36,11 +36,11 @@ from .chebyshev import (
     split,
 )
 
-__all__ = ["CHUNK_POINTS", "COMPILED_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator", "evaluate_points",
-           "evaluate_grid"]
+__all__ = ["CHUNK_POINTS", "COMPILED_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator",
+           "evaluate_points", "evaluate_grid"]
 
 CHUNK_POINTS = 1 << 13  # NumPy evaluates scattered points in blocks of this many: their scratch stays in cache
-COMPILED_POINTS = 1 << 18  # from this many scattered points on, the compiled kernel (whose loading costs ~0.4 s once)
+COMPILED_POINTS = 1 << 18  # from this many scattered points on, the compiled kernel (whose loading costs ~0.5 s once)
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
 # Multiply-adds in one block of a grid product: its rows are computed in cache and written once, and it
 # is the largest size OpenBLAS runs in one thread (65536 * 4 = 262144; above it, it splits the product
@@ -186,7 +186,7 @@ class SurfaceEvaluator:
         :meth:`error_bound` holds; where ``(x, y)`` is a control point exactly
         its height is returned exactly.  A batch of :data:`COMPILED_POINTS` or
         more runs the compiled kernel of :mod:`.compiled` (loaded on the first
-        such batch, about 0.4 s once per process); a smaller one runs the same
+        such batch, about 0.5 s once per process); a smaller one runs the same
         operations in NumPy, in blocks of ``chunk`` points whose scratch stays
         in cache.  The two give the same bits, and many points are shared
         among threads (:mod:`.threads`), so the values do not depend on the
