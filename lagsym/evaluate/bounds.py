@@ -18,9 +18,10 @@ EPS = float(np.finfo(float).eps)
 EPS_BASIS = 2.0**-63
 """The unit the basis's own rounding is counted in.  The compensated recurrence
 (:class:`.chebyshev.CompensatedBasis`) carries its rounding errors, so before
-its one rounding to float64 a value is within a few units of ``2**-100`` of
-the exact one; counting ``2**-63`` (x86's ``longdouble``, which the basis once
-ran in) leaves a margin of some ten orders of magnitude."""
+its one rounding to float64 a value of degree ``k`` is within about ``k**2``
+units of ``2**-106`` of the exact one; counting ``k**2`` units of ``2**-63``
+(x86's ``longdouble``, which the basis once ran in) leaves a margin of some
+twelve orders of magnitude."""
 
 
 def _cheb_growth(n: int, smax: float) -> np.ndarray:

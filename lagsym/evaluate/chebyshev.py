@@ -180,10 +180,13 @@ def chebyshev_basis(x, offset: float, scale: float, n: int, out: np.ndarray | No
     """``T_k((x - offset) / scale)`` for ``k < n``, as an ``(n, len(x))`` float64 array, each value rounded once.
 
     The compensated recurrence of :class:`CompensatedBasis`: the normalization
-    and the recurrence carry their rounding errors exactly, so each value is
-    the exact ``T_k`` of the exact ``(x - offset) / scale`` within a few units of
-    ``2**-100`` before its one rounding to float64 (in practice rounded
-    correctly).  The same in float64 on every platform; no ``longdouble``.
+    and the recurrence carry their rounding errors exactly, so before its one
+    rounding to float64 each value is the exact ``T_k`` of the exact
+    ``(x - offset) / scale`` within about ``k**2`` units of ``2**-106`` (of
+    ``T_k``'s size; what is neglected is the error terms' own rounding), and
+    in practice it is rounded correctly.  The same in float64 on every
+    platform, with no ``longdouble``.  A value beyond about ``1e300`` (far
+    outside the box, at a high degree) overflows the split and comes out NaN.
 
     Examples
     --------
