@@ -1,9 +1,9 @@
 """Scattered points compiled: the arithmetic of :class:`.chebyshev.CompensatedBasis` and the contraction, fused.
 
 NumPy runs the compensated basis as about a hundred passes over a block of
-points per axis (at 5 nodes), each reading and writing memory; here every point's basis and sum
-stay in registers, a block of :data:`BLOCK` points at a time, in loops the
-compiler vectorizes across points.  The operations on each point are those of
+points per axis (at 5 nodes), each reading and writing memory; here every
+point's basis and sum stay in registers, a block of :data:`BLOCK` points at a
+time, in loops the compiler vectorizes across points.  The operations on each point are those of
 the NumPy engine in :meth:`.surface.SurfaceEvaluator.points`, one for one and
 in the same order (no fused multiply-add, no reassociation: Numba's default
 without ``fastmath``), so the two give the same bits; ``tests/test_evaluate.py``
@@ -24,7 +24,24 @@ BLOCK = 256
 """Points per block: a block's basis values and error terms stay in the first-level cache."""
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+_inline = njit(cache=True, inline="always", error_model="numpy")  # copied into each caller
+
+
+@_inline
+def _split(v):  # pragma: no cover - compiled
+    """``v = hi + lo``, Veltkamp's split: CompensatedBasis._split."""
+    c = v * SPLIT
+    hi = c - (c - v)
+    return hi, v - hi
+
+
+@_inline
+def _product_error(ahi, alo, bhi, blo, p):  # pragma: no cover - compiled
+    """``a b - p`` exactly for ``p = fl(a b)``, Dekker's product: CompensatedBasis._product_error."""
+    return (((ahi * bhi - p) + ahi * blo) + alo * bhi) + alo * blo
+
+
+@_inline
 def _basis(x, start, k, o, h, hhi, hlo, n, out, w):  # pragma: no cover - compiled
     """``T_j((x - o) / h)`` for ``j < n`` at ``x[start:start + k]`` into ``out[:, :k]``: CompensatedBasis.basis."""
     sh, shi, slo, sl = w[0], w[1], w[2], w[3]
@@ -35,11 +52,9 @@ def _basis(x, start, k, o, h, hhi, hlo, n, out, w):  # pragma: no cover - compil
         b = d - xi
         dl = ((-o) - b) + (xi - (d - b))
         s = d / h
-        c = s * SPLIT
-        hi = c - (c - s)
-        lo = s - hi
+        hi, lo = _split(s)
         p = s * h
-        pe = (((hi * hhi - p) + hi * hlo) + lo * hhi) + lo * hlo
+        pe = _product_error(hi, lo, hhi, hlo, p)
         sh[i], shi[i], slo[i] = s, hi, lo
         sl[i] = (((d - p) - pe) + dl) / h
         out[0, i] = 1.0
@@ -52,10 +67,8 @@ def _basis(x, start, k, o, h, hhi, hlo, n, out, w):  # pragma: no cover - compil
         for i in range(k):
             cu, ce, pu = u[j - 1, i], e[j - 1, i], u[j - 2, i]
             p = cu * sh[i]
-            c = cu * SPLIT
-            uhi = c - (c - cu)
-            ulo = cu - uhi
-            pe = (((shi[i] * uhi - p) + shi[i] * ulo) + slo[i] * uhi) + slo[i] * ulo
+            uhi, ulo = _split(cu)
+            pe = _product_error(shi[i], slo[i], uhi, ulo, p)
             a = p + p
             nu = a - pu
             b = nu - a

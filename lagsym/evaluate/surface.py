@@ -194,7 +194,7 @@ class SurfaceEvaluator:
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
-        xf, yf = np.ascontiguousarray(x.ravel()), np.ascontiguousarray(y.ravel())
+        xf, yf = x.ravel(), y.ravel()  # contiguous: copies of broadcast or strided inputs
         out = np.empty(xf.size)
         into = self._compiled_into if xf.size >= COMPILED_POINTS else self._numpy_into
         run_parts(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
@@ -224,12 +224,11 @@ class SurfaceEvaluator:
         work = CompensatedBasis(size, max(n, m))
         tx, ty = np.empty((n, size)), np.empty((m, size))
         wb, term = np.empty(size), np.empty(size)
-        (xo, xh, _, _), (yo, yh, _, _) = self._axes()
         for lo in range(start, stop, chunk):
             hi = min(lo + chunk, stop)
             k = hi - lo
-            bx = work.basis(xf[lo:hi], xo, xh, n, tx)
-            by = work.basis(yf[lo:hi], yo, yh, m, ty)
+            bx = work.basis(xf[lo:hi], self.x_offset, self.x_scale, n, tx)
+            by = work.basis(yf[lo:hi], self.y_offset, self.y_scale, m, ty)
             z, w, t = out[lo:hi], wb[:k], term[:k]
             for b in range(m):
                 np.multiply(bx[0], c[0, b], out=w)
