@@ -7,7 +7,7 @@ alternating so a busy spell of a shared machine falls on all alike:
 - ``evaluate_points``: the stable evaluator, whose result keeps
   :meth:`SurfaceEvaluator.error_bound` (the compensated Chebyshev basis, each
   value rounded once; control points return their heights exactly); 10**6
-  points run its compiled kernel, loaded before the timed runs;
+  points run its compiled kernel, loaded before the timed runs (``load_compiled()``);
 - the same arithmetic in NumPy (``evaluate_points`` on blocks of 131,072
   points, below the compiled kernel's threshold): the same values, bit for bit;
 - ``SurfaceEvaluator.fast_points``: the plain float64 recurrence, for the
@@ -36,7 +36,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from lagsym.evaluate import COMPILED_POINTS, evaluate_points, lambdify_surface, surface_evaluator  # noqa: E402
+from lagsym.evaluate import (COMPILED_POINTS, evaluate_points, lambdify_surface, load_compiled,  # noqa: E402
+                             surface_evaluator)
 from lagsym.io import read_points  # noqa: E402
 from lagsym.lagrange import lagrange_surface  # noqa: E402
 
@@ -73,7 +74,8 @@ def main(argv=None) -> int:
         "lagsym `fast_points` (float64 basis, no bound)": lambda: ev.fast_points(px, py),
     }
     times: dict[str, list[float]] = {k: [] for k in methods}
-    results = {k: fn() for k, fn in methods.items()}  # also loads the compiled kernel
+    load_compiled()
+    results = {k: fn() for k, fn in methods.items()}
     engines = list(results.values())[1:3]
     if a.points >= COMPILED_POINTS and not np.array_equal(*engines):
         raise SystemExit("the compiled kernel and NumPy differ")

@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
-from .evaluate.surface import grid_product
+from .evaluate.surface import COMPILED_POINTS, grid_product
 from .values import as_exact
 
 __all__ = [
@@ -316,9 +316,10 @@ def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS) -> 
     memory in use does not grow with the grid.
     """
     ev = surface_evaluator(surface)
-    w = ev.x_factor(grid.xs)  # (nx, m): small
-    ty = ev.y_basis(grid.ys)  # (m, ny): small
     rows = max(1, block_points // grid.ny)
+    compiled = min(rows, grid.nx) * grid.ny >= COMPILED_POINTS  # the blocks' products run compiled: the factors too
+    w = ev.x_factor(grid.xs, compiled)  # (nx, m): small
+    ty = ev.y_basis(grid.ys, compiled)  # (m, ny): small
     for start in range(0, grid.nx, rows):
         stop = min(start + rows, grid.nx)
         xs = grid.xs[start:stop]

@@ -315,6 +315,14 @@ def test_the_sampling_page_quotes_the_threads():
     assert f"contiguous parts of {THREAD_POINTS:,} values or more" in text
 
 
+def test_the_sampling_page_quotes_when_the_kernels_load():
+    from lagsym.evaluate.engine import LOAD_SECONDS
+
+    text = " ".join(page("sampling.md").split())
+    assert LOAD_SECONDS == 0.5 and "(`LOAD_SECONDS`, 0.5 s)" in text and "have taken 0.5 s" in text
+    assert "once such batches have taken half a second in NumPy" in " ".join(page("architecture.md").split())
+
+
 def test_the_pages_quote_the_compiled_threshold():
     from lagsym.evaluate import COMPILED_POINTS
 

@@ -24,6 +24,7 @@ from lagsym.evaluate import (
     evaluate_grid,
     evaluate_points,
     lambdify_surface,
+    load_compiled,
     surface_evaluator,
 )
 from lagsym.grid import curve_from_points, grid_from_table
@@ -215,6 +216,7 @@ def test_the_compensated_basis_is_the_exact_value_rounded_once(offset, scale, lo
 
 @pytest.mark.parametrize("shape, spread", [((5, 5), 0.25), ((7, 3), 1.5), ((2, 9), 0.0), ((14, 11), 0.1)])
 def test_a_large_batch_runs_compiled_with_the_bits_of_small_ones(shape, spread):
+    load_compiled()  # large batches run compiled from here on (lagsym.evaluate.engine)
     rng = np.random.default_rng(shape[0])
     n, m = shape
     xs = np.cumsum(rng.uniform(0.5, 2.0, n)) - 3.3

@@ -21,8 +21,10 @@ The modules, one concern each:
 
 * :mod:`.chebyshev`: the exact change of basis and the basis values (the
   compensated recurrence, each value rounded once);
-* :mod:`.compiled`: the same arithmetic for a large batch of scattered points,
-  compiled (Numba), loaded only for such a batch;
+* :mod:`.compiled`: the same arithmetic for large batches of scattered points
+  and grids, compiled (Numba), with the same bits;
+* :mod:`.engine`: which of the two runs a large batch (the compiled kernels
+  once they have paid for their loading, about half a second);
 * :mod:`.surface`: :class:`SurfaceEvaluator`, values on grids and at points,
   partial derivatives and the curvature bound (what drop-cutter needs);
 * :mod:`.curve`: :class:`CurveEvaluator`, the 1-D case;
@@ -50,6 +52,7 @@ from .surface import (
     SurfaceEvaluator,
     evaluate_grid,
     evaluate_points,
+    load_compiled,
     surface_evaluator,
 )
 
@@ -76,5 +79,6 @@ __all__ = [
     "evaluate_points",
     "evaluate_grid",
     "lebesgue_constant",
+    "load_compiled",
     "power_partials",
 ]

@@ -14,6 +14,7 @@ throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
 
 from __future__ import annotations
 
+import time
 import weakref
 from dataclasses import dataclass
 from fractions import Fraction
@@ -24,6 +25,8 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
+from .engine import COMPILED_POINTS, spent_in_numpy, use_compiled
+from .product import grid_product, readonly_view
 from .threads import parts, run_parts
 from .chebyshev import (
     CompensatedBasis,
@@ -37,52 +40,23 @@ from .chebyshev import (
 )
 
 __all__ = ["CHUNK_POINTS", "COMPILED_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator",
-           "evaluate_points", "evaluate_grid"]
+           "evaluate_points", "evaluate_grid", "grid_product", "load_compiled"]
 
 CHUNK_POINTS = 1 << 13  # NumPy evaluates scattered points in blocks of this many: their scratch stays in cache
-COMPILED_POINTS = 1 << 18  # from this many scattered points on, the compiled kernel (whose loading costs ~0.5 s once)
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
-# Multiply-adds in one block of a grid product: its rows are computed in cache and written once, and it
-# is the largest size OpenBLAS runs in one thread (65536 * 4 = 262144; above it, it splits the product
-# between threads).  Each BLAS call costs a few microseconds however small: blocks of 20 rows of a
-# 2000-point grid took 3-4 % longer than blocks of 26 (min of 61 runs).
-PRODUCT_BLOCK = 262_144
 
 
-def _readonly_view(a: np.ndarray) -> np.ndarray:
-    """``a`` seen read-only, so the compiled kernel has one version whatever the caller's arrays."""
-    v = a.view()
-    v.flags.writeable = False
-    return v
+def load_compiled() -> None:
+    """Load the compiled kernels now, so that every large batch after runs compiled (:mod:`.engine`).
 
-
-def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """``out = w @ ty`` for a tall ``w`` and a wide ``ty`` with a short inner dimension, in blocks of rows.
-
-    One BLAS product over a whole large grid hands the work to BLAS's own
-    threads, which on a loaded machine fight over the cores (a 2000 x 2000
-    grid took 2-3 times as long as in blocks); each block here
-    (:data:`PRODUCT_BLOCK` multiply-adds, small enough for BLAS to run it in
-    one thread) is computed in cache and written to ``out`` once.  Every
-    element is the dot product of its row and column, within the rounding of
-    that sum; BLAS may add its terms in another order than one ``w @ ty``
-    does (OpenBLAS's AVX-512 kernels do, by the last bit).  A large grid's
-    rows are shared among threads (:mod:`.threads`), each running the blocks
-    one thread would, so the values are the same whatever the threads.
+    For a process that will evaluate many large batches (a notebook, a
+    benchmark): about half a second once, then a few milliseconds for each
+    10**6 points or 2000 x 2000 grid.  The values are the same either way.
     """
-    n = w.shape[0]
-    out = np.empty((n, ty.shape[1])) if out is None else out
-    if w.shape[1] == 0:
-        out[...] = 0.0
-        return out
-    rows = max(1, PRODUCT_BLOCK // max(ty.shape[1] * w.shape[1], 1))
-
-    def work(lo, hi):
-        for r in range(lo, hi, rows):
-            np.matmul(w[r:min(r + rows, hi)], ty, out=out[r:min(r + rows, hi)])
-
-    run_parts(work, parts(n, ty.shape[1], rows))
-    return out
+    ev = _WARM_UP
+    xs = np.linspace(-1.0, 1.0, 5)
+    grid_product(ev.x_factor(xs, True), ev.y_basis(xs, True), compiled=True)
+    ev._compiled_into(np.empty(5), xs, xs, 0, 5, CHUNK_POINTS)
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,21 +105,54 @@ class SurfaceEvaluator:
         """Number of coefficients in x and in y (nodes of the control grid)."""
         return self.coefficients.shape
 
-    def x_factor(self, xs) -> np.ndarray:
+    def x_factor(self, xs, compiled: bool = False) -> np.ndarray:
         """``W = Tx.T @ C`` for the grid lines ``xs``: shape ``(len(xs), m)``.
 
-        A grid is then ``W @ self.y_basis(ys)``, one matrix product, which
-        lets a sampler compute the small factor once and stream blocks of rows.
+        A grid is then ``grid_product(W, self.y_basis(ys))``, which lets a
+        sampler compute the small factor once and stream blocks of rows.
+        ``W[i, b] = C[0, b] Tx[0, i] + C[1, b] Tx[1, i] + ...``, left to right,
+        as :meth:`points` forms it.  ``compiled`` runs the compiled kernels
+        (for a large grid, where Numba is loaded anyway), with the same bits.
         """
-        n = self.shape[0]
-        return chebyshev_basis(xs, self.x_offset, self.x_scale, n).T @ self.coefficients
+        xs = np.asarray(xs, dtype=float).ravel()
+        c = self.coefficients
+        n, m = c.shape
+        tx = self._basis(xs, self._axes()[0], n, compiled)
+        w = np.empty((xs.size, m))
+        if compiled:
+            from .compiled import factor_kernel
 
-    def y_basis(self, ys) -> np.ndarray:
-        """``Ty``: the Chebyshev basis of the grid lines ``ys``, shape ``(m, len(ys))``."""
-        return chebyshev_basis(ys, self.y_offset, self.y_scale, self.shape[1])
+            factor_kernel(readonly_view(tx), c, w)
+            return w
+        col, term = np.empty(xs.size), np.empty(xs.size)
+        for b in range(m):
+            np.multiply(tx[0], c[0, b], out=col)
+            for a in range(1, n):
+                np.multiply(tx[a], c[a, b], out=term)
+                col += term
+            w[:, b] = col
+        return w
+
+    def y_basis(self, ys, compiled: bool = False) -> np.ndarray:
+        """``Ty``: the Chebyshev basis of the grid lines ``ys``, shape ``(m, len(ys))``; ``compiled`` as :meth:`x_factor`."""
+        return self._basis(np.asarray(ys, dtype=float).ravel(), self._axes()[1], self.shape[1], compiled)
+
+    @staticmethod
+    def _basis(v: np.ndarray, axis: tuple[float, ...], n: int, compiled: bool) -> np.ndarray:
+        """:func:`.chebyshev.chebyshev_basis` of ``v`` on ``axis`` (``(offset, scale, ...)``), NumPy or compiled."""
+        if not compiled:
+            return chebyshev_basis(v, axis[0], axis[1], n)
+        from .compiled import basis_kernel  # Numba loads with the compiled engine, not with lagsym
+
+        out = np.empty((n, v.size))
+        basis_kernel(readonly_view(v), np.array(axis), n, out)
+        return out
 
     def grid(self, xs, ys) -> np.ndarray:
-        """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``.
+        """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``: the bits :meth:`points` gives at each.
+
+        A grid of :data:`COMPILED_POINTS` values or more may run compiled, as
+        :mod:`.engine` rules, with the same bits.
 
         Examples
         --------
@@ -159,7 +166,13 @@ class SurfaceEvaluator:
         """
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
-        return self.snap_grid(grid_product(self.x_factor(xs), self.y_basis(ys)), xs, ys)
+        size = xs.size * ys.size
+        compiled = use_compiled(size)
+        start = time.perf_counter()
+        z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled)
+        if not compiled:
+            spent_in_numpy(size, time.perf_counter() - start)
+        return self.snap_grid(z, xs, ys)
 
     @staticmethod
     def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -185,19 +198,23 @@ class SurfaceEvaluator:
         ``sum_b (sum_a C[a, b] Tx[a]) Ty[b]`` adds its terms left to right, so
         :meth:`error_bound` holds; where ``(x, y)`` is a control point exactly
         its height is returned exactly.  A batch of :data:`COMPILED_POINTS` or
-        more runs the compiled kernel of :mod:`.compiled` (loaded on the first
-        such batch, about 0.5 s once per process); a smaller one runs the same
-        operations in NumPy, in blocks of ``chunk`` points whose scratch stays
-        in cache.  The two give the same bits, and many points are shared
-        among threads (:mod:`.threads`), so the values do not depend on the
-        batch, the block or the threads.
+        more may run the compiled kernel of :mod:`.compiled`, as :mod:`.engine`
+        rules; otherwise the same operations run in NumPy, in blocks of
+        ``chunk`` points whose scratch stays in cache.  The two give the same
+        bits, and many points are shared among threads (:mod:`.threads`), so
+        the values do not depend on the engine, the batch, the block or the
+        threads.
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
         xf, yf = x.ravel(), y.ravel()  # contiguous: copies of broadcast or strided inputs
         out = np.empty(xf.size)
-        into = self._compiled_into if xf.size >= COMPILED_POINTS else self._numpy_into
+        compiled = use_compiled(xf.size)
+        into = self._compiled_into if compiled else self._numpy_into
+        start = time.perf_counter()
         run_parts(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
+        if not compiled:
+            spent_in_numpy(xf.size, time.perf_counter() - start)
         return out.reshape(shape)
 
     def _axes(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -207,10 +224,10 @@ class SurfaceEvaluator:
 
     def _compiled_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
         """:meth:`points` of ``xf[start:stop], yf[start:stop]`` into ``out`` by the compiled kernel."""
-        from .compiled import points_kernel  # Numba loads with the first large batch, not with lagsym
+        from .compiled import points_kernel  # Numba loads with the compiled engine, not with lagsym
 
         xa, ya = (np.array(a) for a in self._axes())
-        points_kernel(_readonly_view(xf), _readonly_view(yf), start, stop, self.coefficients, xa, ya, out)
+        points_kernel(readonly_view(xf), readonly_view(yf), start, stop, self.coefficients, xa, ya, out)
         self._snap_points(out[start:stop], xf[start:stop], yf[start:stop])
 
     def _numpy_into(self, out, xf, yf, start: int, stop: int, chunk: int) -> None:
@@ -396,3 +413,11 @@ def evaluate_grid(surface, xs, ys) -> np.ndarray:
     return surface_evaluator(surface).grid(xs, ys)
 
 
+
+
+_WARM_UP = SurfaceEvaluator(
+    x_offset=0.0, x_scale=1.0, y_offset=0.0, y_scale=1.0,
+    coefficients=_readonly(np.eye(3)), data_range=1.0, bounds=(-1.0, 1.0, -1.0, 1.0),
+    x_nodes=_readonly(np.array([-1.0, 0.0, 1.0])), y_nodes=_readonly(np.array([-1.0, 0.0, 1.0])),
+    x_exact=_readonly([True] * 3, bool), y_exact=_readonly([True] * 3, bool), node_values=_readonly(np.eye(3)),
+)  # a small surface whose evaluation loads every compiled kernel (load_compiled)

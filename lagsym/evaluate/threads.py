@@ -50,7 +50,7 @@ def run_parts(work, cuts: list[tuple[int, int]]) -> None:
     """``work(start, stop)`` for every part, the first in the calling thread and each other in a thread of its own.
 
     Plain threads, started and joined here: a pool's set-up cost about a
-    third of a millisecond on the development machine, a sixth of a
+    third of a millisecond on the benchmark machine, a sixth of a
     2000 x 2000 sample.  The first error raised in any part is raised again
     once all have ended.
     """
