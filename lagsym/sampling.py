@@ -25,7 +25,8 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
-from .evaluate.surface import COMPILED_POINTS, grid_product
+from .evaluate.engine import use_compiled
+from .evaluate.product import grid_product
 from .values import as_exact
 
 __all__ = [
@@ -317,7 +318,7 @@ def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS) -> 
     """
     ev = surface_evaluator(surface)
     rows = max(1, block_points // grid.ny)
-    compiled = min(rows, grid.nx) * grid.ny >= COMPILED_POINTS  # the blocks' products run compiled: the factors too
+    compiled = use_compiled(min(rows, grid.nx) * grid.ny)  # the blocks may run compiled: then the factors too
     w = ev.x_factor(grid.xs, compiled)  # (nx, m): small
     ty = ev.y_basis(grid.ys, compiled)  # (m, ny): small
     for start in range(0, grid.nx, rows):

@@ -308,11 +308,12 @@ def test_the_planning_benchmark_mesh_comes_within_5_um():
 
 
 def test_the_sampling_page_quotes_the_threads():
-    from lagsym.evaluate.threads import MAX_THREADS, THREAD_POINTS
+    from lagsym.evaluate.threads import MAX_THREADS, TAKE_VALUES, THREAD_POINTS
 
     text = page("sampling.md")
     assert MAX_THREADS == 4 and "shared among up to four threads" in text
-    assert f"contiguous parts of {THREAD_POINTS:,} values or more" in text
+    assert f"each thread having {THREAD_POINTS:,} values or more" in text
+    assert f"blocks of about {TAKE_VALUES:,} values (`TAKE_VALUES`)" in text
 
 
 def test_the_sampling_page_quotes_when_the_kernels_load():

@@ -108,3 +108,14 @@ def test_small_batches_never_count_towards_loading():
         "for _ in range(5): sample(s, 400, 400)\n"
         "print(loaded(), engine._spent[0] == 0.0)"))
     assert out == ["False", "True"]
+
+
+def test_writing_one_large_sample_does_not_load_the_kernels(tmp_path):
+    """A command's one large grid, streamed to a file in blocks, runs in NumPy: loading would cost more than it saves."""
+    out = _run(PRELUDE + (
+        "from lagsym.export import write_sample; from lagsym.sampling import sample_grid\n"
+        f"write_sample({str(tmp_path / 'a.npy')!r}, s, sample_grid(s, 700, 700))\n"
+        "print(loaded(), engine._spent[0] > 0)"))
+    assert out == ["False", "True"]
+    z = np.load(tmp_path / "a.npy")
+    assert z.shape == (490_000, 3)

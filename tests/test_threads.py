@@ -83,3 +83,41 @@ def test_an_error_in_any_part_is_raised_after_every_part_has_ended(failing):
         threads.run_parts(work, [(0, 1), (1, 2), (2, 3)])
     assert sorted(ran) == [p for p in (0, 1, 2) if p != failing]
     assert threading.active_count() == before
+
+
+def test_blocks_are_each_taken_once_by_the_threads_and_the_calling_thread_takes_its_share(monkeypatch):
+    monkeypatch.setattr(threads, "available_cores", lambda: 3)
+    taken = []
+    callers = set()
+
+    def work(lo, hi):
+        taken.append((lo, hi))
+        callers.add(threading.get_ident())
+        threading.Event().wait(0.002)
+
+    n = 3 * threads.THREAD_POINTS
+    threads.run_blocks(work, n, 10_000)
+    assert sorted(taken) == [(lo, min(lo + 10_000, n)) for lo in range(0, n, 10_000)]
+    assert threading.get_ident() in callers and len(callers) == 3
+
+
+def test_no_block_is_taken_after_an_error(monkeypatch):
+    monkeypatch.setattr(threads, "available_cores", lambda: 2)
+    before = threading.active_count()
+    taken = []
+
+    def work(lo, hi):
+        taken.append(lo)
+        if lo == 0:
+            raise ValueError("block 0")
+        threading.Event().wait(0.01)
+
+    with pytest.raises(ValueError, match="block 0"):
+        threads.run_blocks(work, 2 * threads.THREAD_POINTS, 1000)
+    assert len(taken) < 10 and threading.active_count() == before
+
+
+def test_one_thread_runs_the_whole_in_one_call():
+    calls = []
+    threads.run_blocks(lambda lo, hi: calls.append((lo, hi)), threads.THREAD_POINTS, 1000)
+    assert calls == [(0, threads.THREAD_POINTS)]

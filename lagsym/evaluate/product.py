@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .engine import spent_in_numpy, use_compiled
-from .threads import parts, run_parts
+from .threads import block_items, run_blocks
 
 __all__ = ["PRODUCT_BLOCK", "grid_product", "readonly_view"]
 
@@ -39,7 +39,8 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
     ``compiled`` (by default as :mod:`.engine` rules for the size) runs
     :func:`.compiled.product_kernel`, which writes each output row once from
     cache; NumPy computes blocks of :data:`PRODUCT_BLOCK` values, with the
-    same bits.  A large grid's rows are shared among threads (:mod:`.threads`).
+    same bits.  A large grid's blocks of rows are shared among threads
+    (:func:`.threads.run_blocks`).
     """
     n, m = w.shape[0], ty.shape[1]
     out = np.empty((n, m)) if out is None else out
@@ -57,7 +58,7 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
 
         target = out if out.flags.c_contiguous and out.flags.aligned else np.empty((n, m))
         wv, tv = (readonly_view(np.ascontiguousarray(a, dtype=float)) for a in (w, ty))
-        run_parts(lambda lo, hi: product_kernel(wv, tv, lo, hi, target), parts(n, m, 4))
+        run_blocks(lambda lo, hi: product_kernel(wv, tv, lo, hi, target), n, block_items(m, 4), m)
         if target is not out:
             out[...] = target
         return out
@@ -73,5 +74,5 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
                 np.multiply(w[r:e, b:b + 1], ty[b], out=t)
                 z += t
 
-    run_parts(work, parts(n, m, rows))
+    run_blocks(work, n, block_items(m, rows), m)
     return out

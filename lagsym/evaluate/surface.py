@@ -27,7 +27,7 @@ from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
 from .engine import COMPILED_POINTS, spent_in_numpy, use_compiled
 from .product import grid_product, readonly_view
-from .threads import parts, run_parts
+from .threads import block_items, run_blocks
 from .chebyshev import (
     CompensatedBasis,
     chebyshev_basis,
@@ -212,7 +212,7 @@ class SurfaceEvaluator:
         compiled = use_compiled(xf.size)
         into = self._compiled_into if compiled else self._numpy_into
         start = time.perf_counter()
-        run_parts(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), parts(xf.size, 1, chunk))
+        run_blocks(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), xf.size, block_items(1, chunk))
         if not compiled:
             spent_in_numpy(xf.size, time.perf_counter() - start)
         return out.reshape(shape)
