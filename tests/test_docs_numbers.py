@@ -322,6 +322,7 @@ def test_the_sampling_page_quotes_when_the_kernels_load():
     text = " ".join(page("sampling.md").split())
     assert LOAD_SECONDS == 0.5 and "(`LOAD_SECONDS`, 0.5 s)" in text and "have taken 0.5 s" in text
     assert "once such batches have taken half a second in NumPy" in " ".join(page("architecture.md").split())
+    assert "until they have taken 0.5 s together" in " ".join((ROOT / "README.md").read_text().split())
 
 
 def test_the_pages_quote_the_compiled_threshold():

@@ -8,9 +8,10 @@ time, in loops the compiler vectorizes across points.  On a grid
 basis rows and written once.  The operations on each value are those of the
 NumPy engine in :mod:`.surface`, one for one and in the same order (no fused
 multiply-add, no reassociation: Numba's default without ``fastmath``), so the
-two give the same bits; ``tests/test_evaluate.py`` checks it.  This module is
-loaded only for a large batch (Numba's import and the cached kernels take
-about 0.5 s, once per process).
+two give the same bits; ``tests/test_evaluate.py`` and ``tests/test_engine.py``
+check it.  This module is loaded only with the compiled engine
+(:mod:`.engine`: Numba's import and the cached kernels take about 0.5 s,
+once per process).
 """
 
 from __future__ import annotations
@@ -216,7 +217,7 @@ def product_kernel(w, ty, lo, hi, out):  # pragma: no cover - compiled
     """``out[i, j] = w[i, 0] ty[0, j] + w[i, 1] ty[1, j] + ...``, left to right, for rows ``lo <= i < hi``.
 
     Four rows at a time share each load of ``ty``, :data:`COLUMNS` columns
-    at a time: the first two to five terms in one pass (all of them up to
+    at a time: the first one to five terms in one pass (all of them up to
     five terms), the rest four more per pass, each adding to what the pass
     before left in the output, which stays in cache.  A last group of fewer
     than four rows repeats its last row (each copy of it gets the same
