@@ -1,10 +1,12 @@
-"""Both cores for a large evaluation: contiguous parts of the points or grid rows, one thread each.
+"""Both cores for a large evaluation: blocks of the points or grid rows, taken in turn by one thread a core.
 
-NumPy lets go of the interpreter lock inside its array loops and BLAS calls,
-so threads working on separate parts of one output run side by side.  Each
-part is computed exactly as it would be alone (the same blocks, the same
-arithmetic), so the values are the same bit for bit whatever the threads.
-Below :data:`THREAD_POINTS` values a part the threads would cost more than
+NumPy lets go of the interpreter lock inside its array loops, and the
+compiled kernels run without it, so threads working on separate parts of one
+output run side by side.  Each part or block is computed exactly as it would
+be alone (the same arithmetic), so the values are the same bit for bit
+whatever the threads.  :func:`run_blocks` hands out blocks as threads come
+free; :func:`run_parts` runs given parts, one a thread.  Below
+:data:`THREAD_POINTS` values a thread the threads would cost more than
 they save, and one thread does all.  The threads end with the call: none is
 left running (a plan forks its worker processes only while no other thread
 runs, :mod:`lagsym.toolpath.workers`).
