@@ -20,8 +20,11 @@ from __future__ import annotations
 
 import sys
 import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
-__all__ = ["COMPILED_POINTS", "LOAD_SECONDS", "compiled_loaded", "use_compiled", "spent_in_numpy"]
+__all__ = ["COMPILED_POINTS", "LOAD_SECONDS", "compiled_loaded", "use_compiled", "spent_in_numpy", "choose_engine"]
 
 COMPILED_POINTS = 1 << 18
 """Values (scattered points or grid nodes) from which a batch may run compiled."""
@@ -49,3 +52,13 @@ def spent_in_numpy(values: int, seconds: float) -> None:
     if values >= COMPILED_POINTS:
         with _lock:
             _spent[0] += seconds
+
+
+@contextmanager
+def choose_engine(values: int) -> Iterator[bool]:
+    """Whether a batch of ``values`` runs compiled (:func:`use_compiled`); the time it takes in NumPy is counted."""
+    compiled = use_compiled(values)
+    start = time.perf_counter()
+    yield compiled
+    if not compiled:
+        spent_in_numpy(values, time.perf_counter() - start)

@@ -10,11 +10,9 @@ bit), so a grid and the same points give the same bits.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
-from .engine import spent_in_numpy, use_compiled
+from .engine import choose_engine
 from .threads import block_items, run_blocks
 
 __all__ = ["PRODUCT_BLOCK", "grid_product", "readonly_view"]
@@ -48,11 +46,8 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
         out[...] = 0.0
         return out
     if compiled is None:
-        compiled, start = use_compiled(n * m), time.perf_counter()
-        grid_product(w, ty, out, compiled)
-        if not compiled:
-            spent_in_numpy(n * m, time.perf_counter() - start)
-        return out
+        with choose_engine(n * m) as compiled:
+            return grid_product(w, ty, out, compiled)
     if compiled:
         from .compiled import product_kernel  # Numba loads with the compiled engine, not with lagsym
 

@@ -14,7 +14,6 @@ throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
 
 from __future__ import annotations
 
-import time
 import weakref
 from dataclasses import dataclass
 from fractions import Fraction
@@ -25,7 +24,7 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
-from .engine import COMPILED_POINTS, spent_in_numpy, use_compiled
+from .engine import COMPILED_POINTS, choose_engine
 from .product import grid_product, readonly_view
 from .threads import block_items, run_blocks
 from .chebyshev import (
@@ -166,12 +165,8 @@ class SurfaceEvaluator:
         """
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
-        size = xs.size * ys.size
-        compiled = use_compiled(size)
-        start = time.perf_counter()
-        z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled)
-        if not compiled:
-            spent_in_numpy(size, time.perf_counter() - start)
+        with choose_engine(xs.size * ys.size) as compiled:
+            z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled)
         return self.snap_grid(z, xs, ys)
 
     @staticmethod
@@ -209,12 +204,9 @@ class SurfaceEvaluator:
         shape = x.shape
         xf, yf = x.ravel(), y.ravel()  # contiguous: copies of broadcast or strided inputs
         out = np.empty(xf.size)
-        compiled = use_compiled(xf.size)
-        into = self._compiled_into if compiled else self._numpy_into
-        start = time.perf_counter()
-        run_blocks(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), xf.size, block_items(1, chunk))
-        if not compiled:
-            spent_in_numpy(xf.size, time.perf_counter() - start)
+        with choose_engine(xf.size) as compiled:
+            into = self._compiled_into if compiled else self._numpy_into
+            run_blocks(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), xf.size, block_items(1, chunk))
         return out.reshape(shape)
 
     def _axes(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -411,8 +403,6 @@ def evaluate_points(surface, x, y) -> np.ndarray:
 def evaluate_grid(surface, xs, ys) -> np.ndarray:
     """Evaluate a surface on the grid ``xs`` x ``ys``; result ``Z[i, j] = F(xs[i], ys[j])``."""
     return surface_evaluator(surface).grid(xs, ys)
-
-
 
 
 _WARM_UP = SurfaceEvaluator(
