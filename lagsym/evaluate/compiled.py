@@ -86,6 +86,18 @@ def _basis(x, start, k, o, h, hhi, hlo, n, out, w):  # pragma: no cover - compil
             out[j, i] = nu + ne
 
 
+@_inline
+def _column(tx, c, b, k, out):  # pragma: no cover - compiled
+    """``out[:k] = c[0, b] tx[0, :k] + c[1, b] tx[1, :k] + ...``, left to right: ``.surface._column``."""
+    c0 = c[0, b]
+    for i in range(k):
+        out[i] = c0 * tx[0, i]
+    for a in range(1, c.shape[0]):
+        cab = c[a, b]
+        for i in range(k):
+            out[i] = out[i] + cab * tx[a, i]
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def points_kernel(x, y, lo, hi, c, xa, ya, out):  # pragma: no cover - compiled
     """``out[lo:hi] = sum_ab c[a, b] T_a(s(x)) T_b(t(y))``, unsnapped: the NumPy engine's values.
@@ -103,12 +115,7 @@ def points_kernel(x, y, lo, hi, c, xa, ya, out):  # pragma: no cover - compiled
         _basis(x, start, k, xa[0], xa[1], xa[2], xa[3], n, tx, w)
         _basis(y, start, k, ya[0], ya[1], ya[2], ya[3], m, ty, w)
         for b in range(m):
-            for i in range(k):
-                wb[i] = c[0, b] * tx[0, i]
-            for a in range(1, n):
-                cab = c[a, b]
-                for i in range(k):
-                    wb[i] = wb[i] + cab * tx[a, i]
+            _column(tx, c, b, k, wb)
             if b == 0:
                 for i in range(k):
                     z[i] = wb[i] * ty[0, i]
@@ -134,16 +141,9 @@ def basis_kernel(x, axis, n, out):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, error_model="numpy")
 def factor_kernel(tx, c, out):  # pragma: no cover - compiled
     """``out[i, b] = c[0, b] tx[0, i] + c[1, b] tx[1, i] + ...``, left to right: a grid's ``W``, as points form it."""
-    n, m = c.shape
     col = np.empty(tx.shape[1])
-    for b in range(m):
-        c0 = c[0, b]
-        for i in range(col.size):
-            col[i] = c0 * tx[0, i]
-        for a in range(1, n):
-            cab = c[a, b]
-            for i in range(col.size):
-                col[i] = col[i] + cab * tx[a, i]
+    for b in range(c.shape[1]):
+        _column(tx, c, b, col.size, col)
         out[:, b] = col
 
 

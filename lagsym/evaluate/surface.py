@@ -45,6 +45,15 @@ CHUNK_POINTS = 1 << 13  # NumPy evaluates scattered points in blocks of this man
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
 
 
+def _column(tx: np.ndarray, c: np.ndarray, b: int, out: np.ndarray, term: np.ndarray) -> np.ndarray:
+    """``out = c[0, b] tx[0] + c[1, b] tx[1] + ...``, left to right: column ``b`` of ``W``, as grids and points form it."""
+    np.multiply(tx[0], c[0, b], out=out)
+    for a in range(1, c.shape[0]):
+        np.multiply(tx[a], c[a, b], out=term)
+        out += term
+    return out
+
+
 def load_compiled() -> None:
     """Load the compiled kernels now, so that every large batch after runs compiled (:mod:`.engine`).
 
@@ -125,11 +134,7 @@ class SurfaceEvaluator:
             return w
         col, term = np.empty(xs.size), np.empty(xs.size)
         for b in range(m):
-            np.multiply(tx[0], c[0, b], out=col)
-            for a in range(1, n):
-                np.multiply(tx[a], c[a, b], out=term)
-                col += term
-            w[:, b] = col
+            w[:, b] = _column(tx, c, b, col, term)
         return w
 
     def y_basis(self, ys, compiled: bool = False) -> np.ndarray:
@@ -240,10 +245,7 @@ class SurfaceEvaluator:
             by = work.basis(yf[lo:hi], self.y_offset, self.y_scale, m, ty)
             z, w, t = out[lo:hi], wb[:k], term[:k]
             for b in range(m):
-                np.multiply(bx[0], c[0, b], out=w)
-                for a in range(1, n):
-                    np.multiply(bx[a], c[a, b], out=t)
-                    w += t
+                _column(bx, c, b, w, t)
                 if b == 0:
                     np.multiply(w, by[0], out=z)
                 else:
