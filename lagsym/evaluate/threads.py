@@ -7,13 +7,24 @@ be alone (the same arithmetic), so the values are the same bit for bit
 whatever the threads.  :func:`run_blocks` hands out blocks as threads come
 free; :func:`run_parts` runs given parts, one a thread.  Below
 :data:`THREAD_POINTS` values a thread the threads would cost more than
-they save, and one thread does all.  The threads end with the call: none is
-left running (a plan forks its worker processes only while no other thread
-runs, :mod:`lagsym.toolpath.workers`).
+they save, and one thread does all.
+
+The other threads are helpers kept from one call to the next: starting a
+thread and waiting for it to run cost 0.1-0.5 ms on the benchmark machine,
+up to half of a 2000 x 2000 sample, against a few microseconds to wake one.
+Between calls a helper waits on a lock of its own, holding no other, and
+runs no work: nothing is left running when a call returns.  The helpers are
+low-level threads (:mod:`_thread`), not counted by
+:func:`threading.active_count`, so a plan still forks its worker processes
+(:mod:`lagsym.toolpath.workers`, which forks only while no other thread
+runs); a forked process has no helpers and starts its own when it needs
+them.  One caller at a time uses the helpers; a call made while another
+thread's call has them runs all its parts itself.
 """
 
 from __future__ import annotations
 
+import _thread
 import os
 import threading
 
@@ -57,33 +68,94 @@ def parts(n: int, per_item: int = 1, align: int = 1) -> list[tuple[int, int]]:
     return [(lo, min(lo + size, n)) for lo in range(0, n, size)]
 
 
-def run_parts(work, cuts: list[tuple[int, int]]) -> None:
-    """``work(start, stop)`` for every part, the first in the calling thread and each other in a thread of its own.
+class _Helper:
+    """A thread kept for later calls: it runs one posted part at a time and waits on its own lock in between."""
 
-    Plain threads, started and joined here: a pool's set-up cost about a
-    third of a millisecond on the benchmark machine, a sixth of a
-    2000 x 2000 sample.  The first error raised in any part is raised again
-    once all have ended.
+    def __init__(self):
+        self._go, self._done = _thread.allocate_lock(), _thread.allocate_lock()
+        self._go.acquire()
+        self._done.acquire()
+        self._part = None
+        self.alive = True
+        _thread.start_new_thread(self._loop, ())
+
+    def _loop(self) -> None:
+        try:
+            while True:
+                self._go.acquire()
+                part, self._part = self._part, None
+                try:
+                    part()  # records its own errors (run_parts)
+                finally:
+                    self._done.release()
+        finally:
+            self.alive = False
+
+    def post(self, part) -> None:
+        """Run ``part()`` in this thread."""
+        self._part = part
+        self._go.release()
+
+    def wait(self) -> None:
+        """Wait until the part posted last has ended."""
+        self._done.acquire()
+
+
+_pool = _thread.allocate_lock()  # held by the one caller using the helpers
+_helpers: list[_Helper] = []
+
+
+def _forget_helpers() -> None:
+    """In a forked child: the helper threads did not come along."""
+    global _pool, _helpers
+    _pool, _helpers = _thread.allocate_lock(), []
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_helpers)
+
+
+def run_parts(work, cuts: list[tuple[int, int]], stop: list | None = None) -> None:
+    """``work(start, stop)`` for every part, the first in the calling thread and each other in a helper of its own.
+
+    The first error raised in any part is raised again once all have ended.
+    Where another thread's call has the helpers, this thread runs the parts
+    one after another.  Interrupted while it waits for the helpers, the call
+    appends to ``stop`` (so a part that checks it ends early), leaves the
+    helpers to end their parts, starts fresh helpers next time, and raises.
     """
     if len(cuts) == 1:
         work(*cuts[0])
         return
+    if not _pool.acquire(blocking=False):
+        for cut in cuts:
+            work(*cut)
+        return
     errors: list[BaseException] = []
 
-    def run(lo, hi):
+    def part(lo, hi):
         try:
             work(lo, hi)
         except BaseException as e:  # raised again in the calling thread
             errors.append(e)
 
-    threads = [threading.Thread(target=run, args=cut, daemon=True) for cut in cuts[1:]]
-    for t in threads:
-        t.start()
     try:
-        work(*cuts[0])
+        _helpers[:] = [h for h in _helpers if h.alive]
+        while len(_helpers) < len(cuts) - 1:
+            _helpers.append(_Helper())
+        busy = _helpers[:len(cuts) - 1]
+        for helper, (lo, hi) in zip(busy, cuts[1:]):
+            helper.post(lambda lo=lo, hi=hi: part(lo, hi))
+        part(*cuts[0])
+        for helper in busy:
+            helper.wait()
+    except BaseException:  # interrupted while the helpers run: they end their parts and are not used again
+        if stop is not None:
+            stop.append(True)
+        _helpers.clear()
+        raise
     finally:
-        for t in threads:
-            t.join()
+        _pool.release()
     if errors:
         raise errors[0]
 
@@ -97,10 +169,8 @@ def run_blocks(work, n: int, block: int, per_item: int = 1) -> None:
     """``work(start, stop)`` over ``n`` items in blocks of ``block``, each thread taking the next block when it is done.
 
     The threads :func:`thread_count` allows, as :func:`run_parts` runs them;
-    where fixed parts would leave the calling thread waiting for one started
-    late (starting a thread took 0.05-0.15 ms on the benchmark machine, a
-    tenth of a 2000 x 2000 sample) or slowed by the machine, here it takes
-    fewer blocks.  Each block is computed as it would be alone, so the values
+    where fixed parts would leave the calling thread waiting for a helper
+    woken late or slowed by the machine, here it takes fewer blocks.  Each block is computed as it would be alone, so the values
     do not depend on which thread computed which.  After an error no thread
     takes another block.
     """
@@ -124,4 +194,4 @@ def run_blocks(work, n: int, block: int, per_item: int = 1) -> None:
                 failed.append(True)
                 raise
 
-    run_parts(take, [(0, n)] * count)
+    run_parts(take, [(0, n)] * count, failed)
