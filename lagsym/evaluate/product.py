@@ -15,9 +15,20 @@ import numpy as np
 from .engine import choose_engine
 from .threads import block_items, run_blocks
 
-__all__ = ["PRODUCT_BLOCK", "grid_product", "readonly_view"]
+__all__ = ["PRODUCT_BLOCK", "aligned_empty", "grid_product", "readonly_view"]
 
 PRODUCT_BLOCK = 1 << 15  # values of a grid product NumPy computes at a time: the block and its scratch stay in cache
+
+
+def aligned_empty(n: int, m: int) -> np.ndarray:
+    """An uninitialised ``(n, m)`` array whose first value starts a 64-byte cache line.
+
+    With a multiple of eight values a row, every row does, and no store of a
+    row straddles two lines.
+    """
+    buf = np.empty(n * m + 8)
+    k = (-buf.ctypes.data % 64) // 8
+    return buf[k:k + n * m].reshape(n, m)
 
 
 def readonly_view(a: np.ndarray) -> np.ndarray:
@@ -41,7 +52,7 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
     (:func:`.threads.run_blocks`).
     """
     n, m = w.shape[0], ty.shape[1]
-    out = np.empty((n, m)) if out is None else out
+    out = aligned_empty(n, m) if out is None else out
     if w.shape[1] == 0:
         out[...] = 0.0
         return out
