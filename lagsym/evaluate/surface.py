@@ -176,8 +176,20 @@ class SurfaceEvaluator:
 
     @staticmethod
     def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Indices into ``v`` of values that are a node exactly, and which node."""
-        k = np.clip(np.searchsorted(nodes, v), 0, len(nodes) - 1)
+        """Indices into ``v`` of values that are a node exactly (ascending), and which node.
+
+        Where ``v`` is a sorted axis many times longer than the nodes (a
+        grid's lines), each node's run of equal values is found by bisection
+        instead of looking up every value.
+        """
+        if v.size > 8 * nodes.size and np.all(v[:-1] <= v[1:]):
+            lo, hi = np.searchsorted(v, nodes, "left"), np.searchsorted(v, nodes, "right")
+            found = np.flatnonzero((hi > lo) & exact)
+            if not found.size:
+                return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+            return (np.concatenate([np.arange(lo[k], hi[k]) for k in found]),
+                    np.repeat(found, hi[found] - lo[found]))
+        k = np.minimum(np.searchsorted(nodes, v), len(nodes) - 1)
         hit = (nodes[k] == v) & exact[k]
         return np.flatnonzero(hit), k[hit]
 
