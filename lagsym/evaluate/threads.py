@@ -9,9 +9,12 @@ free; :func:`run_parts` runs given parts, one a thread.  Below
 :data:`THREAD_POINTS` values a thread the threads would cost more than
 they save, and one thread does all.
 
-The other threads are helpers kept from one call to the next: starting a
-thread and waiting for it to run cost 0.1-0.5 ms on the benchmark machine,
-up to half of a 2000 x 2000 sample, against a few microseconds to wake one.
+The other threads are helpers kept from one call to the next.  Starting a
+thread blocks the caller until the new thread runs: 0.26-0.41 ms (median)
+on the benchmark machine, a quarter of a 2000 x 2000 sample, whose idle
+cores halt and take as long to wake.  Posting a part to a parked helper
+returns in 0.02-0.04 ms, and the helper joins in 0.06-0.09 ms later while
+the calling thread is already at work (``benchmarks/bench_threads.py``).
 Between calls a helper waits on a lock of its own, holding no other, and
 runs no work: nothing is left running when a call returns.  The helpers are
 low-level threads (:mod:`_thread`), not counted by
