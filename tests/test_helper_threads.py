@@ -1,15 +1,21 @@
 """The helper threads kept between large evaluations: reused, parked between calls, safe to fork, never deadlocked."""
 
+import gc
 import os
 import signal
 import subprocess
 import sys
 import threading
 import time
+import weakref
 
+import numpy as np
 import pytest
 
 from lagsym.evaluate import threads
+from lagsym.grid import grid_from_table
+from lagsym.lagrange import lagrange_surface
+from lagsym.sampling import sample
 
 
 def _idents(count: int) -> set[int]:
@@ -99,3 +105,29 @@ def test_the_hand_over_benchmark_runs_and_prints_its_table():
     rows = [ln for ln in done.stdout.splitlines() if ln.startswith("| ") and "us)" not in ln]
     assert len(rows) == 4 and all(len(r.split("|")) == 6 for r in rows)
     assert "the caller held: the peer" in done.stdout
+
+
+def test_nothing_of_a_call_is_kept_by_the_helpers_once_it_returns():
+    class Output:
+        pass
+
+    out, seen = Output(), set()
+    threads.run_parts(lambda lo, hi, out=out: seen.add(threading.get_ident()), [(0, 1), (1, 2)])
+    assert len(seen) == 2  # a helper ran the second part
+    gone = weakref.ref(out)
+    del out
+    assert gone() is None  # the helper's reference to its part died with the call
+    gc.disable()  # freed by its count of references, as soon as the caller drops it: not by a later collection
+    try:
+        s = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 3]]))
+        z = sample(s, 1000, 600).z  # shared among the threads (600,000 values)
+        assert threads.thread_count(1000, 600) < 2 or threads._helpers
+        assert np.isfinite(z).all()
+        memory = z
+        while memory.base is not None:
+            memory = memory.base  # the allocation the grid's values live in
+        gone = weakref.ref(memory)
+        del z, memory
+        assert gone() is None
+    finally:
+        gc.enable()

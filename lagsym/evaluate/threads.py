@@ -15,8 +15,9 @@ on the benchmark machine, a quarter of a 2000 x 2000 sample, whose idle
 cores halt and take as long to wake.  Posting a part to a parked helper
 returns in 0.02-0.04 ms, and the helper joins in 0.06-0.09 ms later while
 the calling thread is already at work (``benchmarks/bench_threads.py``).
-Between calls a helper waits on a lock of its own, holding no other, and
-runs no work: nothing is left running when a call returns.  The helpers are
+Between calls a helper waits on a lock of its own, holding no other, runs
+no work and keeps no reference to the call's work or output: nothing is
+left running, and nothing of the call is kept alive, when a call returns.  The helpers are
 low-level threads (:mod:`_thread`), not counted by
 :func:`threading.active_count`, so a plan still forks its worker processes
 (:mod:`lagsym.toolpath.workers`, which forks only while no other thread
@@ -90,6 +91,7 @@ class _Helper:
                 try:
                     part()  # records its own errors (run_parts)
                 finally:
+                    part = None  # nothing of the call (its output above all) is kept until the next
                     self._done.release()
         finally:
             self.alive = False
