@@ -40,3 +40,17 @@ def test_a_long_sorted_axis_snaps_its_nodes_to_the_control_heights():
             rows, cols = np.flatnonzero(xs == a + 1), np.flatnonzero(ys == b + 1)
             assert rows.size == 1 and cols.size >= 1
             assert (z[np.ix_(rows, cols)] == heights[a, b]).all()
+
+
+def test_the_compiled_lookup_finds_the_same_lines_as_a_comparison_of_every_pair():
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        m = int(rng.integers(1, 8))
+        nodes = np.sort(rng.choice(np.arange(-5, 20) / 4, m, replace=False))
+        exact = rng.random(m) < 0.8
+        v = rng.choice(np.concatenate([nodes, np.arange(-6, 22) / 4, [np.nan, np.inf, -np.inf, -0.0]]),
+                       int(rng.integers(0, 200)))
+        if rng.random() < 0.7:
+            v = np.sort(v)
+        i, k = SurfaceEvaluator._hits(nodes, exact, v, compiled=True)
+        assert (i.tolist(), k.tolist()) == _naive(nodes, exact, v)

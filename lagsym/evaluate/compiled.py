@@ -21,7 +21,7 @@ from numba import njit
 
 from .chebyshev import SPLIT
 
-__all__ = ["BLOCK", "COLUMNS", "basis_kernel", "factor_kernel", "points_kernel", "product_kernel"]
+__all__ = ["BLOCK", "COLUMNS", "basis_kernel", "factor_kernel", "hits_kernel", "points_kernel", "product_kernel"]
 
 BLOCK = 256
 """Points per block: a block's basis values and error terms stay in the first-level cache."""
@@ -148,6 +148,49 @@ def factor_kernel(tx, c, out):  # pragma: no cover - compiled
 
 
 @_inline
+def _first_not_below(a, x, right):  # pragma: no cover - compiled
+    """The first index of ascending ``a`` whose value is not below ``x`` (``right``: above ``x``), or ``a.size``."""
+    lo, hi = 0, a.size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if a[mid] < x or (right and a[mid] == x):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def hits_kernel(nodes, exact, v):  # pragma: no cover - compiled
+    """Indices into ``v`` of values equal to a node (ascending) whose ``exact`` is set, and which node.
+
+    ``nodes`` ascending.  :meth:`.surface.SurfaceEvaluator._hits` in compiled
+    code: on an ascending ``v`` each node's run of equal values is found by
+    bisection in ``v``, otherwise each value is looked up among the nodes.
+    """
+    at, which = np.empty(v.size, dtype=np.intp), np.empty(v.size, dtype=np.intp)
+    count = 0
+    ascending = True
+    for i in range(1, v.size):
+        if not v[i - 1] <= v[i]:  # NaN too
+            ascending = False
+            break
+    if ascending:
+        for k in range(nodes.size):
+            if exact[k]:
+                for i in range(_first_not_below(v, nodes[k], False), _first_not_below(v, nodes[k], True)):
+                    at[count], which[count] = i, k
+                    count += 1
+    elif nodes.size:
+        for i in range(v.size):
+            k = min(_first_not_below(nodes, v[i], False), nodes.size - 1)
+            if nodes[k] == v[i] and exact[k]:
+                at[count], which[count] = i, k
+                count += 1
+    return at[:count].copy(), which[:count].copy()
+
+
+@_inline
 def _first_terms(w, ty, rows, jb, je, out, r):  # pragma: no cover - compiled
     """``out[q][jb:je]`` = the first ``r`` (1 to 5) terms of row ``rows[q]``'s sums, left to right."""
     r0, r1, r2, r3 = rows
@@ -235,3 +278,4 @@ def product_kernel(w, ty, lo, hi, out):  # pragma: no cover - compiled
             _first_terms(w, ty, rows, jb, je, out_rows, first)
             for b in range(first, k, 4):
                 _four_more_terms(w, ty, rows, b, jb, je, out_rows)
+

@@ -171,17 +171,26 @@ class SurfaceEvaluator:
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
         with choose_engine(xs.size * ys.size) as compiled:
+            at, heights = self._grid_hits(xs, ys, compiled)  # while the small arrays are in cache, before the grid
             z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled)
-        return self.snap_grid(z, xs, ys)
+        if heights is not None:
+            z[at] = heights
+        return z
 
     @staticmethod
-    def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _hits(nodes: np.ndarray, exact: np.ndarray, v: np.ndarray,
+              compiled: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Indices into ``v`` of values that are a node exactly (ascending), and which node.
 
         Where ``v`` is a sorted axis many times longer than the nodes (a
         grid's lines), each node's run of equal values is found by bisection
-        instead of looking up every value.
+        instead of looking up every value.  ``compiled`` looks up each value
+        in one compiled pass (:func:`.compiled.hits_kernel`), with the same result.
         """
+        if compiled:
+            from .compiled import hits_kernel
+
+            return hits_kernel(nodes, exact, v)
         if v.size > 8 * nodes.size and np.all(v[:-1] <= v[1:]):
             lo, hi = np.searchsorted(v, nodes, "left"), np.searchsorted(v, nodes, "right")
             found = np.flatnonzero((hi > lo) & exact)
@@ -193,13 +202,23 @@ class SurfaceEvaluator:
         hit = (nodes[k] == v) & exact[k]
         return np.flatnonzero(hit), k[hit]
 
+    def _grid_hits(self, xs: np.ndarray, ys: np.ndarray, compiled: bool = False) -> tuple:
+        """``(index, heights)``: the grid nodes ``(xs[i], ys[j])`` that are control points exactly, and their heights.
+
+        ``(None, None)`` where there are none; ``compiled`` as :meth:`_hits`.
+        """
+        ix, kx = self._hits(self.x_nodes, self.x_exact, xs, compiled)
+        if ix.size:
+            iy, ky = self._hits(self.y_nodes, self.y_exact, ys, compiled)
+            if iy.size:
+                return np.ix_(ix, iy), self.node_values[np.ix_(kx, ky)]
+        return None, None
+
     def snap_grid(self, z: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         """Set ``z[i, j]`` to the control height where ``(xs[i], ys[j])`` is a control point exactly; in place."""
-        ix, kx = self._hits(self.x_nodes, self.x_exact, xs)
-        if ix.size:
-            iy, ky = self._hits(self.y_nodes, self.y_exact, ys)
-            if iy.size:
-                z[np.ix_(ix, iy)] = self.node_values[np.ix_(kx, ky)]
+        at, heights = self._grid_hits(xs, ys)
+        if heights is not None:
+            z[at] = heights
         return z
 
     def points(self, x, y, chunk: int = CHUNK_POINTS) -> np.ndarray:
