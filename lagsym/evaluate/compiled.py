@@ -278,4 +278,3 @@ def product_kernel(w, ty, lo, hi, out):  # pragma: no cover - compiled
             _first_terms(w, ty, rows, jb, je, out_rows, first)
             for b in range(first, k, 4):
                 _four_more_terms(w, ty, rows, b, jb, je, out_rows)
-

@@ -64,6 +64,7 @@ def load_compiled() -> None:
     ev = _WARM_UP
     xs = np.linspace(-1.0, 1.0, 5)
     grid_product(ev.x_factor(xs, True), ev.y_basis(xs, True), compiled=True)
+    ev._grid_hits(xs, xs, True)
     ev._compiled_into(np.empty(5), xs, xs, 0, 5, CHUNK_POINTS)
 
 
@@ -188,9 +189,9 @@ class SurfaceEvaluator:
         in one compiled pass (:func:`.compiled.hits_kernel`), with the same result.
         """
         if compiled:
-            from .compiled import hits_kernel
+            from .compiled import hits_kernel  # Numba loads with the compiled engine, not with lagsym
 
-            return hits_kernel(nodes, exact, v)
+            return hits_kernel(readonly_view(nodes), readonly_view(exact), readonly_view(v))
         if v.size > 8 * nodes.size and np.all(v[:-1] <= v[1:]):
             lo, hi = np.searchsorted(v, nodes, "left"), np.searchsorted(v, nodes, "right")
             found = np.flatnonzero((hi > lo) & exact)

@@ -16,8 +16,8 @@ cores halt and take as long to wake.  Posting a part to a parked helper
 returns in 0.02-0.04 ms, and the helper joins in 0.06-0.09 ms later while
 the calling thread is already at work (``benchmarks/bench_threads.py``).
 Between calls a helper waits on a lock of its own, holding no other, runs
-no work and keeps no reference to the call's work or output: nothing is
-left running, and nothing of the call is kept alive, when a call returns.  The helpers are
+no work and keeps no reference to the call's work or output: when a call
+returns nothing of it is left running or kept alive.  The helpers are
 low-level threads (:mod:`_thread`), not counted by
 :func:`threading.active_count`, so a plan still forks its worker processes
 (:mod:`lagsym.toolpath.workers`, which forks only while no other thread
