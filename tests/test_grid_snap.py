@@ -14,9 +14,11 @@ def _naive(nodes, exact, v):
     return [i for i, _ in pairs], [k for _, k in pairs]
 
 
-def test_the_lines_on_nodes_are_those_a_comparison_of_every_pair_finds():
-    rng = np.random.default_rng(1)
-    for _ in range(2000):
+def _random_axes(seed: int, count: int = 2000):
+    """``count`` random ``(nodes, exact, axis)``: a few quarter-step nodes, most exact, and an axis of nodes, other
+    quarter steps, NaN, infinities and -0.0, sorted seven times in ten."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
         m = int(rng.integers(1, 8))
         nodes = np.sort(rng.choice(np.arange(-5, 20) / 4, m, replace=False))
         exact = rng.random(m) < 0.8
@@ -24,6 +26,11 @@ def test_the_lines_on_nodes_are_those_a_comparison_of_every_pair_finds():
                        int(rng.integers(0, 200)))
         if rng.random() < 0.7:
             v = np.sort(v)
+        yield nodes, exact, v
+
+
+def test_the_lines_on_nodes_are_those_a_comparison_of_every_pair_finds():
+    for nodes, exact, v in _random_axes(1):
         i, k = SurfaceEvaluator._hits(nodes, exact, v)
         assert (i.tolist(), k.tolist()) == _naive(nodes, exact, v)
 
@@ -43,14 +50,6 @@ def test_a_long_sorted_axis_snaps_its_nodes_to_the_control_heights():
 
 
 def test_the_compiled_lookup_finds_the_same_lines_as_a_comparison_of_every_pair():
-    rng = np.random.default_rng(3)
-    for _ in range(2000):
-        m = int(rng.integers(1, 8))
-        nodes = np.sort(rng.choice(np.arange(-5, 20) / 4, m, replace=False))
-        exact = rng.random(m) < 0.8
-        v = rng.choice(np.concatenate([nodes, np.arange(-6, 22) / 4, [np.nan, np.inf, -np.inf, -0.0]]),
-                       int(rng.integers(0, 200)))
-        if rng.random() < 0.7:
-            v = np.sort(v)
+    for nodes, exact, v in _random_axes(3):
         i, k = SurfaceEvaluator._hits(nodes, exact, v, compiled=True)
         assert (i.tolist(), k.tolist()) == _naive(nodes, exact, v)
