@@ -39,12 +39,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from lagsym.gcode.limits import VARIABLE_RANGES  # noqa: E402
 from lagsym.simulate import simulate  # noqa: E402
 from lagsym.simulate.alarms import BlockAlarm, ControlAlarm  # noqa: E402
 from lagsym.simulate.blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, Label,  # noqa: E402
                                     Nop, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, Stop, While, Words)
-from lagsym.simulate.control import Control  # noqa: E402
+from lagsym.simulate.control import ControlState  # noqa: E402
 from lagsym.simulate.executor import _labels, _match_loops  # noqa: E402
 from lagsym.simulate.reader import read_blocks  # noqa: E402
 from lagsym.simulate.runaway import Runaway, endless_jumps  # noqa: E402
@@ -59,7 +58,7 @@ def interpret(text: str, dialect: str = "fanuc", precision: int = 8, stop_after:
     """The moves and the blocks executed, running each block's closures in turn (``stop_after`` > 0: that many)."""
     blocks = _match_loops(read_blocks(text, dialect))
     labels = _labels(blocks)
-    m = Control(dialect, precision, VARIABLE_RANGES[dialect])
+    m = ControlState(dialect, precision)
     handlers = [_RUN[type(b)] for b in blocks]
     runaway = Runaway(endless=endless_jumps(blocks, labels, dialect, precision), blocks=blocks)
     pc, executed = 0, 0

@@ -8,12 +8,12 @@ the one :class:`Placement` (``mm_per_unit`` and ``origin_mm``).
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 
+from .controls import Control, control, names, work_offset
 from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
@@ -21,14 +21,14 @@ __all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TO
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
            "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
-DIALECTS = ("fanuc", "linuxcnc", "heidenhain", "grbl")
+DIALECTS = names()
+"""The names of the registered controls (:data:`lagsym.controls.CONTROLS`)."""
 TOOL_SHAPES = ("ball", "flat", "bull")  # bull: a bull-nose (corner-radius) end mill
 LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
 # A program ends its blocks with LF or CR LF: with CR alone rs274 and ISO tape readers see one block.
 PROGRAM_LINE_ENDINGS = ("lf", "crlf")
 UNITS = ("mm", "inch")
 COOLANTS = ("off", "flood", "mist")  # M08 flood, M07 mist, M09 off at the end
-_WORK_OFFSET = re.compile(r"G5[4-9]|G59\.[1-3]|G54\.1 P[1-9]\d{0,2}")
 DIRECTIONS = ("x", "y")
 BOUNDARIES = ("inside", "centre", "past")
 DEFAULT_TOLERANCE_MM = 0.005
@@ -238,8 +238,9 @@ class MachineSettings:
     Attributes
     ----------
     dialect : str
-        ``fanuc`` (also Haas and ISO-reading Bridgeport controls), ``linuxcnc``,
-        ``heidenhain`` or ``grbl``.
+        The control's name, one of :data:`lagsym.controls.CONTROLS`: ``fanuc``
+        (also ISO-reading Bridgeport controls), ``haas``, ``linuxcnc``,
+        ``heidenhain`` or ``grbl``; :attr:`control` is its value.
     mm_per_unit : float
         Millimetres per surface unit (the CLI's ``--scale``).
     origin_mm : tuple of float
@@ -269,7 +270,7 @@ class MachineSettings:
     surface_units: str = "mm"
 
     def __post_init__(self):
-        choice(self.dialect, DIALECTS, "dialect")
+        c = control(self.dialect)
         choice(self.units, UNITS, "units")
         choice(self.surface_units, UNITS, "surface units")
         choice(self.coolant, COOLANTS, "coolant")
@@ -289,17 +290,21 @@ class MachineSettings:
             v = getattr(self, name)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))):
                 raise InputError(f"{name.replace('_', ' ')} {v!r} must be a whole number")
-        if not (1 <= int(self.program_number) <= 9999):
-            raise ToolpathError(f"program number {self.program_number} must be 1 to 9999")
+        low, high = c.program_numbers
+        if not (low <= int(self.program_number) <= high):
+            raise ToolpathError(f"program number {self.program_number} must be {low} to {high} for a {c.name} program")
         if self.tool_number < 1:
             raise InputError(f"tool number {self.tool_number} must be 1 or more")
         if self.length_offset is not None and self.length_offset < 1:
             raise InputError(f"length offset H{self.length_offset} must be 1 or more")
         if self.decimals is not None and not (0 <= self.decimals <= 6):
             raise ToolpathError(f"decimals {self.decimals} must be 0 to 6")
-        if not isinstance(self.work_offset, str) or not _WORK_OFFSET.fullmatch(self.work_offset):
-            raise InputError(f"work offset {self.work_offset!r} is not one of G54 to G59, G59.1 to G59.3 "
-                             "or G54.1 P1 to P300")
+        work_offset(self.work_offset, exact=True)
+
+    @property
+    def control(self) -> Control:
+        """The control the program is for (:data:`lagsym.controls.CONTROLS`)."""
+        return control(self.dialect)
 
     @property
     def length_offset_number(self) -> int:

@@ -22,12 +22,11 @@ from fractions import Fraction
 
 from .errors import InputError
 
-__all__ = ["as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice", "work_offset",
+__all__ = ["as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
            "NotANumber", "MAX_EXPONENT"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
-_WORK_OFFSET = re.compile(r"^G5[4-9]$|^G59\.[1-3]$|^G54\.1 ?P([1-9]\d?|[12]\d\d|300)$")
 _DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
 
 
@@ -220,23 +219,3 @@ def choice(value, options: Iterable, what: str):
     if value not in options:
         raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
     return value
-
-
-def work_offset(text: str, what: str = "work offset") -> str:
-    """A work-offset word written as a block of its own: G54-G59, G59.1-G59.3 or G54.1 P1-P300, nothing else.
-
-    The word goes into the program as it is, so anything else (a second block, a comment, an M word) is refused.
-
-    Examples
-    --------
-    >>> work_offset("g55"), work_offset("G54.1 P12")
-    ('G55', 'G54.1 P12')
-    >>> work_offset("G54 M30")
-    Traceback (most recent call last):
-    ...
-    lagsym.errors.InputError: work offset 'G54 M30' is not one of G54-G59, G59.1-G59.3 or G54.1 P1-P300
-    """
-    word = str(text).strip().upper()
-    if not _WORK_OFFSET.match(word):
-        raise InputError(f"{what} {text!r} is not one of G54-G59, G59.1-G59.3 or G54.1 P1-P300")
-    return word

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from lagsym.controls import CONTROLS
 from lagsym.errors import ProgramError
 from lagsym.gcode import WordError, numeric_words, parse_moves, strip_comments, words
 from lagsym.gcode import limits
@@ -75,15 +76,12 @@ def test_comments_are_read_as_rs274_reads_them(rs274):
 
 
 def test_the_macro_writers_keep_the_controls_limits():
-    # One table: the writers hold no limits of their own, and the table's rows agree with its columns.
-    for module in (fanuc, linuxcnc, heidenhain):
-        assert not hasattr(module, "MAX_BLOCK") and not hasattr(module, "VARIABLE_RANGES"), module.__name__
-    for dialect in ("fanuc", "linuxcnc", "heidenhain"):
-        assert limits.LIMITS[dialect].max_block == limits.MAX_BLOCK[dialect]
-    for dialect in ("fanuc", "heidenhain"):
-        assert limits.LIMITS[dialect].variables["full"] == limits.MACRO_VARIABLES[dialect]
-    for dialect, ranges in limits.MACRO_VARIABLES.items():
-        assert all(any(lo <= a and b <= hi for lo, hi in limits.VARIABLE_RANGES[dialect]) for a, b in ranges)
+    # One home: the writers and the checks hold no limits of their own; a macro's variables are ones the control reads.
+    for module in (fanuc, linuxcnc, heidenhain, limits):
+        assert not any(hasattr(module, n) for n in ("MAX_BLOCK", "VARIABLE_RANGES", "LIMITS")), module.__name__
+    for c in CONTROLS.values():
+        for ranges in c.macro_variables.values():
+            assert all(any(lo <= a and b <= hi for lo, hi in c.variables) for a, b in ranges), c.name
 
 
 @settings(max_examples=300)

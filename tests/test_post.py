@@ -17,13 +17,14 @@ from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
 from lagsym.machine import MachineSettings, RasterSpec, Tool
-from lagsym.post.program import PointProgram, format_moves, iso_comment, point_program, write_program, writer
+from lagsym.controls import names
+from lagsym.post.program import PointProgram, format_moves, iso_comment, point_program, write_program
 from lagsym.toolpath import plan_toolpath
 
 from conftest import EXAMPLES
 from gcheck import check_feeds, interpret, resolution_mm
 
-POINT_DIALECTS = ("fanuc", "linuxcnc", "grbl")
+POINT_DIALECTS = names(point_lists=True)
 NUMBER_WORD = re.compile(r"([XYZF])(-?[0-9.]+)")
 
 
@@ -104,8 +105,8 @@ def test_safe_z_must_clear_the_path(path4):
 def test_unknown_dialect_names_the_choices():
     with pytest.raises(InputError, match="fanuc"):
         MachineSettings(dialect="sinumerik")
-    with pytest.raises(ProgramError, match="point-list writer"):
-        writer("heidenhain")
+    with pytest.raises(ProgramError, match="heidenhain.*no point-list writer; use one of fanuc, linuxcnc, grbl"):
+        write_program(PointProgram(np.zeros((2, 3)), MachineSettings(dialect="heidenhain")))
 
 
 def test_the_program_model_is_read_only():
@@ -141,15 +142,6 @@ def test_the_interpreter_check_catches_a_bad_program(rs274):
         interpret(rs274, "G21 G90\nG1 X1. F100.\nG1 X2. Q5.\nM2\n")
     with pytest.raises(AssertionError, match="no percent sign or program end"):
         interpret(rs274, "G21 G90\nG1 X1. F100.\n")
-
-
-def test_the_dialect_modules_do_not_import_the_writer_table():
-    """lagsym.post.program imports the dialects for WRITERS; nothing below it imports it back."""
-    import grimp
-
-    graph = grimp.build_graph("lagsym")
-    for module in ("fanuc", "linuxcnc", "grbl", "model", "moves"):
-        assert not graph.find_shortest_chain(importer=f"lagsym.post.{module}", imported="lagsym.post.program")
 
 
 @pytest.mark.parametrize("dialect", POINT_DIALECTS)

@@ -14,12 +14,11 @@ import math
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from lagsym.gcode.limits import VARIABLE_RANGES
 from lagsym.simulate import ControlAlarm, simulate
 from lagsym.simulate.alarms import BlockAlarm
 from lagsym.simulate.blocks import Assign, AssignNamed, IfThen, Words
 from lagsym.simulate.compiler import compile_program
-from lagsym.simulate.control import Control
+from lagsym.simulate.control import ControlState
 from lagsym.simulate.executor import _labels, _match_loops, _run
 from lagsym.simulate.reader import read_blocks
 from lagsym.simulate.runaway import Runaway
@@ -27,7 +26,7 @@ from lagsym.simulate.runaway import Runaway
 
 def interpreted(text: str, dialect: str, precision: int):
     """Variables, moves or alarm of a straight program, each block's closures called in turn."""
-    m = Control(dialect, precision, VARIABLE_RANGES[dialect])
+    m = ControlState(dialect, precision)
     try:
         blocks = read_blocks(text, dialect)
     except ControlAlarm as e:
@@ -54,7 +53,7 @@ def interpreted(text: str, dialect: str, precision: int):
 
 def compiled(text: str, dialect: str, precision: int):
     """The same from the compiled segments."""
-    m = Control(dialect, precision, VARIABLE_RANGES[dialect])
+    m = ControlState(dialect, precision)
     try:
         blocks = _match_loops(read_blocks(text, dialect))
         table, where = compile_program(m, blocks, _labels(blocks))

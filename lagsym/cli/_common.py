@@ -8,7 +8,8 @@ from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
-from ..values import as_exact, in_range, whole, work_offset
+from ..controls import CONTROLS, work_offset
+from ..values import as_exact, in_range, whole
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:
@@ -119,9 +120,14 @@ def SPINDLE_RPM(text: str) -> float:  # noqa: N802 - named as the other option t
 HEIGHT_MM = number(-LENGTH_MM, LENGTH_MM, "mm")
 STOCK_MM = number(0.0, 100.0, "mm")
 DECIMALS = count(0, 6)
-PROGRAM_NUMBER = count(1, 9999)
+PROGRAM_NUMBER = count(1, max(c.program_numbers[1] for c in CONTROLS.values()))  # the control's own range is checked
 TOOL_NUMBER = count(0, 9999)
 DIGITS = count(1, 1000)
+
+
+def dialect_help(choices) -> str:
+    """The ``--dialect`` choices with the controls each stands for, the first the default."""
+    return ", ".join(f"{n} ({'default; ' if i == 0 else ''}{CONTROLS[n].title})" for i, n in enumerate(choices))
 
 
 def WORK_OFFSET(text: str) -> str:  # noqa: N802 - named as the other option types

@@ -8,7 +8,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
-from ._common import (FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -35,7 +35,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
-    p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help="control language (default fanuc)")
+    p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help=f"the control: {dialect_help(MACRO_DIALECTS)}")
     p.add_argument("--precision", type=int, choices=PRECISIONS,
                    help="significant digits of the control's arithmetic "
                         "(default 8 for fanuc and heidenhain, 15 for linuxcnc)")

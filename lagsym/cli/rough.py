@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from ..controls import control, names
 from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
+from ._common import (dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
                       number, origin)
 from .job import add_max_points
 
@@ -38,10 +39,12 @@ examples:
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
-    p.add_argument("--dialect", choices=("fanuc", "linuxcnc", "grbl"), default="fanuc", help="fanuc (default), linuxcnc or grbl")
+    p.add_argument("--dialect", choices=names(point_lists=True), default="fanuc",
+                   help=f"the control: {dialect_help(names(point_lists=True))}")
     p.add_argument("--macro", action="store_true",
-                   help="write a parametric macro (fanuc or linuxcnc): the control computes every height from the "
-                        "surface equation plus a proved clearance; a few kilobytes whatever the block")
+                   help=f"write a parametric macro ({' or '.join(names(point_lists=True, macros=True))}): the control "
+                        "computes every height from the surface equation plus a proved clearance; a few kilobytes "
+                        "whatever the block")
     p.add_argument("--precision", type=int, choices=(8, 15), metavar="N",
                    help="with --macro: significant digits of the control's arithmetic, 8 or 15 "
                         "(default 8 for fanuc, 15 for linuxcnc)")
@@ -132,8 +135,9 @@ def _refuse(args) -> None:
 
     if args.precision is not None and not args.macro:
         raise InputError(f"--precision {args.precision} applies to a macro only: add --macro or leave it out")
-    if args.macro and args.dialect == "grbl":
-        raise InputError("--macro: a roughing macro is written for fanuc or linuxcnc, not grbl (no macro language)")
+    if args.macro and control(args.dialect).macro is None:
+        raise InputError(f"--macro: a roughing macro is written for {' or '.join(names(point_lists=True, macros=True))}, "
+                         f"not {args.dialect} (no macro language)")
     if args.pattern == "offset" and args.direction is not None:
         raise InputError(f"--direction {args.direction} does not apply with --pattern offset (rectangles, no rows)")
     if args.pattern == "offset" and args.milling == "zigzag":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..controls import CONTROLS, control
 from ..io import read_program
 from ..simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, SIM_DIALECTS, detect_dialect, moves_csv, simulate
 from ._common import count, emit
@@ -34,9 +35,11 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("program", help="the program file")
-    p.add_argument("--dialect", choices=SIM_DIALECTS, help="control language (default: guessed from the text)")
+    p.add_argument("--dialect", choices=SIM_DIALECTS,
+                   help="the control (default: guessed from the text: fanuc, linuxcnc or heidenhain)")
     p.add_argument("--precision", type=int, choices=(8, 15),
-                   help="significant digits (default 8 for fanuc and heidenhain, 15 for linuxcnc)")
+                   help="significant digits (default the control's: " + ", ".join(
+                       f"{c.macro.default_precision} for {c.name}" for c in CONTROLS.values() if c.macro) + ")")
     p.add_argument("--max-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_BLOCKS, metavar="N",
                    help=f"stop after N executed blocks as a runaway loop (default {MAX_BLOCKS}; the moves take "
                         f"at most {BYTES_PER_MOVE} bytes a block, up to {MAX_BLOCKS_LIMIT})")
@@ -48,7 +51,7 @@ def add_arguments(p) -> None:
 def run(args, out, err) -> int:
     text = read_program(args.program)
     dialect = args.dialect or detect_dialect(text)
-    precision = args.precision or (15 if dialect == "linuxcnc" else 8)
+    precision = args.precision or control(dialect).macro.default_precision
     with progress_bar(err) as progress:
         sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks,
                        progress=progress)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..controls import names
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
 from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec,
@@ -9,7 +10,7 @@ from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import (CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+from ._common import (dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._progress import progress_bar
 
@@ -27,14 +28,14 @@ examples:
   lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 --safe-z 400 \\
       --dialect linuxcnc -o part.ngc"""
 
-POINT_DIALECTS = ("fanuc", "linuxcnc", "grbl")
+POINT_DIALECTS = names(point_lists=True)
 
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=POINT_DIALECTS, default="fanuc",
-                   help="fanuc (default; also Haas and ISO-reading Bridgeport controls), linuxcnc or grbl")
+                   help=f"the control: {dialect_help(POINT_DIALECTS)}")
     g = p.add_argument_group("raster")
     g.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
     g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")

@@ -1,10 +1,11 @@
 """One program for a whole job: the header, each operation with its tool change, spindle and coolant, the end.
 
 Moves are written by :func:`lagsym.post.format_moves` (Z rounded up, modal
-words left out), rapids as ``G00``.  Fanuc and LinuxCNC change tools with
-``T M06`` and take each tool's length with ``G43 H``; Grbl has no tool
-changer, so the program stops (``M00``) for the operator to change the tool
-and set its length.  The cycle-time estimate counts feed moves at their
+words left out), rapids as ``G00``.  The framing is the control's
+(:class:`~lagsym.controls.Framing`): a control with a tool changer changes
+tools with ``T M06`` and takes each tool's length with ``G43 H``; one without
+(Grbl) stops the program (``M00``) for the operator to change the tool and set
+its length.  The cycle-time estimate counts feed moves at their
 feeds and rapids at the job's rapid rate, along straight lines.
 """
 
@@ -67,32 +68,27 @@ def job_program(job: PlannedJob) -> JobProgram:
     for op, m in zip(job.operations, minutes):
         lines += _operation(op, _settings(spec, op.spec), spec, changed=op.tool.number != current)
         current = op.tool.number
-    lines += ["M05", "M30", "%"] if spec.dialect == "fanuc" else ["M05", "M02"]
+    f = base.control.framing
+    lines += ["M05", f.end] + (["%"] if f.percent else [])
     return JobProgram(base.eol.join(lines) + base.eol, minutes)
 
 
-def _comment(text: str, dialect: str) -> str:
-    t = iso_comment(text)
-    return f"({t[:70] if dialect == 'grbl' else t})"
-
-
 def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
-    spec = job.spec
-    out = []
+    spec, f = job.spec, s.control.framing
+    out = ["%"] if f.percent else []
     title = iso_comment(spec.title)
-    if spec.dialect == "fanuc":
-        out += ["%", f"O{spec.program_number:04d}" + (f" ({title})" if title else "")]
+    if f.program_word:
+        out.append(f.program_word.format(spec.program_number) + (f" ({title})" if title else ""))
     elif title:
-        out.append(_comment(title, spec.dialect))
+        out.append(f.comment(title))
     st = job.stock
-    out.append(_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM", spec.dialect))
+    out.append(f.comment(iso_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM")))
     for i, (op, m) in enumerate(zip(job.operations, minutes), 1):
         t = op.tool
         kind = op.spec.kind + (" MACRO" if isinstance(op.path, RoughMacro) else "")
-        out.append(_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN", spec.dialect))
-    out.append(_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN",
-                        spec.dialect))
-    out.append(f"{units_word(s)} G17 G90 G94" if spec.dialect == "grbl" else f"{units_word(s)} G17 G40 G49 G80 G90 G94")
+        out.append(f.comment(iso_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN")))
+    out.append(f.comment(iso_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN")))
+    out.append(f"{units_word(s)} {f.safe_start}")
     out.append(spec.work_offset)
     return out
 
@@ -101,19 +97,21 @@ def _operation(op, s: MachineSettings, spec, changed: bool) -> list[str]:
     """The blocks of one operation: tool change (when the tool changes), spindle, coolant, moves, retract."""
     t, p = op.tool, op.points_mm
     num = lambda v: fixed(float(v) * s.unit_factor, s.digits)  # noqa: E731 - one length format for this operation
-    out = [_comment(f"{op.spec.kind} {t.name} T{t.number} {t.tool.label}", spec.dialect)]
+    c = s.control
+    f = c.framing
+    out = [f.comment(iso_comment(f"{op.spec.kind} {t.name} T{t.number} {t.tool.label}"))]
     if changed:
-        if spec.dialect == "grbl":
-            out += ["M05", f"G00 Z{num(spec.safe_z_mm)}", _comment(f"LOAD T{t.number} AND SET ITS LENGTH", "grbl"),
-                    "M00"]
+        if f.tool_change:
+            out.append(f"T{t.number} {f.tool_change}")
         else:
-            out.append(f"T{t.number} M06")
+            out += ["M05", f"G00 Z{num(spec.safe_z_mm)}", f.comment(iso_comment(f"LOAD T{t.number} AND SET ITS LENGTH")),
+                    "M00"]
     out.append(f"S{int(round(op.spec.spindle_rpm))} M03")
     coolant = COOLANTS[op.spec.coolant]
     if coolant:
         out.append(coolant)
     out.append(f"G00 X{num(p[0, 0])} Y{num(p[0, 1])}")
-    out.append(f"G00 Z{num(spec.safe_z_mm)}" if spec.dialect == "grbl" else f"G43 H{t.number} Z{num(spec.safe_z_mm)}")
+    out.append(f"G43 H{t.number} Z{num(spec.safe_z_mm)}" if c.length_offsets else f"G00 Z{num(spec.safe_z_mm)}")
     if isinstance(op.path, RoughMacro):
         out += rough_macro_blocks(op.path, s)
     else:

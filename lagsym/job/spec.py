@@ -4,7 +4,7 @@ An unknown key, a missing one or a bad value is refused with the file, the
 key and (for a choice) the valid values.  Example::
 
     points = "paper-example-4.json"     # relative to the job file
-    dialect = "linuxcnc"                 # fanuc, linuxcnc or grbl
+    dialect = "linuxcnc"                 # fanuc, haas, linuxcnc or grbl
     scale = 20                           # mm per surface unit
     safe_z = 80
 
@@ -31,6 +31,7 @@ from pathlib import Path
 
 from ..errors import InputError, LagsymError
 from ..io.files import read_bytes
+from ..controls import control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
 from ..values import in_range
@@ -40,7 +41,8 @@ __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KIN
 KINDS = ("rough", "semi-finish", "finish", "cross-finish")
 """Operation kinds, in the order a machinist runs them."""
 COOLANTS = {"off": None, "flood": "M08", "mist": "M07"}
-JOB_DIALECTS = ("fanuc", "linuxcnc", "grbl")
+JOB_DIALECTS = names(point_lists=True)
+"""The controls a job is written for: those with point-list programs."""
 
 _TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": list, "work_offset": str,
         "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
@@ -126,7 +128,8 @@ def _keys(table: dict, allowed: dict, where: str, source: str) -> dict:
 
 _NAMES = {float: "a number", int: "a whole number", str: "a string", list: "a list", dict: "a table",
           bool: "true or false"}
-MACRO_DIALECTS = ("fanuc", "linuxcnc")  # of the job's dialects, those with a macro language
+MACRO_DIALECTS = names(point_lists=True, macros=True)
+"""Of the job's controls, those with a macro language (a roughing operation may be a macro)."""
 PRECISIONS = (8, 15)
 
 
@@ -184,17 +187,18 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         if ranks[i] < ranks[i - 1]:
             raise InputError(f"{source}: operations[{i}] ({ops[i].kind}) comes after {ops[i - 1].kind}; "
                              f"run them in the order {', '.join(KINDS)}")
-    dialect = data.get("dialect", "fanuc")
+    dialect = _choice(data.get("dialect", "fanuc"), JOB_DIALECTS, "dialect", source)
     for i, op in enumerate(ops):
         if op.options.get("macro") and dialect not in MACRO_DIALECTS:
             raise InputError(f"{source}: operations[{i}].macro: a roughing macro is written for "
                              f"{' or '.join(MACRO_DIALECTS)}, not {dialect!r}")
     program_number = data.get("program_number", 1000)
-    if not 1 <= program_number <= 9999:
-        raise InputError(f"{source}: program_number = {program_number} must be 1 to 9999")
+    low, high = control(dialect).program_numbers
+    if not low <= program_number <= high:
+        raise InputError(f"{source}: program_number = {program_number} must be {low} to {high}")
     return JobSpec(
         source=source, points=base / data["points"],
-        dialect=_choice(data.get("dialect", "fanuc"), JOB_DIALECTS, "dialect", source),
+        dialect=dialect,
         units=_choice(data.get("units", "mm"), UNITS, "units", source),
         mm_per_unit=_positive(data.get("scale", 1.0), "scale", source),
         origin_mm=tuple(_length(v, f"origin[{k}]", source) for k, v in enumerate(origin)),

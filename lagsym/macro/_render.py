@@ -58,7 +58,7 @@ def iso_end(settings: MachineSettings, stop: str) -> list[str]:
 
 def check_text(lines, settings: MachineSettings) -> None:
     """Refuse a block longer than the dialect's control reads (see :mod:`lagsym.gcode.limits`)."""
-    check_blocks(lines, settings.dialect)
+    check_blocks(lines, settings.control)
 
 
 def number_variables(body, base: int, ranges: tuple[tuple[int, int], ...], letter: str = "#") -> dict[str, int]:

@@ -1,15 +1,17 @@
-"""Fanuc Custom Macro B (also Haas): ``#`` variables, ``WHILE [..] DOm .. ENDm``, ``[ ]`` brackets.
+"""Fanuc Custom Macro B (Fanuc, and Haas, whose macros are Fanuc's): ``#`` variables, ``WHILE [..] DOm .. ENDm``.
 
-Limits kept (see docs/macros.md and :mod:`lagsym.gcode.limits`): common
-variables ``#100-#199`` or ``#500-#999`` (``#100-#149``, ``#500-#531`` on the
-``small`` profile); at most 3 nested ``DO`` levels (the program uses 2); at most 5
-nested brackets (expressions here use at most 2); a decimal point on every
-constant, at most 8 significant digits on 8-digit controls, no exponent;
-``O`` number 1-9999; ``%`` framing.
+Limits kept (see docs/macros.md and :mod:`lagsym.controls`): the control's
+common variables (a Fanuc's ``#100-#199`` or ``#500-#999``, ``#100-#149`` and
+``#500-#531`` on the ``small`` profile; a Haas's general-purpose ranges); at
+most 3 nested ``DO`` levels (the program uses 2); at most 5 nested brackets
+(expressions here use at most 2); a decimal point on every constant, at most 8
+significant digits on 8-digit controls, no exponent; the control's ``O``
+number and ``%`` framing.
 """
 
 from __future__ import annotations
 
+from ..controls import Control
 from ..errors import ProgramError
 from ..gcode.limits import variable_ranges
 from ._render import check_text, expression, header_comments, iso_end, iso_start, literal, number_variables
@@ -20,10 +22,15 @@ __all__ = ["render", "body_lines", "DEFAULT_BASE"]
 DEFAULT_BASE = 100
 
 
-def body_lines(loops, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> list[str]:
-    """The blocks of the loops alone (no header, approach or end), for a program that frames them itself."""
+def body_lines(loops, precision: int = 8, variable_base: int | None = None, variables: str = "full", *,
+               control: str | Control = "fanuc") -> list[str]:
+    """The blocks of the loops alone (no header, approach or end), for a program that frames them itself.
+
+    The variables are numbered from ``variable_base`` within the ranges of
+    ``control``'s macro option ``variables``.
+    """
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
-    number = number_variables(loops.body, base, variable_ranges("fanuc", variables))
+    number = number_variables(loops.body, base, variable_ranges(control, variables))
 
     def name(v):
         return f"#{number[v.name]}"
@@ -62,11 +69,11 @@ def body_lines(loops, precision: int = 8, variable_base: int | None = None, vari
 
 def render(loops, settings, precision: int = 8, variable_base: int | None = None, variables: str = "full") -> str:
     """The Fanuc macro program for ``loops`` (a :class:`~lagsym.macro.loops.MacroLoops`) as text with the settings' line endings."""
-    out = ["%", f"O{settings.program_number:04d} ({loops.title})"]
+    out = ["%", settings.control.framing.program_word.format(settings.program_number) + f" ({loops.title})"]
     out += [f"({c})" for c in header_comments(loops, settings, precision)]
     out.append(f"G{'21' if settings.units == 'mm' else '20'} G17 G40 G49 G80 G90")
     out += iso_start(loops, settings, ("M6", "M3"))
-    out += body_lines(loops, precision, variable_base, variables)
+    out += body_lines(loops, precision, variable_base, variables, control=settings.control)
     out += iso_end(settings, "M30") + ["%"]
     check_text(out, settings)
     return settings.eol.join(out) + settings.eol

@@ -121,7 +121,7 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
     base = DEFAULT_BASE if variable_base is None else int(variable_base)
     names = variables_of(loops.body) + [f"h{n}" for n in range(SCRATCH)]
     number = number_variables([Assign(Var(n), Const(0)) for n in names], base,
-                              variable_ranges("heidenhain", variables), letter="Q")
+                              variable_ranges(settings.control, variables), letter="Q")
     dp, uf = settings.digits, settings.unit_factor
     unit = "MM" if settings.units == "mm" else "INCH"
 
@@ -148,5 +148,5 @@ def render(loops, settings, precision: int = 8, variable_base: int | None = None
     out.append(f"L Z{safe} R0 FMAX M30")
     out.append(f"END PGM {settings.program_number} {unit}")
     lines = [f"{n} {line}" for n, line in enumerate(out)]
-    check_blocks(lines, "heidenhain")
+    check_blocks(lines, settings.control)
     return settings.eol.join(lines) + settings.eol

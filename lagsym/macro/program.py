@@ -10,9 +10,11 @@ dialect's writer from :data:`RENDERERS`.  The result is a
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
+from ..controls import CONTROLS, control, names
 from ..errors import ProgramError, ToolpathError
 from ..lagrange import LagrangeSurface
 from ..machine import MachineSettings, RasterSpec, Tool
@@ -29,9 +31,12 @@ __all__ = ["MACRO_DIALECTS", "PRECISIONS", "DEFAULT_PRECISION", "DEFAULT_FORM", 
            "macro_program"]
 
 RENDERERS = {"fanuc": fanuc.render, "linuxcnc": linuxcnc.render, "heidenhain": heidenhain.render}
-MACRO_DIALECTS = tuple(RENDERERS)
+"""The macro writer of each macro language (:attr:`lagsym.controls.MacroLanguage.name`)."""
+MACRO_DIALECTS = names(macros=True)
+"""The controls with a macro language."""
 PRECISIONS = (8, 15)
-DEFAULT_PRECISION = {"fanuc": 8, "linuxcnc": 15, "heidenhain": 8}
+DEFAULT_PRECISION = MappingProxyType({c.name: c.macro.default_precision for c in CONTROLS.values() if c.macro})
+"""Each macro control's default arithmetic precision, from its :class:`~lagsym.controls.MacroLanguage`."""
 DEFAULT_FORM = {8: "lagrange", 15: "horner"}
 
 
@@ -125,8 +130,9 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
         For a flat-end cutter with a diameter (see :func:`lagsym.macro.loops.macro_loops`),
         or a safe Z less than the feed height above the path.
     """
-    dialect = choice(settings.dialect, MACRO_DIALECTS, "macro dialect")
-    precision = DEFAULT_PRECISION[dialect] if precision is None else choice(int(precision), PRECISIONS, "precision")
+    c = control(settings.dialect, "macro dialect", MACRO_DIALECTS)
+    dialect = c.name
+    precision = c.macro.default_precision if precision is None else choice(int(precision), PRECISIONS, "precision")
     form = DEFAULT_FORM[precision] if form is None else choice(form, FORMS, "form")
     loops = macro_loops(surface, settings, raster, tool, form)
     _check_clearance(surface, settings, tool, loops)
@@ -138,5 +144,5 @@ def macro_program(surface: LagrangeSurface, settings: MachineSettings, raster: R
             f"more than the tolerance {tolerance_mm:g} mm; use a control with 15-digit arithmetic "
             f"(--precision 15){', the lagrange form' if form == 'horner' else ''}, fewer control points, "
             f"or the point-list toolpath")
-    text = RENDERERS[dialect](loops, settings, precision=precision, variable_base=variable_base, variables=variables)
+    text = RENDERERS[c.macro.name](loops, settings, precision=precision, variable_base=variable_base, variables=variables)
     return MacroProgram(text=text, dialect=dialect, precision=precision, predicted_error_mm=err_mm, loops=loops)

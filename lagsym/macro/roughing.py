@@ -39,6 +39,7 @@ from fractions import Fraction
 import numpy as np
 
 from .._arrays import freeze_fields
+from ..controls import control, names
 from ..errors import ToolpathError
 from ..evaluate import surface_evaluator
 from ..machine import MachineSettings, Tool
@@ -53,9 +54,9 @@ from .raster import Axis, MacroRaster
 __all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]
 
 MACRO_MILLING = ("zigzag",)
-_GRID = Fraction(1, 10_000)
-TILES = {"fanuc": 8, "linuxcnc": 8}  # tiles a side of the clearance tables; other dialects: one tile, no table
-TABLE_BASE = {"fanuc": 500, "linuxcnc": 1000}  # the tables' first variable number  # the loops' constants (positions, steps, levels) on a 0.0001 grid of program units
+JOB_MACROS = names(point_lists=True, macros=True)
+"""The controls a job's roughing macro is written for: a macro language inside a point-list program."""
+_GRID = Fraction(1, 10_000)  # the loops' constants (positions, steps, levels) on a 0.0001 grid of program units
 
 
 @dataclass(frozen=True)
@@ -292,7 +293,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     check_rough_request(tool, stock, spec, ev, place, max_points, "--max-points")
     per_mm = Fraction(1) if settings.units == "mm" else Fraction(5, 127)
     rf = row_form(surface, settings, spec.direction, form)
-    tiles = TILES[settings.dialect] if settings.dialect in TILES else 1
+    language = settings.control.macro
+    tiles = language.table_tiles if language is not None and language.table_base is not None else 1
     lay = _layout(rf, stock, tool, spec, per_mm, tiles)
     radius = _near(tool.radius_mm, per_mm)
     arith = _arithmetic_mm(rf, lay, radius, ev, place, settings, per_mm, precision)
@@ -316,7 +318,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     if tiles == 1:
         tables, setup = (a[0][0], b[0][0]), ()
     else:
-        base = TABLE_BASE[settings.dialect]
+        base = language.table_base
         tables = (base, tiles)
         setup = tuple(SetItem(base + k * tiles * tiles + ir * tiles + ip, const(t[ip][ir]))
                       for k, t in enumerate((a, b)) for ir in range(tiles) for ip in range(tiles))
@@ -387,7 +389,7 @@ def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base:
     from . import fanuc, linuxcnc
     from ..gcode.numbers import fixed
 
-    dialect = choice(settings.dialect, ("fanuc", "linuxcnc"), "dialect of a roughing macro in a job")
+    c = control(settings.dialect, "dialect of a roughing macro in a job", JOB_MACROS)
     uf, dp = settings.unit_factor, settings.digits
     z0 = float(rm.loops.start[2])
     out = []
@@ -395,9 +397,9 @@ def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base:
         out.append(f"G00 Z{fixed(z0 + settings.feed_height_mm * uf, dp)}")
     out.append(f"G01 Z{fixed(z0, dp)} F{fixed(settings.plunge_feed_mm_min * uf, 1, trim=True)}")
     out.append(f"F{fixed(settings.feed_mm_min * uf, 1, trim=True)}")
-    if dialect == "fanuc":
-        return out + fanuc.body_lines(rm.loops, rm.precision, variable_base)
-    return out + linuxcnc.body_lines(rm.loops, rm.precision)
+    if c.macro.name == "linuxcnc":
+        return out + linuxcnc.body_lines(rm.loops, rm.precision)
+    return out + fanuc.body_lines(rm.loops, rm.precision, variable_base, control=c)
 
 
 def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
@@ -405,6 +407,6 @@ def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base
     """The whole program for ``rm``: header, tool, approach, the loops, the end (Fanuc, LinuxCNC or Heidenhain)."""
     from .program import RENDERERS
 
-    dialect = choice(settings.dialect, tuple(RENDERERS), "macro dialect")
-    return RENDERERS[dialect](rm.loops, settings, precision=rm.precision, variable_base=variable_base,
+    c = control(settings.dialect, "macro dialect", names(macros=True))
+    return RENDERERS[c.macro.name](rm.loops, settings, precision=rm.precision, variable_base=variable_base,
                               variables=variables)

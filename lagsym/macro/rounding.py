@@ -48,18 +48,25 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..controls import CONTROLS
 from ..machine import MachineSettings
 from .model import Assign, Var, add, const, div, mul, round_, sub, var
 
 __all__ = ["ROUNDING_DIALECTS", "resolution", "slope_lift", "round_statement", "round_half_away", "tip_statements",
            "tips_on_grid", "tip_lift"]
 
-ROUNDING_DIALECTS = ("fanuc", "linuxcnc")  # macro languages with ROUND[..]
+ROUNDING_DIALECTS = tuple(c.name for c in CONTROLS.values() if c.macro is not None and c.macro.rounds)
+"""The controls whose macro language has ``ROUND[..]`` (:attr:`lagsym.controls.MacroLanguage.rounds`)."""
+
+
+def _rounds(settings: MachineSettings) -> bool:
+    macro = settings.control.macro
+    return macro is not None and macro.rounds
 
 
 def resolution(settings: MachineSettings) -> Fraction:
     """One unit of the program's last decimal where the control rounds positions itself, else 0."""
-    if settings.dialect not in ROUNDING_DIALECTS:
+    if not _rounds(settings):
         return Fraction(0)
     return Fraction(1, 10 ** settings.digits)
 
@@ -78,7 +85,7 @@ def slope_lift(surface, settings: MachineSettings) -> Fraction:
     >>> slope_lift(s, MachineSettings(dialect="heidenhain"))
     Fraction(3, 1000)
     """
-    if settings.dialect in ROUNDING_DIALECTS:
+    if _rounds(settings):
         return Fraction(0)
     from ..evaluate import surface_evaluator
 

@@ -37,7 +37,6 @@ and runs those functions on the arithmetic and variables of
 
 from __future__ import annotations
 
-from ..gcode.limits import MAX_BLOCK, VARIABLE_RANGES
 from .alarms import ControlAlarm
 from .executor import MAX_DO, simulate
 from .expressions import MAX_BRACKETS
@@ -46,5 +45,5 @@ from .result import BYTES_PER_MOVE, SimMove, SimMoves, Simulation, moves_csv
 from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS
 
 __all__ = ["ControlAlarm", "SimMove", "SimMoves", "Simulation", "simulate", "detect_dialect", "moves_csv",
-           "SIM_DIALECTS", "VARIABLE_RANGES", "MAX_BLOCK", "MAX_BRACKETS", "MAX_DO",
+           "SIM_DIALECTS", "MAX_BRACKETS", "MAX_DO",
            "MAX_BLOCKS", "MAX_IDLE_BLOCKS", "BYTES_PER_MOVE"]

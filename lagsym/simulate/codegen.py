@@ -124,7 +124,7 @@ class Segment:
         if ref[0] != "lit":
             return f"GET({self.index(ref)})"
         n = ref[1]
-        if n == 0 and self.gen.m.dialect == "fanuc":
+        if n == 0 and self.gen.m.language.vacant_zero:
             return "Z"  # #0 is always vacant; vacant reads as 0
         if not self.gen.in_range(n):
             return f"GET({n})"  # the control's alarm when the block runs
@@ -160,7 +160,7 @@ class Segment:
     # ------------------------------------------------------------------ statements
 
     def assign(self, b: Assign, conditional: bool = False) -> None:
-        """``#n = expr``: the value first, then the variable's check, as :meth:`Control.set` does."""
+        """``#n = expr``: the value first, then the variable's check, as :meth:`ControlState.set` does."""
         ref = b.target.node
         if ref[0] != "lit":
             r, t = self.temp(), self.temp()
@@ -169,7 +169,7 @@ class Segment:
             self.emit(f"V[CHECK({r})] = P({t})")
             return
         n = ref[1]
-        if not self.gen.in_range(n) or (n == 0 and self.gen.m.dialect == "fanuc"):
+        if not self.gen.in_range(n) or (n == 0 and self.gen.m.language.vacant_zero):
             self.emit(f"{self.temp()} = {self.value(b.value.node)}")
             self.emit(f"CHECK({n})")
             return

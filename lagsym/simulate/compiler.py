@@ -244,7 +244,7 @@ def compile_program(m, blocks, labels) -> tuple[list, list[int]]:
 
     The first list has, at each block where a segment starts, ``(function,
     blocks in it, index of its last block)``, and None elsewhere.  ``m`` is
-    the :class:`~lagsym.simulate.control.Control` the functions run on: they
+    the :class:`~lagsym.simulate.control.ControlState` the functions run on: they
     read and set its variables, modes and moves.
     """
     prog = _Program(m, blocks, labels)

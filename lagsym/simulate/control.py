@@ -10,16 +10,25 @@ from __future__ import annotations
 import math
 from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND_UP, Context, Decimal
 
+from ..controls import Control, control
 from .alarms import BlockAlarm
 from .result import SimMoves
 
-__all__ = ["Control"]
+__all__ = ["ControlState"]
 
-class Control:
-    """Variables, modal state and arithmetic of one run."""
 
-    def __init__(self, dialect: str, precision: int, ranges):
-        self.dialect, self.precision, self.ranges = dialect, precision, ranges
+class ControlState:
+    """Variables, modal state and arithmetic of one run on a control (a :class:`~lagsym.controls.Control`).
+
+    ``ranges`` are the variable numbers the program may use, by default the control's.
+    """
+
+    def __init__(self, dialect: str | Control, precision: int, ranges=None):
+        c = control(dialect)
+        if c.macro is None:
+            raise ValueError(f"a {c.name} control has no macro language to simulate")
+        self.dialect, self.language = c.name, c.macro
+        self.precision, self.ranges = precision, c.variables if ranges is None else ranges
         self.ctx = Context(prec=precision, Emin=-99, Emax=99)
         self.vars: dict[int, Decimal] = {}
         self.constants: dict[str, Decimal] = {}
@@ -33,7 +42,7 @@ class Control:
     def const(self, text: str) -> Decimal:
         value = self.constants.get(text)
         if value is None:
-            if self.dialect == "fanuc":
+            if self.language.counts_digits:
                 whole, _, frac = text.lstrip("+-").partition(".")
                 digits = len(whole.lstrip("0")) + len(frac)
                 if digits > self.precision:
@@ -53,7 +62,7 @@ class Control:
         return int(value.to_integral_value(rounding=ROUND_HALF_UP))
 
     def get(self, n: int) -> Decimal:
-        if n == 0 and self.dialect == "fanuc":
+        if n == 0 and self.language.vacant_zero:
             return Decimal(0)  # #0 is always vacant; vacant reads as 0 in arithmetic
         self.check(n)
         return self.vars.get(n, Decimal(0))
@@ -80,9 +89,9 @@ class Control:
         if name == "ABS":
             return c.abs(a)
         if name == "FIX":  # Fanuc drops the fraction (toward zero); LinuxCNC rounds down
-            return a.to_integral_value(rounding=ROUND_DOWN if self.dialect == "fanuc" else ROUND_FLOOR)
+            return a.to_integral_value(rounding=ROUND_DOWN if self.language.fix_toward_zero else ROUND_FLOOR)
         if name == "FUP":  # Fanuc raises the magnitude (away from zero); LinuxCNC rounds up
-            return a.to_integral_value(rounding=ROUND_UP if self.dialect == "fanuc" else ROUND_CEILING)
+            return a.to_integral_value(rounding=ROUND_UP if self.language.fix_toward_zero else ROUND_CEILING)
         if name == "ROUND":
             return a.to_integral_value(rounding=ROUND_HALF_UP)
         if name == "EXP":

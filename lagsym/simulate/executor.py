@@ -1,4 +1,4 @@
-"""The executor: links loops and branches, compiles the blocks and runs them on a :class:`Control`."""
+"""The executor: links loops and branches, compiles the blocks and runs them on a :class:`~lagsym.simulate.control.ControlState`."""
 
 from __future__ import annotations
 
@@ -6,13 +6,12 @@ from dataclasses import replace
 from decimal import localcontext
 
 from ..errors import ProgramError
-from ..gcode.limits import VARIABLE_RANGES
+from ..controls import control
 from ..progress import MOST_CALLS, Progress, Tally
-from ..values import choice
 from .alarms import BlockAlarm, ControlAlarm, alarm_at
 from .blocks import Block, End, Label, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, While
 from .compiler import alarm_block, compile_program
-from .control import Control
+from .control import ControlState
 from .reader import SIM_DIALECTS, detect_dialect, read_blocks
 from .result import Simulation
 from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS, Runaway, endless_jumps
@@ -32,12 +31,15 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     text : str
         The program.
     dialect : str, optional
-        ``fanuc``, ``linuxcnc`` or ``heidenhain``; guessed from the text if not given.
+        A control with a macro language (``SIM_DIALECTS``: ``fanuc``, ``haas``,
+        ``linuxcnc``, ``heidenhain``); guessed from the text if not given
+        (a Fanuc, LinuxCNC or Heidenhain program: a Haas program reads as a Fanuc's).
     precision : int
         Significant digits of every stored value and every operation's result (8 or 15).
     variable_ranges : tuple of (int, int), optional
-        Variable numbers the program may use; by default the dialect's (Fanuc
-        #1-#33, #100-#199, #500-#999; LinuxCNC #1-#5602; Heidenhain Q0-Q99).
+        Variable numbers the program may use; by default the control's
+        (:attr:`lagsym.controls.Control.variables`: Fanuc #1-#33, #100-#199,
+        #500-#999; LinuxCNC #1-#5602; Heidenhain Q0-Q99; ...).
     max_blocks : int
         Blocks executed before the run is stopped as a runaway loop; the
         moves take at most :data:`~lagsym.simulate.result.BYTES_PER_MOVE` bytes
@@ -64,19 +66,19 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     >>> [(m.x, m.z) for m in sim.moves]
     [(0.0, 0.0), (1.0, 1.0), (2.0, 4.0)]
     """
-    dialect = choice(dialect or detect_dialect(text), SIM_DIALECTS, "dialect")
+    c = control(dialect or detect_dialect(text), "dialect", SIM_DIALECTS)
     if int(precision) < 1 or int(precision) > 34:
         raise ProgramError(f"precision {precision} must be 1 to 34 significant digits")
-    blocks = _match_loops(read_blocks(text, dialect))
+    blocks = _match_loops(read_blocks(text, c))
     labels = _labels(blocks)
-    m = Control(dialect, int(precision), variable_ranges or VARIABLE_RANGES[dialect])
-    runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, dialect, int(precision)), blocks)
+    m = ControlState(c, int(precision), variable_ranges or None)
+    runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, c, int(precision)), blocks)
     table, where = compile_program(m, blocks, labels)
     executed = _run(table, where, blocks, m, runaway, Tally(progress, "executing blocks"))
-    return Simulation(dialect=dialect, precision=int(precision), moves=m.moves, blocks=executed)
+    return Simulation(dialect=c.name, precision=int(precision), moves=m.moves, blocks=executed)
 
 
-def _run(table, where, blocks, m: Control, runaway: Runaway, tally: Tally | None = None) -> int:
+def _run(table, where, blocks, m: ControlState, runaway: Runaway, tally: Tally | None = None) -> int:
     """Run the compiled segments from the first block; the number of blocks executed, counted in ``tally``."""
     tally = tally if tally is not None else Tally(None, "executing blocks")
     pc, executed, n = 0, 0, len(blocks)

@@ -279,27 +279,32 @@ _AXIS_DECIMAL = set("XYZABCIJKRUVW")
 _PLAIN_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)")
 
 
-def _word_value(letter: str, text: str, dialect: str):
+def _word_value(letter: str, text: str, increments: bool):
     """The closure for the value of one word: a constant read as the control reads it, or an expression.
 
-    A Fanuc reads an axis word without a decimal point in least input
-    increments (``X12`` is 0.012 mm); the simulator refuses it rather than guess.
+    A Fanuc (``increments``) reads an axis word without a decimal point in
+    least input increments (``X12`` is 0.012 mm); the simulator refuses it
+    rather than guess.
     """
     t = text.strip()
     if not t:
         raise BlockAlarm("114", f"address {letter} without a value")
     if _PLAIN_NUMBER.fullmatch(t):
-        if letter in _AXIS_DECIMAL and "." not in t and dialect == "fanuc":
+        if letter in _AXIS_DECIMAL and "." not in t and increments:
             raise BlockAlarm("decimal-point",
                              f"{letter}{t} has no decimal point (a Fanuc would read it in least increments)")
         return expr_of(("num", t))
     return expression(t)
 
 
-def word_values(text: str, dialect: str) -> tuple[tuple[str, object], ...]:
-    """The words of a comment-free block as ``(letter, closure)`` pairs, each value read as ``dialect`` reads it."""
+def word_values(text: str, increments: bool) -> tuple[tuple[str, object], ...]:
+    """The words of a comment-free block as ``(letter, closure)`` pairs, each value read as the control reads it.
+
+    ``increments``: the control reads an axis word without a decimal point in
+    least input increments (:attr:`lagsym.controls.MacroLanguage.integer_increments`).
+    """
     try:
         split = words(text)
     except WordError as e:
         raise BlockAlarm("114", str(e)) from None
-    return tuple((letter, _word_value(letter, value, dialect)) for letter, value in split)
+    return tuple((letter, _word_value(letter, value, increments)) for letter, value in split)

@@ -10,11 +10,14 @@ import re
 from dataclasses import replace
 
 from ..gcode.words import strip_comments
+from ..controls import CONTROLS
 from .alarms import BlockAlarm
 from .blocks import Assign, Block, End, Goto, IfGoto, IfThen, Nop, While, Words
 from .expressions import expression, reference, word_values
 
 __all__ = ["parse_block"]
+
+INCREMENTS = CONTROLS["fanuc"].macro.integer_increments  # how this language reads an axis word with no point
 
 
 def parse_block(line: int, raw: str, text: str) -> Block:
@@ -59,4 +62,4 @@ def _statement(line: int, raw: str, t: str) -> Block:
         if not 1 <= n <= 9999:
             raise BlockAlarm("114", f"program number O{n} is not 1-9999")
         return Nop(line, raw)
-    return Words(line, raw, word_values(t, "fanuc"))
+    return Words(line, raw, word_values(t, INCREMENTS))

@@ -10,11 +10,15 @@ from __future__ import annotations
 import re
 
 from ..gcode.words import strip_comments
+from ..controls import CONTROLS
 from .alarms import BlockAlarm
 from .blocks import Assign, AssignNamed, Block, Nop, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, Words
 from .expressions import expression, reference, word_values
 
+
 __all__ = ["parse_block"]
+
+INCREMENTS = CONTROLS["linuxcnc"].macro.integer_increments  # how this language reads an axis word with no point
 
 _OWORD = re.compile(r"[oO]\s*(\d+|<[^>]+>)\s*([a-z]+)\s*(.*)", re.I)
 _CONDITIONAL = {"while": OWhile, "if": OIf, "elseif": OElseIf}
@@ -44,4 +48,4 @@ def parse_block(line: int, raw: str, text: str) -> Block:
         if lhs.startswith("#<"):
             return AssignNamed(line, raw, lhs[2:-1].strip().lower(), expression(rhs))
         return Assign(line, raw, reference(lhs), expression(rhs))
-    return Words(line, raw, word_values(t, "linuxcnc"))
+    return Words(line, raw, word_values(t, INCREMENTS))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 
-from ..gcode.limits import MAX_BLOCK
+from ..controls import Control, control, names
 from . import fanuc, heidenhain, linuxcnc
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import Block, Nop
@@ -12,7 +12,9 @@ from .blocks import Block, Nop
 __all__ = ["SIM_DIALECTS", "PARSERS", "detect_dialect", "read_blocks"]
 
 PARSERS = {"fanuc": fanuc.parse_block, "linuxcnc": linuxcnc.parse_block, "heidenhain": heidenhain.parse_block}
-SIM_DIALECTS = tuple(PARSERS)
+"""The parser of each macro language (:attr:`lagsym.controls.MacroLanguage.name`)."""
+SIM_DIALECTS = names(macros=True)
+"""The controls the simulator runs: those with a macro language."""
 
 
 def detect_dialect(text: str) -> str:
@@ -30,7 +32,7 @@ def detect_dialect(text: str) -> str:
     return "fanuc"
 
 
-def read_blocks(text: str, dialect: str) -> list[Block]:
+def read_blocks(text: str, dialect: str | Control) -> list[Block]:
     """The blocks of ``text`` in order, without blank, ``%`` and block-delete (``/``) lines.
 
     Raises
@@ -38,8 +40,9 @@ def read_blocks(text: str, dialect: str) -> list[Block]:
     ControlAlarm
         For a line longer than the control reads, or one its parser cannot read.
     """
-    limit = MAX_BLOCK[dialect]
-    parse = PARSERS[dialect]
+    c = control(dialect)
+    limit = c.max_block
+    parse = PARSERS[c.macro.name]
     blocks = []
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     for n, raw in enumerate(lines, start=1):

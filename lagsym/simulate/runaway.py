@@ -29,7 +29,7 @@ from decimal import Decimal
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
                      OWhile, Stop, While, Words)
-from .control import Control
+from .control import ControlState
 
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
 
@@ -46,7 +46,7 @@ class Runaway:
         self.endless, self.blocks = endless or {}, blocks
         self.moves_seen = 0
         self.idle_from = 0  # the block count at the last backward jump that found a new move
-        self.snapshot: tuple | None = None  # (block index, Control.state()) at the last doubling
+        self.snapshot: tuple | None = None  # (block index, ControlState.state()) at the last doubling
         self.turns, self.power = 0, 1
 
     def check(self, control, executed: int, target: int, block) -> None:
@@ -85,7 +85,7 @@ class _NotConstant(Exception):
     pass
 
 
-class _Probe(Control):
+class _Probe(ControlState):
     """A control with no variables: evaluating an expression on it says whether the expression is a constant."""
 
     def get(self, n: int) -> Decimal:
@@ -95,7 +95,7 @@ class _Probe(Control):
         raise _NotConstant
 
 
-class _Reader(Control):
+class _Reader(ControlState):
     """A control whose every variable reads ``value``, noting which are read."""
 
     def __init__(self, dialect: str, precision: int, value: int):

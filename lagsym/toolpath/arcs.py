@@ -41,7 +41,7 @@ control's axis words, and no arc turns more steeply than
 Grbl does not move on the circle: it cuts an arc into chords no further
 than its arc tolerance (``$12``, 0.002 mm by default) inside it, and ends on
 a chord from the start radius's circle to the end.  For Grbl
-(:data:`CHORD_MM`) a circle bulging up is checked that much lower and one
+(:attr:`lagsym.controls.Control.chord_mm`) a circle bulging up is checked that much lower and one
 hollow upward that much higher; a ``$12`` above the default voids the
 guarantee.
 """
@@ -55,9 +55,7 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..gcode.numbers import program_ints
 
-__all__ = ["Arcs", "fit_arcs", "RADIUS_LIMIT", "MAX_RADIUS_MM", "CHORD_MM"]
-
-CHORD_MM = {"grbl": 0.002}  # how far inside its arcs a control's chords may lie (Grbl's default $12), mm
+__all__ = ["Arcs", "fit_arcs", "RADIUS_LIMIT", "MAX_RADIUS_MM"]
 
 RADIUS_LIMIT = {"mm": 0.002, "inch": 0.0002}  # LinuxCNC: start and end radius may differ by this (program units)
 RADIUS_AGREE = 0.75  # the part of that limit a written arc may use

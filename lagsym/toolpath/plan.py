@@ -20,7 +20,7 @@ from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..progress import Progress, Tally
 from . import chordal
-from .arcs import CHORD_MM, Arcs, fit_arcs
+from .arcs import Arcs, fit_arcs
 from .dropcutter import drop_cutter
 from .filter import filter_rows
 from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
@@ -200,7 +200,7 @@ def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSett
     return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa,
                                      raster.chordal_tolerance_mm, settings.unit_factor, settings.digits,
                                      settings.units, (x0, x1) if raster.direction == "x" else (y0, y1),
-                                     cl.radius * cl.mm_per_unit, CHORD_MM.get(settings.dialect, 0.0)))
+                                     cl.radius * cl.mm_per_unit, settings.control.chord_mm))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
