@@ -15,6 +15,11 @@ lagsym writes for (sources in docs/controllers.md):
   4 digits, ``H`` up to 400 (0i-MF), ``G54``-``G59`` and ``G54.1 P1``-``P48``;
   its common variables are ``#100-#199`` and ``#500-#999`` with the full macro
   option, ``#100-#149`` and ``#500-#531`` on the smaller ones (profile ``small``);
+- a Haas mill (classic and NGC) reads Fanuc-compatible Custom Macro B with
+  five-digit ``O`` numbers, ``G54``-``G59``, ``G110``-``G129`` and ``G154 P1``-``P99``,
+  200 tools and length offsets; its general-purpose variables are
+  ``#100-#149``, ``#500-#549``, ``#600-#699`` and ``#800-#999`` (``#150-#199`` and
+  ``#550-#599`` hold probe data, ``#700-#799`` are the control's own);
 - LinuxCNC reads 255 characters a line (LINELEN) and 9 digits here by choice;
 - Grbl 1.1 buffers 80 characters a line and has no tool changer or length offsets;
 - a Heidenhain TNC reads ``±99999.9999`` and Q parameters ``Q0``-``Q99``, and
@@ -22,10 +27,10 @@ lagsym writes for (sources in docs/controllers.md):
 
 Examples
 --------
->>> control("fanuc").framing.program_word.format(1000)
-'O1000'
+>>> control("haas").framing.program_word.format(1000)
+'O01000'
 >>> [c.name for c in CONTROLS.values() if c.macro is not None]
-['fanuc', 'linuxcnc', 'heidenhain']
+['fanuc', 'haas', 'linuxcnc', 'heidenhain']
 """
 
 from __future__ import annotations
@@ -212,6 +217,19 @@ CONTROLS: Mapping[str, Control] = MappingProxyType({c.name: c for c in (
                             counts_digits=True, integer_increments=True, table_base=500, table_tiles=8),
         dnc_profile="fanuc"),
     Control(
+        name="haas", title="Haas mills (classic and NGC), Fanuc-compatible Custom Macro B",
+        max_block=128, axis_digits=8, tools=200, length_offsets=200,
+        work_offsets=r"G5[4-9]|G11\d|G12\d|G154 P([1-9]|[1-9]\d)",
+        work_offset_text="G54 to G59, G110 to G129 or G154 P1 to P99",
+        program_numbers=(1, 99999), variables=((1, 33), (100, 199), (500, 699), (800, 999)),
+        macro_variables={"full": ((100, 149), (500, 549), (600, 699), (800, 999)),
+                         "small": ((100, 149), (500, 549), (600, 699), (800, 999))},
+        framing=Framing(percent=True, program_word="O{:05d}", safe_start="G17 G40 G49 G80 G90 G94", end="M30",
+                        tool_change="M06"),
+        macro=MacroLanguage("fanuc", default_precision=8, rounds=True, fix_toward_zero=True, vacant_zero=True,
+                            counts_digits=True, integer_increments=True, table_base=800, table_tiles=8),
+        dnc_profile="haas"),
+    Control(
         name="linuxcnc", title="LinuxCNC (rs274ngc)",
         max_block=255, axis_digits=9, tools=99999, length_offsets=99999,
         work_offsets=r"G5[4-9]|G59\.[1-3]", work_offset_text="G54 to G59 or G59.1 to G59.3",
@@ -254,12 +272,12 @@ def work_offset(text, what: str = "work offset", exact: bool = False) -> str:
 
     Examples
     --------
-    >>> work_offset("g55"), work_offset("G54.1 P12")
-    ('G55', 'G54.1 P12')
+    >>> work_offset("g55"), work_offset("G54.1 P12"), work_offset("G154 P20")
+    ('G55', 'G54.1 P12', 'G154 P20')
     >>> work_offset("G54 M30")
     Traceback (most recent call last):
     ...
-    lagsym.errors.InputError: work offset 'G54 M30' is not a work offset word of any control: fanuc G54 to G59 or G54.1 P1 to P48; linuxcnc G54 to G59 or G59.1 to G59.3; grbl G54 to G59
+    lagsym.errors.InputError: work offset 'G54 M30' is not a work offset word of any control: fanuc G54 to G59 or G54.1 P1 to P48; haas G54 to G59, G110 to G129 or G154 P1 to P99; linuxcnc G54 to G59 or G59.1 to G59.3; grbl G54 to G59
     """
     word = text if exact or not isinstance(text, str) else text.strip().upper()
     if not isinstance(word, str) or re.fullmatch(WORK_OFFSET_WORDS, word) is None:
@@ -274,7 +292,7 @@ def names(*, point_lists: bool = False, macros: bool = False) -> tuple[str, ...]
     Examples
     --------
     >>> names(point_lists=True)
-    ('fanuc', 'linuxcnc', 'grbl')
+    ('fanuc', 'haas', 'linuxcnc', 'grbl')
     """
     return tuple(c.name for c in CONTROLS.values()
                  if (c.point_lists or not point_lists) and (c.macro is not None or not macros))
@@ -293,7 +311,7 @@ def control(name, what: str = "dialect", options: tuple[str, ...] | None = None)
     >>> control("acme")
     Traceback (most recent call last):
     ...
-    lagsym.errors.InputError: dialect 'acme' is not one of fanuc, linuxcnc, heidenhain, grbl
+    lagsym.errors.InputError: dialect 'acme' is not one of fanuc, haas, linuxcnc, heidenhain, grbl
     """
     if isinstance(name, Control):
         name = name.name

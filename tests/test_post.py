@@ -105,7 +105,7 @@ def test_safe_z_must_clear_the_path(path4):
 def test_unknown_dialect_names_the_choices():
     with pytest.raises(InputError, match="fanuc"):
         MachineSettings(dialect="sinumerik")
-    with pytest.raises(ProgramError, match="heidenhain.*no point-list writer; use one of fanuc, linuxcnc, grbl"):
+    with pytest.raises(ProgramError, match="heidenhain.*no point-list writer; use one of fanuc, haas, linuxcnc, grbl"):
         write_program(PointProgram(np.zeros((2, 3)), MachineSettings(dialect="heidenhain")))
 
 

@@ -189,7 +189,7 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
                              f"run them in the order {', '.join(KINDS)}")
     dialect = _choice(data.get("dialect", "fanuc"), JOB_DIALECTS, "dialect", source)
     for i, op in enumerate(ops):
-        if op.options.get("macro") and dialect not in MACRO_DIALECTS:
+        if op.options.get("macro") and control(dialect).macro is None:
             raise InputError(f"{source}: operations[{i}].macro: a roughing macro is written for "
                              f"{' or '.join(MACRO_DIALECTS)}, not {dialect!r}")
     program_number = data.get("program_number", 1000)
