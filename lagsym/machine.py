@@ -17,7 +17,7 @@ from .controls import Control, control, names, work_offset
 from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
-__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
+__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "program_units_per_mm",
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
            "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
@@ -330,8 +330,8 @@ class MachineSettings:
 
     @property
     def unit_factor(self) -> float:
-        """Program units per millimetre."""
-        return 1.0 if self.units == "mm" else 1.0 / 25.4
+        """Program units per millimetre (:func:`program_units_per_mm`, as a float)."""
+        return float(program_units_per_mm(self.units))
 
 
 @dataclass(frozen=True)

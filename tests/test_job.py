@@ -36,7 +36,7 @@ def job_text(**changes) -> str:
 BAD = [
     ({"rapid = 5000": "rapid = 5000\nspeed = 3"}, "unknown key 'speed'"),
     ({"scale = 20": 'scale = "20"'}, "scale = '20' must be a number"),
-    ({'dialect = "linuxcnc"': 'dialect = "haas"'}, "dialect = 'haas' is not one of fanuc, linuxcnc, grbl"),
+    ({'dialect = "linuxcnc"': 'dialect = "heidenhain"'}, "dialect = 'heidenhain' is not one of fanuc, haas, linuxcnc, grbl"),
     ({'coolant = "flood"': 'coolant = "oil"'}, "coolant = 'oil' is not one of off, flood, mist"),
     ({"diameter = 10": "diameter = -10"}, "tools.rougher.diameter = -10 must be a number above 0"),
     ({'tool = "ball6"': 'tool = "ball8"'}, "tool = 'ball8' is not one of rougher, ball6"),
@@ -50,7 +50,7 @@ BAD = [
     ({"stepover = 5": "stepover = 5\nprecision = 8"}, "operations[0].precision applies to a roughing macro only"),
     ({"stepover = 5": "stepover = 5\nmacro = 1"}, "operations[0].macro = 1 must be true or false"),
     ({"stepover = 5": "stepover = 5\nmacro = true", 'dialect = "linuxcnc"': 'dialect = "grbl"'},
-     "operations[0].macro: a roughing macro is written for fanuc or linuxcnc, not 'grbl'"),
+     "operations[0].macro: a roughing macro is written for fanuc or haas or linuxcnc, not 'grbl'"),
     ({"stepover = 5": "stepover = 5\nmacro = true\nmilling = 'climb'"}, "a roughing macro cuts zig-zag only"),
     ({"stepover = 5": "stepover = 5\nmacro = true\nprecision = 12"}, "precision = 12 is not one of 8, 15"),
 ]

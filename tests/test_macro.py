@@ -356,7 +356,7 @@ def test_inch_programs_are_in_inches():
 
 
 def test_unknown_dialect_names_the_choices():
-    with pytest.raises(InputError, match="fanuc, linuxcnc, heidenhain"):
+    with pytest.raises(InputError, match="macro dialect 'grbl' is not one of fanuc, haas, linuxcnc, heidenhain"):
         macro_program(surface("paper-example-1"), machine(dialect="grbl"), RasterSpec(), FLAT)
 
 

@@ -203,7 +203,7 @@ def test_a_job_with_a_roughing_macro_runs_in_rs274(rs274, tmp_path, run_cli):
 
 
 @pytest.mark.parametrize("args, words", [
-    (("--dialect", "grbl", "--macro"), "a roughing macro is written for fanuc or linuxcnc, not grbl"),
+    (("--dialect", "grbl", "--macro"), "a roughing macro is written for fanuc or haas or linuxcnc, not grbl"),
     (("--precision", "8",), "--precision 8 applies to a macro only"),
     (("--macro", "--max-samples", "1000"), "--max-samples 1000: a roughing macro makes no drop-cutter samples"),
     (("--macro", "--milling", "conventional"), "a roughing macro cuts zig-zag only"),

@@ -234,8 +234,8 @@ def test_unsupported_o_words_are_refused_not_skipped():
 
 
 def test_a_dialect_outside_the_list_is_an_input_error():
-    with pytest.raises(InputError, match="dialect 'haas' is not one of fanuc, linuxcnc, heidenhain"):
-        simulate("G1 X1.\n", "haas")
+    with pytest.raises(InputError, match="dialect 'grbl' is not one of fanuc, haas, linuxcnc, heidenhain"):
+        simulate("G1 X1.\n", "grbl")
 
 
 def test_blocks_are_frozen():

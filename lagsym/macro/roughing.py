@@ -42,7 +42,7 @@ from .._arrays import freeze_fields
 from ..controls import control, names
 from ..errors import ToolpathError
 from ..evaluate import surface_evaluator
-from ..machine import MachineSettings, Tool
+from ..machine import MachineSettings, Tool, program_units_per_mm
 from ..toolpath.rough import RoughSpec, Stock, check_points, check_rough_request
 from ..values import choice
 from .clearance import Clearance, clearance_tables
@@ -291,7 +291,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     ev = evaluator or surface_evaluator(surface)
     place = settings.placement
     check_rough_request(tool, stock, spec, ev, place, max_points, "--max-points")
-    per_mm = Fraction(1) if settings.units == "mm" else Fraction(5, 127)
+    per_mm = program_units_per_mm(settings.units)
     rf = row_form(surface, settings, spec.direction, form)
     language = settings.control.macro
     tiles = language.table_tiles if language is not None and language.table_base is not None else 1
