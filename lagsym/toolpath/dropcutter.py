@@ -53,8 +53,8 @@ CL_MARGIN = 1e-7
 _CHUNK = 1 << 12  # positions per call of the kernel, and per worker's task
 
 
-def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corner: float | None = None, lattice: int = 8,
-                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
+def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corner: float | None = None,
+                lattice: int = 8, starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
                 workers: Workers | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
