@@ -14,16 +14,17 @@ from fractions import Fraction
 import numpy as np
 
 from .controls import Control, control, names, work_offset
+# The cutter is a value of its own (lagsym.cutter); its names stay importable from here, where callers know them.
+from .cutter import TOOL_SHAPES, Cutter, Tool, cutter_profile
 from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
-__all__ = ["Placement", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS", "program_units_per_mm",
+__all__ = ["Placement", "Cutter", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
-           "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
+           "program_units_per_mm", "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
 DIALECTS = names()
 """The names of the registered controls (:data:`lagsym.controls.CONTROLS`)."""
-TOOL_SHAPES = ("ball", "flat", "bull")  # bull: a bull-nose (corner-radius) end mill
 LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n", "cr": "\r"}
 # A program ends its blocks with LF or CR LF: with CR alone rs274 and ISO tape readers see one block.
 PROGRAM_LINE_ENDINGS = ("lf", "crlf")
@@ -138,97 +139,6 @@ class Placement:
         scale = as_exact(self.mm_per_unit, "millimetres per surface unit") * k
         origin = tuple(as_exact(v, "origin") * k for v in self.origin_mm)
         return scale, origin
-
-
-@dataclass(frozen=True)
-class Tool:
-    """A milling cutter: ``shape`` is ``"ball"``, ``"flat"`` or ``"bull"``, ``diameter_mm`` its diameter (0: a point).
-
-    A bull-nose (``"bull"``) end mill has a flat end of diameter
-    ``diameter_mm - 2 * corner_radius_mm`` rounded into its side by a torus of
-    radius ``corner_radius_mm`` (more than 0, less than half the diameter).
-    The ball and the flat end are its two limits (corner radius the radius, or
-    0), so one profile, :meth:`profile_mm`, describes every cutter.
-
-    Examples
-    --------
-    >>> Tool("bull", 10.0, corner_radius_mm=1.0).corner_mm
-    1.0
-    >>> Tool("bull", 10.0)
-    Traceback (most recent call last):
-    ...
-    lagsym.errors.InputError: a bull-nose cutter needs a corner radius (--corner-radius), more than 0 and less than half its diameter 10 mm
-    """
-
-    shape: str = "ball"
-    diameter_mm: float = 6.0
-    corner_radius_mm: float | None = None
-
-    def __post_init__(self):
-        choice(self.shape, TOOL_SHAPES, "tool shape")
-        object.__setattr__(self, "diameter_mm", positive(self.diameter_mm, "tool diameter", allow_zero=True))
-        r = self.corner_radius_mm
-        if self.shape != "bull":
-            if r is not None:
-                raise InputError(f"a corner radius ({r!r} mm) is for a bull-nose cutter (tool shape bull), "
-                                 f"not a {self.shape} end")
-            return
-        half = self.diameter_mm / 2.0
-        if r is None:
-            raise InputError(f"a bull-nose cutter needs a corner radius (--corner-radius), more than 0 and less "
-                             f"than half its diameter {self.diameter_mm:g} mm")
-        r = finite(r, "corner radius")
-        if not 0.0 < r < half:
-            raise InputError(f"corner radius {r:g} mm must be more than 0 and less than half the tool diameter "
-                             f"({half:g} mm); a corner radius of half the diameter is a ball end (tool shape ball)")
-        object.__setattr__(self, "corner_radius_mm", r)
-
-    @property
-    def radius_mm(self) -> float:
-        """Half the diameter."""
-        return self.diameter_mm / 2.0
-
-    @property
-    def corner_mm(self) -> float:
-        """The corner radius: the radius for a ball, 0 for a flat end."""
-        if self.shape == "ball":
-            return self.radius_mm
-        return 0.0 if self.shape == "flat" else float(self.corner_radius_mm)
-
-    def profile_mm(self, d2) -> np.ndarray:
-        """Height of the cutter's lower surface above its tip at squared distance ``d2`` (mm²) from its axis.
-
-        Within the radius only; the flat part is 0, the corner a quarter circle.
-
-        Examples
-        --------
-        >>> Tool("ball", 2.0).profile_mm(1.0).item(), Tool("flat", 2.0).profile_mm(1.0).item()
-        (1.0, 0.0)
-        """
-        return cutter_profile(d2, self.radius_mm, self.corner_mm)
-
-    @property
-    def label(self) -> str:
-        """How a program header names the tool: ``BALL END D6 MM``, ``BULL NOSE D10 R1 MM``."""
-        if self.shape == "bull":
-            return f"BULL NOSE D{self.diameter_mm:g} R{self.corner_mm:g} MM"
-        return f"{self.shape.upper()} END D{self.diameter_mm:g} MM"
-
-
-def cutter_profile(d2, radius: float, corner: float) -> np.ndarray:
-    """Height above the tip of a cutter of ``radius`` with a ``corner`` radius, at squared distance ``d2``.
-
-    ``corner`` is ``radius`` for a ball and 0 for a flat end; any units, the
-    same for all three.  ``d2`` beyond the radius is treated as on the rim.
-    """
-    d2 = np.asarray(d2, dtype=float)
-    if corner <= 0.0:
-        return np.zeros(d2.shape)
-    flat = radius - corner
-    if flat <= 0.0:
-        return radius - np.sqrt(np.maximum(radius * radius - d2, 0.0))
-    out = np.maximum(np.sqrt(np.maximum(d2, 0.0)) - flat, 0.0)
-    return corner - np.sqrt(np.maximum(corner * corner - out * out, 0.0))
 
 
 @dataclass(frozen=True)

@@ -41,25 +41,14 @@ TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is c
 
 def is_ball(tool: Tool | None) -> bool:
     """True for a ball-end cutter with a diameter: one that is offset along the normal."""
-    return tool is not None and tool.shape == "ball" and tool.diameter_mm > 0
+    return tool is not None and tool.is_ball and tool.diameter_mm > 0
 
 
 def refuse_flat_end(tool: Tool | None) -> None:
-    """Refuse a flat-end cutter with a diameter: its cutter location is not a height the control can compute.
-
-    A flat end of radius ``R`` rests on the highest point of the surface under
-    its disc, ``max Z`` over the disc, which has no closed form; the height at
-    the centre (what a zero diameter programs) lies below it wherever the
-    surface slopes and the cutter would cut into the part (30.4 mm on paper
-    example 1 at scale 10 with a 6 mm cutter).
-    """
-    if tool is not None and tool.shape in ("flat", "bull") and tool.diameter_mm > 0:
-        what = "flat-end" if tool.shape == "flat" else "bull-nose"
-        raise ToolpathError(
-            f"a {what} cutter (diameter {tool.diameter_mm:g} mm) rests on the highest point under its disc, "
-            "which a macro cannot compute on the control: use the point-list toolpath "
-            f"(lagsym toolpath --tool-shape {tool.shape}), which drops the cutter onto the exact surface, "
-            "or a ball end (--tool-shape ball), or --tool-diameter 0 for the surface itself")
+    """Refuse a cutter a macro cannot drive: a flat end or bull nose with a diameter (the cutter says why,
+    :meth:`lagsym.cutter.Cutter.check_macro`)."""
+    if tool is not None:
+        tool.check_macro()
 
 
 def ball_offsets(settings: MachineSettings, tool: Tool) -> tuple[float, float]:

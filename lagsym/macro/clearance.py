@@ -188,7 +188,7 @@ def clearance_tables(ev, place, tool, step_mm: float, stock_mm: float, edges_x, 
     lam = _windows(fine["lam"], box, edges_x, edges_y, radius + _GROW_MM)
     cap = _windows(fine["f"], box, edges_x, edges_y, radius + _GROW_MM) + place.origin_mm[2] + stock_mm
     slope = _windows(fine["g"], box, edges_x, edges_y, radius + step_mm + _GROW_MM)
-    up = lam - (1.0 / radius if tool.shape == "ball" else 0.0)
+    up = lam - tool.curvature_per_mm
     taylor, chord = np.maximum(up, 0.0) * radius ** 2 / 2, slope * step_mm / 2
     if direction == "y":
         lam, cap, taylor, chord = lam.T, cap.T, taylor.T, chord.T

@@ -8,7 +8,7 @@ for a flat end ``max F(p)`` over the same set, and for a bull-nose end mill of
 corner radius ``r`` the same maximum of ``F(p) - P(|p - c|)``, ``P`` its profile
 (0 across the flat, ``r - sqrt(r**2 - (d - R + r)**2)`` on the corner; the ball
 and the flat end are its limits ``r = R`` and ``r = 0``,
-:func:`lagsym.machine.cutter_profile`); ``D`` is the disc under the
+:func:`lagsym.cutter.cutter_profile`); ``D`` is the disc under the
 tool and ``B`` the box spanned by the control points.  Only the surface inside
 the box counts: the polynomial is never evaluated outside it (beyond the box
 lies no part, not a cliff and not an extrapolated surface), so near an edge the
@@ -38,10 +38,10 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial import chebyshev as C
 
+from ..cutter import corner_radius
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
-from ..machine import TOOL_SHAPES
-from ..values import choice, positive
+from ..values import positive
 from .newton import jet_coefficients, kernel_geometry
 from .workers import Workers
 
@@ -53,8 +53,8 @@ CL_MARGIN = 1e-7
 _CHUNK = 1 << 12  # positions per call of the kernel, and per worker's task
 
 
-def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: float | None = None, lattice: int = 8,
-                starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
+def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corner: float | None = None,
+                lattice: int = 8, starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
                 workers: Workers | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
@@ -67,11 +67,15 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
         from the box.
     radius : float
         Tool radius in surface units (0: a point, the surface itself).
-    shape : {"ball", "flat", "bull"}
-        Cutter shape.
+    shape : {"ball", "flat", "bull"}, optional
+        Cutter shape (:data:`lagsym.cutter.SHAPES`); without one, ``corner``
+        says the shape (:func:`lagsym.cutter.corner_radius`), and without
+        either the cutter is a ball.
     corner : float, optional
-        Corner radius of a bull-nose cutter (``shape="bull"``), in surface
-        units, more than 0 and less than ``radius``; not given for the others.
+        Corner radius in surface units: of a bull-nose cutter
+        (``shape="bull"``), more than 0 and less than ``radius``; without a
+        shape, 0 (a flat end) to ``radius`` (a ball).  A cutter's own is
+        :meth:`lagsym.cutter.Cutter.grown_mm` scaled to surface units.
     lattice : int
         Candidate contact points per tool radius in the first, dense search.
     starts : int
@@ -100,7 +104,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     0.0
     """
     radius = positive(radius, "tool radius", allow_zero=True)
-    corner = _corner(shape, radius, corner)
+    corner = corner_radius(shape, radius, corner)
     ev = evaluator or surface_evaluator(surface)
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
@@ -123,19 +127,6 @@ def drop_cutter(surface, x, y, radius: float, shape: str = "ball", *, corner: fl
     parts = workers.map(_drop_chunk, tasks) if parallel else [_drop_chunk(ev, *t) for t in tasks]
     out = np.concatenate(parts) if parts else np.empty(0)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
-
-
-def _corner(shape: str, radius: float, corner: float | None) -> float:
-    """The corner radius of the cutter: ``radius`` for a ball, 0 for a flat end, checked for a bull nose."""
-    choice(shape, TOOL_SHAPES, "tool shape")
-    if shape != "bull":
-        if corner is not None:
-            raise ToolpathError(f"a corner radius ({corner!r}) is for a bull-nose cutter, not a {shape} end")
-        return radius if shape == "ball" else 0.0
-    if corner is None or not 0.0 < float(corner) < radius:
-        raise ToolpathError(f"a bull-nose cutter of radius {radius:g} needs a corner radius more than 0 and less "
-                            f"than {radius:g}, not {corner!r}")
-    return float(corner)
 
 
 def _inside_box(cx, cy, box, radius=0.0):

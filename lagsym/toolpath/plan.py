@@ -147,12 +147,12 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     tol = raster.chordal_tolerance_mm
     cl = _Cutter.of(surface, ev, tool, settings)
     # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
-    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner_radius), cl.radius - 2 * cl.unit)) \
+    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
         if raster.boundary == "past" else None
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
-    if scallop is None and tool.shape == "ball" and tool.radius_mm > 0:  # the cusps a fixed side step leaves
+    if scallop is None and tool.is_ball and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     kappa = ev.curvature_bound() / mm_per_unit
     # Drop-cutter's compiled kernel loaded here (the first time, compiled), before the workers fork: they share it.
@@ -274,7 +274,7 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
     """The side step asked for (mm), or the one a ball leaves the scallop height with."""
     if raster.stepover_mm is not None:
         return raster.stepover_mm
-    if tool.shape != "ball":
+    if not tool.is_ball:
         raise ToolpathError("a scallop height (--scallop) needs a ball-end cutter; give --stepover for a flat end")
     return scallop_stepover(tool.radius_mm, raster.scallop_mm)
 
@@ -295,9 +295,9 @@ def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float)
 class _Cutter:
     """Tool-tip heights (mm) over surface positions, as the planner computes them.
 
-    The radius (surface units) includes the stock to leave for a ball or a
-    bull nose (whose corner grows by it too), which then rides that much
-    higher; a flat end is lifted by the stock instead.
+    The radius and corner radius (surface units) are those of the tool grown
+    by the stock to leave (:meth:`lagsym.cutter.Cutter.grown_mm`), whose tip
+    is then lifted by the stock.
     ``snap`` moves positions onto the program's resolution (``grid``): the
     rows, the samples along them and any point added are put there before
     the tool is dropped, so an emitted height is that of a position the
@@ -307,8 +307,7 @@ class _Cutter:
     surface: object
     ev: SurfaceEvaluator
     radius: float
-    shape: str
-    corner: float | None
+    corner: float
     lift_tip: float
     mm_per_unit: float
     grid: ResolutionGrid | None = None
@@ -316,17 +315,13 @@ class _Cutter:
 
     @classmethod
     def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
-        r_mm, stock, mm_per_unit = tool.radius_mm, settings.stock_to_leave_mm, settings.mm_per_unit
-        grid = ResolutionGrid.of(settings, ev.bounds)
-        if tool.shape == "flat":
-            return cls(surface, ev, r_mm / mm_per_unit, "flat", None, stock / mm_per_unit, mm_per_unit, grid)
-        # The tool grown by the stock all round touches the part where the tool touches the part grown by it.
-        r = (r_mm + stock) / mm_per_unit
-        corner = (tool.corner_mm + stock) / mm_per_unit if tool.shape == "bull" else None
-        return cls(surface, ev, r, tool.shape, corner, stock / mm_per_unit, mm_per_unit, grid)
+        stock, mm_per_unit = settings.stock_to_leave_mm, settings.mm_per_unit
+        r_mm, corner_mm = tool.grown_mm(stock)
+        return cls(surface, ev, r_mm / mm_per_unit, corner_mm / mm_per_unit, stock / mm_per_unit, mm_per_unit,
+                   ResolutionGrid.of(settings, ev.bounds))
 
     def __call__(self, x, y, **search) -> np.ndarray:
-        z = drop_cutter(self.surface, x, y, self.radius, self.shape, corner=self.corner, evaluator=self.ev,
+        z = drop_cutter(self.surface, x, y, self.radius, corner=self.corner, evaluator=self.ev,
                         workers=self.workers, **search)
         return (z + self.lift_tip) * self.mm_per_unit
 
@@ -334,11 +329,6 @@ class _Cutter:
     def unit(self) -> float:
         """One unit of the program's last decimal, in surface units (0 without a program grid)."""
         return 0.0 if self.grid is None else self.grid.unit_mm / self.mm_per_unit
-
-    @property
-    def corner_radius(self) -> float:
-        """The corner radius (surface units): the radius for a ball, 0 for a flat end."""
-        return {"ball": self.radius, "flat": 0.0}.get(self.shape, self.corner)
 
     def snap(self, x, y):
         """The positions the program writes for surface positions ``x, y`` (see :mod:`.resolution`)."""

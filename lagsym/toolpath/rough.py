@@ -40,7 +40,7 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
-from ..machine import DIRECTIONS, TOOL_SHAPES, MachineSettings, Tool
+from ..machine import DIRECTIONS, MachineSettings, Tool
 from ..progress import Progress, Tally
 from ..values import choice, finite, positive
 from .chordal import check_moves, crosses_box_edge, lift
@@ -239,7 +239,6 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
 def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place,
                         max_points: int | None, option: str) -> None:
     """What every roughing refuses before any work: the cutter, the side step, the block, one level's size."""
-    choice(tool.shape, TOOL_SHAPES, "tool shape")
     if tool.diameter_mm <= 0:
         raise ToolpathError("roughing needs a cutter with a diameter above 0")
     if spec.stepover_mm > tool.diameter_mm:
@@ -331,10 +330,9 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progr
     out = np.full(x.size, -np.inf)
     if touch.any():
         u, v = place.to_surface(px[touch], py[touch])
-        corner = tool.corner_mm / place.mm_per_unit if tool.shape == "bull" else None
+        radius, corner = tool.radius_mm / place.mm_per_unit, tool.corner_mm / place.mm_per_unit
         z = Tally(progress, "dropping the tool", len(u)).whole(
-            lambda pu, pv: drop_cutter(surface, pu, pv, tool.radius_mm / place.mm_per_unit, tool.shape, corner=corner,
-                                       evaluator=ev, **search), (u, v), _PIECE)
+            lambda pu, pv: drop_cutter(surface, pu, pv, radius, corner=corner, evaluator=ev, **search), (u, v), _PIECE)
         out[touch] = place.height_mm(z) + stock_mm
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 

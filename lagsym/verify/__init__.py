@@ -4,7 +4,7 @@ The box of the control points, in machine millimetres, is covered by a grid
 of cells; each cell keeps the lowest height any part of the tool reached over
 its centre.  Every straight move of the program lowers every cell centre its
 tool passes over to the lowest point the exact lower surface of the tool
-(:func:`lagsym.machine.cutter_profile`: ball, flat or bull nose) reaches
+(:func:`lagsym.cutter.cutter_profile`: ball, flat or bull nose) reaches
 there anywhere along the move, in closed form (:mod:`lagsym.verify.swept`);
 feed moves and rapids (``G00``) go into two maps.  The
 part is the surface over the box and ends at the box edges (the cells on the

@@ -4,7 +4,7 @@
 cell centre ``(xs[i], ys[j])``.  Every move is split into straight segments
 at most a cell long sideways, and each segment lowers every cell centre its
 tool passes over to the lowest point the tool's lower surface
-(:func:`lagsym.machine.cutter_profile`) reaches there along the whole
+(:func:`lagsym.cutter.cutter_profile`) reaches there along the whole
 segment, in closed form (:mod:`lagsym.verify.swept`): one evaluation per
 segment and cell, not one per sampled position.  Segments whose nearest cells
 differ are swept together, one offset of the footprint at a time, so each

@@ -9,7 +9,7 @@ the tool's lower surface over ``c`` is at
 
     g(tau) = A_z + m tau + P(d),   d^2 = (a - tau)^2 + e^2,   0 <= tau <= L, d <= R,
 
-``P`` the tool's profile (:func:`lagsym.machine.cutter_profile`).  ``P`` is
+``P`` the tool's profile (:func:`lagsym.cutter.cutter_profile`).  ``P`` is
 convex and increasing in ``d`` and ``d`` convex in ``tau``, so ``g`` is convex,
 and its lowest value over the move is one of:
 
