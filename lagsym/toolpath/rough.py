@@ -52,7 +52,7 @@ from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_o
 __all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
            "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points"]
 
-MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (about 1 ms each): minutes at most
+MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (the slow part): minutes at most
 
 MILLING = ("zigzag", "climb", "conventional")
 _SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
