@@ -4,14 +4,14 @@ Drop-cutter, the chordal checks and the height-map sweeps create and free
 arrays of a few to some tens of megabytes thousands of times.  glibc's
 ``malloc`` gives such memory back to the system as soon as it is freed (above
 its trim threshold), and the next array of the same size faults in fresh,
-zeroed pages: on the README's finishing command 13 s of system time beside
-46 s of user time, and 740,000 page faults for the side step 2 mm plan.
+zeroed pages: the kernel zeroes and maps every page again, thousands of
+times over a plan, as system time beside the arithmetic.
 :func:`keep_freed_memory` raises glibc's mmap threshold to
 :data:`MMAP_THRESHOLD` and its trim threshold to :data:`TRIM_THRESHOLD`: up
-to that much freed memory stays with the process for the next array (the
-command's peak memory grew by 7 %, 183 to 196 MB, and its system time fell
-to 0.75 s).  The values computed are the same; only where memory comes from
-changes.
+to that much freed memory stays with the process for the next array, which
+reuses pages already mapped, at the price of a peak memory higher by about
+what is kept.  The values computed are the same; only where memory comes
+from changes.
 
 The ``lagsym`` command calls it once before a command runs; a program using
 the library may call it too (it is the process's setting, so the library

@@ -30,7 +30,7 @@ __all__ = ["FORMATS", "render", "nested_form", "decimal_text", "round_significan
            "RoundingMiss", "rounding_miss", "MAX_TERMS"]
 
 FORMATS = ("sympy", "latex", "json", "horner", "python")
-MAX_TERMS = 2_500  # terms SymPy prints by default: a 50 x 50 grid, a few seconds (each term costs about 2 ms)
+MAX_TERMS = 2_500  # terms SymPy prints by default: a 50 x 50 grid; SymPy prints term by term, so a larger one waits
 
 
 def _lhs(obj) -> str:

@@ -7,8 +7,9 @@ power-basis coefficients form a matrix ``Bx`` with ``Bx[i, a]`` the coefficient
 of ``x**a`` in ``L_i``.  The surface ``F(x, y) = sum_ik L_i(x) L_k(y) z_ik`` then
 has the coefficient matrix ``C = Bx.T @ Z @ By`` (``C[a, b]`` multiplies
 ``x**a * y**b``), computed with python-flint's exact rational matrices.  This
-avoids expanding ``n * m`` symbolic products, the textbook route, which is
-hundreds of times slower.
+avoids expanding ``n * m`` symbolic products, the textbook route: each
+would be a SymPy expression built and expanded term by term, where the
+matrix product is one exact computation on the coefficients.
 
 The polynomials are built on plain SymPy symbols, ``x`` and ``y`` by default,
 the ones ``sympy.symbols('x y')`` gives, so that ``subs``, ``diff``,

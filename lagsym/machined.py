@@ -126,7 +126,7 @@ class MachinedPart:
 
 
 def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: dict[int, Tool], block,
-                 placement: Placement = Placement(), cell_mm: float | None = None,
+                 placement: Placement = Placement(), *, cell_mm: float | None = None,
                  program_resolution_mm: float = 0.0005, gouge_limit_mm: float | None = None,
                  max_cells: int | None = MAX_CELLS, progress: Progress | None = None) -> MachinedPart:
     """Simulate a whole job's program from the block ``(x0, x1, y0, y1, top_mm)`` (machine mm).
@@ -165,7 +165,7 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
         before = cut.copy()
         swept = Tally(progress, f"T{number}: sweeping moves",
                       None if progress is None else segments(a, b, tool_grid(tools[number], xs, ys)[2]))
-        crash, at, res = _run(cut, xs, ys, a, b, rapid, tools[number], swept)
+        crash, at, res = _run(cut, xs, ys, a, b, rapid, tool=tools[number], tally=swept)
         resolutions.append(res)
         left = cut - surf
         stages.append(Stage(number, tools[number], first, len(a), float((before - cut).sum() * hx * hy), crash, at,
@@ -254,7 +254,7 @@ def _stages(moves: Moves, changes):
         yield number, first, path[:-1][k], path[1:][k], np.asarray(moves.rapid, dtype=bool)[k]
 
 
-def _run(cut, xs, ys, a, b, rapid, tool: Tool, tally: Tally):
+def _run(cut, xs, ys, a, b, rapid, *, tool: Tool, tally: Tally):
     """Press one stage's moves in order (their segments counted in ``tally``); the deepest material a rapid went
     through, where, and the resolution."""
     tally.start()

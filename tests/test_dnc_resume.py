@@ -77,7 +77,7 @@ def test_a_fault_within_the_set_up_asks_for_the_program_from_the_start():
     settings = profile("fanuc", buffer_chars=100)
     segments = transfer_segments(program, settings, "drip")
     for sure, says in ((150, "then send again"), (1000, "then resume with --start-block")):
-        sender = Sender(None, segments, settings, "drip", "loop://", None, None, resumable_from=start)
+        sender = Sender(None, segments, settings, "drip", "loop://", progress=None, log=None, resumable_from=start)
         sender.sure = sender.pos = sure
         fault = sender.fault("the control held XOFF", "release the feed hold")
         assert says in str(fault), str(fault)

@@ -47,7 +47,7 @@ def test_newton_only_climbs_and_every_height_is_a_real_contact(example4):
                              + np.sqrt(np.maximum(r * r - (qx - cx) ** 2 - (qy - cy) ** 2, 0)) - r)
     v0 = height(px, py)
     qx, qy, val = px.copy(), py.copy(), v0.copy()
-    h, done = newton_ball(ev, qx, qy, val, cx, cy, r, box, r / 8, 1e-9)
+    h, done = newton_ball(ev, qx, qy, val, cx, cy, radius=r, box=box, spacing=r / 8, settle=1e-9)
     assert np.all(val >= v0)
     assert np.all((qx >= 1) & (qx <= 5) & (qy >= 1) & (qy <= 5))
     assert np.all((qx - cx) ** 2 + (qy - cy) ** 2 <= r * r)

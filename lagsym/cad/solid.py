@@ -28,7 +28,7 @@ from .patch import BezierPatch, BSplinePatch, split_half
 __all__ = ["HeightBounds", "lowest_height", "check_base", "exact_height", "volume", "polynomial_volume"]
 
 RELATIVE_TOLERANCE = Fraction(1, 2**40)  # of the Bernstein coefficients' range: far below any machining use
-MAX_PIECES = 4_000  # a safety net (a second or two); near a single minimum the search needs a few hundred
+MAX_PIECES = 4_000  # a safety net bounding the search; near a single minimum it needs a few hundred
 
 
 @dataclass(frozen=True)

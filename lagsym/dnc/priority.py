@@ -4,8 +4,8 @@ XON/XOFF leaves the sender to keep the characters in flight below what the
 control takes past its DC3 (about 10 on a Fanuc), so the sender must wake
 again before the few it wrote have left the line: within 0.35 ms for a
 window of 4 at 115200 baud, 4 ms at 9600.  An ordinary thread on a loaded
-computer is woken milliseconds late, and the line idles (34 % of the line
-rate at 115200 in ``benchmarks/bench_dnc.py`` under load).  With
+computer is woken milliseconds late, and the line idles while it sleeps
+(``benchmarks/bench_dnc.py`` measures the line rate reached under load).  With
 ``LineSettings.realtime`` the thread that sends runs under ``SCHED_FIFO`` at
 :data:`PRIORITY` for the transfer and is put back after it: the scheduler
 then runs it as soon as it wakes.  The sender waits on the port between

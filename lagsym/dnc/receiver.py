@@ -42,8 +42,9 @@ def _settings_text(settings: LineSettings) -> str:
     return f"{settings.baud} baud, {settings.bytesize}{settings.parity[0].upper()}{settings.stopbits:g}"
 
 
-def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 60.0, idle_timeout_s: float = 5.0,
-                    progress: Callable[[int], None] | None = None, log: Callable[[str], None] | None = None,
+def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float = 60.0,
+                    idle_timeout_s: float = 5.0, progress: Callable[[int], None] | None = None,
+                    log: Callable[[str], None] | None = None,
                     ready: Callable[[], None] | None = None,
                     should_stop: Callable[[], bool] | None = None, line=None) -> str:
     """Receive a program the control punches out, as text with ``\\n`` line ends.
@@ -78,8 +79,9 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
     try:
         if ready:
             ready()
-        raw, percents = _collect(line, port, settings, start_timeout_s, idle_timeout_s, progress,
-                                 log or (lambda _m: None), should_stop)
+        raw, percents = _collect(line, port, settings, start_timeout_s=start_timeout_s,
+                                 idle_timeout_s=idle_timeout_s, progress=progress, log=log or (lambda _m: None),
+                                 should_stop=should_stop)
     except KeyboardInterrupt as e:
         what = f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated) else "stopped by the user"
         raise TransferError(f"receive on {port} {what}; nothing was saved: start lagsym receive again, "
@@ -95,7 +97,7 @@ def receive_program(port: str, settings: LineSettings, start_timeout_s: float = 
     return _program_text(bytes(raw), percents, port, settings)
 
 
-def _collect(line, port, settings, start_timeout_s, idle_timeout_s, progress, log, should_stop):
+def _collect(line, port, settings, *, start_timeout_s, idle_timeout_s, progress, log, should_stop):
     """The program's bytes (leader and control codes dropped) and how many ``%`` they hold."""
     raw = bytearray()
     started = ended = False

@@ -53,7 +53,7 @@ _CARRIER_POLL_S = 0.1
 class Sender:
     """One send over an open port: pacing, flow control, accounting.  Not reused."""
 
-    def __init__(self, line, segments, settings: LineSettings, mode: str, port: str,
+    def __init__(self, line, segments, settings: LineSettings, mode: str, port: str, *,
                  progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None,
                  resumable_from: int = 2):
         self.line, self.settings, self.mode, self.port = line, settings, mode, port

@@ -181,7 +181,8 @@ class LineSettings:
 
 
 CARRIER_LOSS_S = 0.5
-"""How long the carrier signal may be down before the line counts as lost (the issue's bound: within a second)."""
+"""How long the carrier signal may be down before the line counts as lost: short enough that a lost line is
+reported within a second, long enough that a shorter flicker is not taken for a loss."""
 
 # Sources for each profile are in docs/dnc.md.
 PROFILES: dict[str, LineSettings] = {

@@ -63,9 +63,10 @@ def transfer_segments(program: Program, settings: LineSettings, mode: str = "upl
     return segments
 
 
-def send_program(port: str, program: Program, settings: LineSettings, mode: str = "upload", start_block: int = 1,
-                 safe_z: str | None = None, progress: Callable[[TransferProgress], None] | None = None,
-                 log: Callable[[str], None] | None = None, line=None) -> TransferResult:
+def send_program(port: str, program: Program, settings: LineSettings, mode: str = "upload", *,
+                 start_block: int = 1, safe_z: str | None = None,
+                 progress: Callable[[TransferProgress], None] | None = None, log: Callable[[str], None] | None = None,
+                 line=None) -> TransferResult:
     """Send a program to a control over a serial line.
 
     Parameters
@@ -109,10 +110,11 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     """
     segments = transfer_segments(program, settings, mode, start_block, safe_z)
     with realtime(settings.realtime):  # refused before the port opens
-        return _send(port, program, settings, mode, start_block, segments, progress, log, line)
+        return _send(port, program, settings, mode, start_block=start_block, segments=segments, progress=progress,
+                     log=log, line=line)
 
 
-def _send(port, program, settings, mode, start_block, segments, progress, log, line) -> TransferResult:
+def _send(port, program, settings, mode, *, start_block, segments, progress, log, line) -> TransferResult:
     """Open the line (unless given one), run the sender and name every fault truly."""
     from .port import LINE_ERRORS, Port, WriteTimeout  # serial loads only when a line is used
     from .sender import Sender
@@ -122,7 +124,7 @@ def _send(port, program, settings, mode, start_block, segments, progress, log, l
     if owned:
         line = Port(port, settings, write_timeout=timeout)
     try:
-        sender = Sender(line, segments, settings, mode, port, progress, log,
+        sender = Sender(line, segments, settings, mode, port, progress=progress, log=log,
                         resumable_from=first_resumable_block(program) if start_block <= 1 else 2)
     except BaseException:
         if owned:

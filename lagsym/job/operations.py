@@ -111,8 +111,8 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     for i, op in enumerate(spec.operations):
         tool = spec.tools[op.tool]
         try:
-            ops.append(_plan(spec, op, tool, surface, ev, stock, i, (max_points, max_samples),
-                             prefixed(progress, f"{op.kind} T{tool.number}")))
+            ops.append(_plan(spec, op, tool, surface, ev, stock, limits=(max_points, max_samples),
+                             progress=prefixed(progress, f"{op.kind} T{tool.number}")))
         except ToolpathError as e:
             raise InputError(f"{spec.source}: operations[{i}] ({op.kind}): {e}") from None
         planned.add(1)
@@ -120,8 +120,8 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     return PlannedJob(spec, surface, stock, tuple(ops))
 
 
-def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, i: int,
-          limits: tuple, progress: Progress | None = None) -> Operation:
+def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, *, limits: tuple,
+          progress: Progress | None = None) -> Operation:
     o = op.options
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
@@ -136,7 +136,8 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
             kinds = np.full(len(rm.points_mm), FEED, dtype=np.int8)
             kinds[0] = PLUNGE
             return Operation(op, tool, rm.points_mm, kinds, rm)
-        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), ev, *limits, progress=progress)
+        rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), evaluator=ev, max_points=limits[0],
+                            max_samples=limits[1], progress=progress)
         return Operation(op, tool, rp.points_mm, rp.kinds, rp)
     default_dir = "y" if op.kind == "cross-finish" else "x"
     stepover = o.get("stepover", None if "scallop" in o else 0.5)

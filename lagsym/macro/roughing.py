@@ -161,7 +161,7 @@ def _tile(index: Var, position: Var, edges) -> tuple:
                                                for k, e in enumerate(edges, 1))
 
 
-def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, top: Fraction, sd: Fraction,
+def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, *, top: Fraction, sd: Fraction,
                 low: Fraction, levels: int, direction: str) -> tuple[tuple, tuple, tuple]:
     """The loops, and the row and point statements of ``F + stock + R |grad F|`` (for the arithmetic check).
 
@@ -228,22 +228,22 @@ def _near(v_mm: float, per_mm: Fraction) -> Fraction:
     return round(Fraction(repr(float(v_mm))) * per_mm / _GRID) * _GRID
 
 
-def _b_mm(ev, place, radius_mm: float, stock_mm: float, k_mm: float, x_mm, y_mm) -> np.ndarray:
-    """``F + stock + R |grad F| + k_mm`` (mm) at box positions ``x_mm, y_mm`` (machine mm), in floats."""
+def _b_mm(ev, place, radius_mm: float, stock_mm: float, x_mm, y_mm) -> np.ndarray:
+    """``F + stock + R |grad F|`` (mm) at box positions ``x_mm, y_mm`` (machine mm), in floats."""
     u, v = place.to_surface(np.asarray(x_mm, float), np.asarray(y_mm, float))
     g = np.hypot(ev.fast_points(u, v, dx=1), ev.fast_points(u, v, dy=1))
-    return place.height_mm(ev.fast_points(u, v)) + stock_mm + radius_mm * g + k_mm
+    return place.height_mm(ev.fast_points(u, v)) + stock_mm + radius_mm * g
 
 
 def _xy(direction: str, p, r):
     return (p, r) if direction == "x" else (r, p)
 
 
-def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: MachineSettings, per_mm: Fraction,
+def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: MachineSettings, *, per_mm: Fraction,
                    precision: int) -> float:
     """Twice the largest difference of the control's ``b`` from the PC's, over 9 x 41 box positions, plus 3 units."""
-    _, row_code, point_code = _statements(rf, lay, radius, (Fraction(0), Fraction(0)), Fraction(0),
-                                          Fraction(1), Fraction(0), 1, "x")
+    _, row_code, point_code = _statements(rf, lay, radius, (Fraction(0), Fraction(0)), top=Fraction(0),
+                                          sd=Fraction(1), low=Fraction(0), levels=1, direction="x")
     ctx = decimal_context(precision)
     worst, size = 0.0, 0.0
     for rv in np.linspace(float(lay.b0), float(lay.b1), 9):
@@ -254,7 +254,7 @@ def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: Mach
             env["pc"] = ctx.create_decimal(repr(float(pv)))
             got.append(float(run(point_code, env, ctx)["z"]))
         x, y = _xy(rf.direction, ps / float(per_mm), np.full(len(ps), rv / float(per_mm)))
-        want = _b_mm(ev, place, float(radius / per_mm), settings.stock_to_leave_mm, 0.0, x, y)
+        want = _b_mm(ev, place, float(radius / per_mm), settings.stock_to_leave_mm, x, y)
         worst = max(worst, float(np.abs(np.array(got) / float(per_mm) - want).max()))
         size = max(size, float(np.abs(want).max()))
     ulp = float(Decimal(1).scaleb(Decimal(repr(size * float(per_mm))).adjusted() + 1 - precision)) / float(per_mm)
@@ -290,14 +290,14 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     settings = dataclasses.replace(settings, stock_to_leave_mm=spec.stock_to_leave_mm)
     ev = evaluator or surface_evaluator(surface)
     place = settings.placement
-    check_rough_request(tool, stock, spec, ev, place, max_points, "--max-points")
+    check_rough_request(tool, stock, spec, ev, place, max_points=max_points, option="--max-points")
     per_mm = program_units_per_mm(settings.units)
     rf = row_form(surface, settings, spec.direction, form)
     language = settings.control.macro
     tiles = language.table_tiles if language is not None and language.table_base is not None else 1
     lay = _layout(rf, stock, tool, spec, per_mm, tiles)
     radius = _near(tool.radius_mm, per_mm)
-    arith = _arithmetic_mm(rf, lay, radius, ev, place, settings, per_mm, precision)
+    arith = _arithmetic_mm(rf, lay, radius, ev, place, settings, per_mm=per_mm, precision=precision)
     edges = [np.array([float(v / per_mm) for v in (lo, *inner, hi)])
              for lo, inner, hi in ((lay.a0, lay.p_edges, lay.a1), (lay.b0, lay.r_edges, lay.b1))]
     ex, ey = edges if spec.direction == "x" else edges[::-1]
@@ -305,8 +305,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
                              10.0 ** -settings.digits / float(per_mm), arith, spec.direction)
     a = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.a_mm]
     b = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.b_mm]
-    rows, pts, tip = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a, b, per_mm,
-                            spec.direction)
+    rows, pts, tip = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a=a, b=b,
+                            per_mm=per_mm, direction=spec.direction)
     top, sd = _near(stock.top_mm, per_mm), _near(spec.stepdown_mm, per_mm)
     low = _down(Fraction(repr(float(tip.min()))) * per_mm)
     count = max(math.ceil((top - low) / sd), 1)
@@ -322,7 +322,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
         tables = (base, tiles)
         setup = tuple(SetItem(base + k * tiles * tiles + ir * tiles + ip, const(t[ip][ir]))
                       for k, t in enumerate((a, b)) for ir in range(tiles) for ip in range(tiles))
-    body, row_code, point_code = _statements(rf, lay, radius, tables, top, sd, low, count, spec.direction)
+    body, row_code, point_code = _statements(rf, lay, radius, tables, top=top, sd=sd, low=low, levels=count,
+                                             direction=spec.direction)
     path = _path(rows, pts, tip, levels, spec.direction)
     _check_safe_z(float(path[:, 2].max()), settings)
     start = tuple(Fraction(repr(float(v))) * per_mm for v in path[0])
@@ -348,7 +349,7 @@ def _check_safe_z(highest_mm: float, settings: MachineSettings) -> None:
                             f"raise --safe-z to at least {need:.3f} mm")
 
 
-def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, a, b, per_mm: Fraction, direction: str):
+def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, *, a, b, per_mm: Fraction, direction: str):
     """The rows' and points' positions (mm) and the tip before the level (mm) at each, rows by points."""
     f = float(per_mm)
     kk = np.arange(lay.np_ + 1)
@@ -362,7 +363,7 @@ def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, a, b, per
     bt = np.array([[float(v) for v in row] for row in b]) / f
     pp, rr = np.meshgrid(pc / f, rc / f)
     x, y = _xy(direction, pp, rr)
-    high = _b_mm(ev, place, radius_mm, stock_mm, 0.0, x, y) + at[ti[None, :], tj[:, None]]
+    high = _b_mm(ev, place, radius_mm, stock_mm, x, y) + at[ti[None, :], tj[:, None]]
     return r / f, p / f, np.minimum(high, bt[ti[None, :], tj[:, None]])
 
 

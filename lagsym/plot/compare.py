@@ -106,7 +106,8 @@ def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str =
         if name == reference:
             _add_plan(p, x, y, pts, f"{name}\n(reference z_f)", bottom)
         else:
-            d_actor = _add_deviation(p, x, y, ref - zs[name], f"d = {reference} - {name}", units, dmax, bottom)
+            d_actor = _add_deviation(p, x, y, ref - zs[name], name=f"d = {reference} - {name}", units=units,
+                                     dmax=dmax, font=bottom)
         plan_axes(p, units, ticks)
         plan_view(p, zoom=0.6)
     bar_column(p, 0, n, z_actor.mapper, zname, h)
@@ -115,7 +116,7 @@ def compare_figure(x, y, surfaces: Mapping[str, np.ndarray], *, reference: str =
     return p
 
 
-def _add_deviation(p, x, y, d, name: str, units: str, dmax: float, font: int):
+def _add_deviation(p, x, y, d, *, name: str, units: str, dmax: float, font: int):
     """One deviation map on the current panel, titled with ``name`` and its largest ``|d|``; returns the actor."""
     dname = f"d ({units})"
     actor = p.add_mesh(scalar_mesh(x, y, np.zeros_like(d), dname, d), scalars=dname, cmap=DEVIATION_CMAP,
@@ -177,7 +178,7 @@ def deviation_figure(x, y, deviations: Mapping[str, np.ndarray], *, reference: s
     actor = None
     for col, (name, d) in enumerate(ds.items()):
         p.subplot(0, col)
-        actor = _add_deviation(p, x, y, d, titles[name], units, dmax, font)
+        actor = _add_deviation(p, x, y, d, name=titles[name], units=units, dmax=dmax, font=font)
         plan_axes(p, units, ticks)
         plan_view(p, zoom=0.75)
     bar_column(p, 0, n, actor.mapper, f"d ({units})", 2 * h)

@@ -110,7 +110,29 @@ class _Row:
     s_z: np.ndarray  # and their heights (mm)
 
 
-def fit_arcs(points_mm, rows, exact_mm, fine_mm, direction: str, kappa: float, tol: float, unit_factor: float,
+@dataclass(frozen=True)
+class _Bounds:
+    """What every arc of one toolpath is checked against; travels together through the fit and its checks."""
+
+    kappa: float  # how fast the cutter path bends down at most (1/mm)
+    tol: float  # the chordal tolerance (mm)
+    unit_mm: float  # one unit of the program's last decimal (mm)
+    limit_mm: float  # how far the start and end radius of a written arc may differ (mm)
+    chord_mm: float  # how far inside its arcs the control's chords may lie (mm)
+
+
+@dataclass(frozen=True)
+class _Chord:
+    """The chord from an arc's start to its end: its ends ``(along, z)``, length, middle and upward unit normal."""
+
+    start: np.ndarray
+    end: np.ndarray
+    length: float
+    mid: np.ndarray
+    normal: np.ndarray
+
+
+def fit_arcs(points_mm, rows, exact_mm, fine_mm, *, direction: str, kappa: float, tol: float, unit_factor: float,
              digits: int, units: str, reach_mm: tuple[float, float], radius_mm: float, chord_mm: float = 0.0) -> Arcs:
     """The arcs that replace moves of the toolpath ``points_mm`` (see the module docstring).
 
@@ -131,6 +153,8 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, direction: str, kappa: float, t
     reach_mm : tuple of float
         The box's extent along the rows (machine mm): an arc stays a tool
         radius ``radius_mm`` inside it.
+    chord_mm : float
+        How far inside its arcs the control's chords may lie (:data:`CHORD_MM`), mm.
     """
     ax, cx = (0, 1) if direction == "x" else (1, 0)
     unit_mm = 10.0 ** -digits / unit_factor
@@ -140,7 +164,7 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, direction: str, kappa: float, t
     safe = (ints[:, ax] * unit_mm >= lo) & (ints[:, ax] * unit_mm <= hi)
     order = np.lexsort((fine_ints[:, ax], fine_ints[:, cx]))
     f_cross = fine_ints[order, cx]
-    limit_mm = RADIUS_AGREE * RADIUS_LIMIT[units] / unit_factor
+    bounds = _Bounds(kappa, tol, unit_mm, RADIUS_AGREE * RADIUS_LIMIT[units] / unit_factor, chord_mm)
     out = []
     n = len(ints)
     same = np.zeros(n, dtype=bool)
@@ -159,7 +183,7 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, direction: str, kappa: float, t
         inside = (sa >= a[0]) & (sa <= a[-1])
         k = np.argsort(sa[inside], kind="stable")
         row = _Row(a, ints[b0:b1, 2] * unit_mm, sa[inside][k], sz[inside][k])
-        for i, j, centre in _greedy(row, kappa, tol, unit_mm, limit_mm, chord_mm):
+        for i, j, centre in _greedy(row, bounds):
             ca = centre[0] * sign
             s3, e3 = points_mm[b0 + i], points_mm[b0 + j]
             v1 = np.array([s3[ax] - ca, s3[2] - centre[1]])
@@ -172,14 +196,14 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, direction: str, kappa: float, t
                 ccw=arr[:, 4].astype(bool), plane="G18" if ax == 0 else "G19")
 
 
-def _greedy(row: _Row, kappa: float, tol: float, unit_mm: float, limit_mm: float, chord_mm: float):
+def _greedy(row: _Row, bounds: _Bounds):
     """``(i, j, centre)`` of the arcs along one run, from each point as far as an arc fits."""
     n, i = len(row.a), 0
     while i < n - 2:
         good, bad, step = None, None, 2
         while True:  # the reach doubled while an arc fits, then bisected back
             hi = min(i + step, n - 1)
-            c = _fit(row, i, hi, kappa, tol, unit_mm, limit_mm, chord_mm)
+            c = _fit(row, i, hi, bounds)
             if c is None:
                 bad = hi
                 break
@@ -192,7 +216,7 @@ def _greedy(row: _Row, kappa: float, tol: float, unit_mm: float, limit_mm: float
             continue
         while bad is not None and bad - good[0] > 1:
             mid = (good[0] + bad) // 2
-            c = _fit(row, i, mid, kappa, tol, unit_mm, limit_mm, chord_mm)
+            c = _fit(row, i, mid, bounds)
             if c is None:
                 bad = mid
             else:
@@ -208,7 +232,7 @@ def _samples(row: _Row, i: int, j: int):
     return row.s_a[k0:k1], row.s_z[k0:k1]
 
 
-def _fit(row: _Row, i: int, j: int, kappa: float, tol: float, unit_mm: float, limit_mm: float, chord_mm: float):
+def _fit(row: _Row, i: int, j: int, bounds: _Bounds):
     """The rounded centre ``(along, z)`` (mm) of an arc from point ``i`` to ``j`` that passes both checks, or None.
 
     The arcs through both ends form a family ordered by their sagitta (the
@@ -218,12 +242,14 @@ def _fit(row: _Row, i: int, j: int, kappa: float, tol: float, unit_mm: float, li
     it.  The middle of what is left is tried, its centre rounded, and the
     rounded arc (or one a unit beside it) checked in full (:func:`_check`).
     """
+    kappa, tol, chord_mm = bounds.kappa, bounds.tol, bounds.chord_mm
     sa, sz = _samples(row, i, j)
     S, E = np.array([row.a[i], row.z[i]]), np.array([row.a[j], row.z[j]])
     chord = E - S
     L = float(np.hypot(*chord))
     normal = np.array([-chord[1], chord[0]]) / L  # the upward side of the chord (the along axis grows)
     mid = (S + E) / 2
+    line = _Chord(S, E, L, mid, normal)
     inner = (sa > S[0]) & (sa < E[0])
     if not inner.any():
         return None
@@ -233,7 +259,7 @@ def _fit(row: _Row, i: int, j: int, kappa: float, tol: float, unit_mm: float, li
     a, cl = sa[inner], sz[inner]
     first, last = int(np.flatnonzero(inner)[0]), int(np.flatnonzero(inner)[-1])
     m_ends = (S[1] - chord_mm - sz[first - 1], E[1] - chord_mm - sz[last + 1])
-    hi = _sagittas(a, cl + tol, S, E, L, mid, normal).min()
+    hi = _sagittas(a, cl + tol, line).min()
     bend, s = 0.0, None
     for _ in range(2):  # once for a dome, again with a hollow's own bend
         c = kappa + bend
@@ -241,7 +267,7 @@ def _fit(row: _Row, i: int, j: int, kappa: float, tol: float, unit_mm: float, li
         for k, h_end, m in ((0, sa[first] - sa[first - 1], m_ends[0]), (-1, sa[last + 1] - sa[last], m_ends[1])):
             q = c * h_end**2 / 2
             need[k] = max(need[k], (np.sqrt(q) - np.sqrt(max(m, 0.0))) ** 2 if m < q else 0.0)
-        lo = _sagittas(a, cl + need + chord_mm, S, E, L, mid, normal).max()
+        lo = _sagittas(a, cl + need + chord_mm, line).max()
         if lo > hi:
             return None
         s = 0.5 * (lo + hi)
@@ -259,16 +285,17 @@ def _fit(row: _Row, i: int, j: int, kappa: float, tol: float, unit_mm: float, li
         return None
     r = (L * L / 4 + s * s) / (2 * abs(s))
     centre = mid + normal * (s - np.sign(s) * r)
-    base = np.rint(centre / unit_mm)
+    base = np.rint(centre / bounds.unit_mm)
     for step in ((0, 0), (0, -1), (0, 1), (-1, 0), (1, 0), (-1, -1), (1, 1), (-1, 1), (1, -1)):
-        c = (base + step) * unit_mm
-        if _check(c, S, E, sa, sz, kappa, tol, limit_mm, chord_mm):
+        c = (base + step) * bounds.unit_mm
+        if _check(c, line, sa, sz, bounds):
             return c
     return None
 
 
-def _sagittas(a, z, S, E, L, mid, normal):
-    """The signed sagitta of the circle through ``S``, ``E`` and each point ``(a, z)`` (positive: bulging up)."""
+def _sagittas(a, z, line: _Chord):
+    """The signed sagitta of the circle through the chord's ends and each point ``(a, z)`` (positive: bulging up)."""
+    L, mid, normal = line.length, line.mid, line.normal
     d = np.stack([a - mid[0], z - mid[1]], axis=1)
     tangent = np.array([normal[1], -normal[0]])
     u, w = d @ tangent, d @ normal
@@ -285,28 +312,29 @@ def _heights(centre_a, centre_z, radius, dome, a):
     return np.where(dome, centre_z + root, centre_z - root)
 
 
-def _passes(low, high, sa, sz, kappa, tol, bend):
+def _passes(low, high, sa, sz, bounds: _Bounds, bend):
     """Both checks of a circle's heights: ``low`` never below the path, ``high`` within ``tol`` above it.
 
     ``low - sz`` at two neighbouring samples is ``m0`` and ``m1``; with the
-    path less the circle bending down no faster than ``c = kappa + bend``,
+    path less the circle bending down no faster than ``c = bounds.kappa + bend``,
     the path rises above the circle between them by at most the largest of
     ``-(1-u) m0 - u m1 + c h**2 u (1-u) / 2`` (``h`` apart), which must be 0
     or less.
     """
     m = low - sz
-    q = (kappa + bend) * np.diff(sa) ** 2 / 2.0
+    q = (bounds.kappa + bend) * np.diff(sa) ** 2 / 2.0
     m0, m1 = m[:-1], m[1:]
     with np.errstate(invalid="ignore", divide="ignore"):
         u = np.clip(np.where(q > 0, (m0 - m1 + q) / (2 * q), 0.0), 0.0, 1.0)
     if np.any(m < 0.0) or np.any(-(1 - u) * m0 - u * m1 + q * u * (1 - u) > 0.0):
         return False
     inner = (sa > sa[0]) & (sa < sa[-1])  # the ends are written points, kept as the line moves keep them
-    return bool(np.all(high[inner] - sz[inner] <= tol))
+    return bool(np.all(high[inner] - sz[inner] <= bounds.tol))
 
 
-def _check(c, S, E, sa, sz, kappa, tol, limit_mm, chord_mm):
-    """Whether the rounded arc about ``c`` from ``S`` to ``E`` passes both checks."""
+def _check(c, line: _Chord, sa, sz, bounds: _Bounds):
+    """Whether the rounded arc about ``c`` along the chord ``line`` passes both checks."""
+    S, E, limit_mm, chord_mm = line.start, line.end, bounds.limit_mm, bounds.chord_mm
     rs, re = float(np.hypot(*(S - c))), float(np.hypot(*(E - c)))
     if abs(rs - re) > limit_mm or max(rs, re) > MAX_RADIUS_MM:
         return False
@@ -322,4 +350,4 @@ def _check(c, S, E, sa, sz, kappa, tol, limit_mm, chord_mm):
     v -= r_hi - r_lo
     if v < MIN_COS * r_hi:
         return False
-    return _passes(low, high, sa, sz, kappa, tol, 0.0 if dome else r_hi * r_hi / v**3)
+    return _passes(low, high, sa, sz, bounds, 0.0 if dome else r_hi * r_hi / v**3)

@@ -169,7 +169,7 @@ def bent_moves(keep: np.ndarray, bend: np.ndarray, threshold: float = BENT_MM) -
     return np.maximum(top, near[keep[1:]]) > threshold
 
 
-def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
+def _move_dips(cl, move, length, radius):
     """How far the true cutter path may rise above each straight move ``a -> b``, where, and the path there.
 
     Samples the path at evenly spaced interior points (at least
@@ -180,8 +180,10 @@ def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
     fine samples of a row (see :func:`bent_moves` for a ridge between two
     samples); the largest is the move's dip.  Returns the dip (0 or more,
     mm), the fraction along the move where it was found and the cutter
-    location there (mm).
+    location there (mm).  ``move`` is ``(ax, ay, az, bx, by, bz)``, the
+    ends of the moves.
     """
+    ax, ay, az, bx, by, bz = move
     m = len(ax)
     if m == 0:
         return np.zeros(0), np.zeros(0), np.zeros(0)
@@ -204,14 +206,14 @@ def _move_dips(cl, ax, ay, az, bx, by, bz, length, radius):
     # The zoom's first round reaches the worst sample's neighbours, a move's end where it is one: known already.
     lo, hi = np.maximum(worst - 1, 0), np.minimum(worst + 1, idx.size - 1)
     ends = (np.where(first[worst], az, zc[lo]), np.where(last[worst], bz, zc[hi]))
-    du, dz, zw = _zoom(cl, (ax, ay, az, bx, by, bz), u[worst], d[worst], zc[worst], 1.0 / (n_move + 1), ends)
+    du, dz, zw = _zoom(cl, move, u[worst], d[worst], zc[worst], 1.0 / (n_move + 1), ends=ends)
     return np.maximum(np.maximum(est[worst], dz), 0.0), du, zw
 
 
 _ZOOM_SAMPLES, _ZOOM_ROUNDS = 6, 3
 
 
-def _zoom(cl, move, u, d, z, half, ends=None):
+def _zoom(cl, move, u, d, z, half, *, ends=None):
     """The dip of each move searched closer around its worst sample ``u`` (fraction along it; ``half`` apart).
 
     A path that bends sharply next to a sample (where the tool starts to
@@ -242,7 +244,7 @@ def _zoom(cl, move, u, d, z, half, ends=None):
     return u, d, z
 
 
-def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
+def check_moves(cl, vx, vy, vz, vrow, sag, *, seen, dense, tol, radius):
     """Check the moves marked ``dense`` against the true cutter path; with a tolerance, split those that dip more.
 
     ``cl(x, y, **search)`` gives the cutter locations (mm) over surface
@@ -257,7 +259,7 @@ def check_moves(cl, vx, vy, vz, vrow, sag, seen, dense, tol, radius):
     for _ in range(_CHECK_SPLITS + 1):
         a, b = check, check + 1
         length = np.hypot(vx[b] - vx[a], vy[b] - vy[a])
-        d, u, zc = _move_dips(cl, vx[a], vy[a], vz[a], vx[b], vy[b], vz[b], length, radius)
+        d, u, zc = _move_dips(cl, (vx[a], vy[a], vz[a], vx[b], vy[b], vz[b]), length, radius)
         sag[check] = np.maximum(d, seen)
         if tol is None:
             break

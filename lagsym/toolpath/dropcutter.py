@@ -157,8 +157,8 @@ _HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator, float] = weakref.Wea
 def _height_scale(ev: SurfaceEvaluator) -> float:
     """Spread of the surface's coefficients in the power basis of the normalized coordinates.
 
-    The scale :data:`CL_MARGIN` and the search's settling threshold were set
-    against; the Chebyshev coefficients are converted back (in floats) only
+    The scale :data:`CL_MARGIN` and the search's settling threshold are
+    relative to; the Chebyshev coefficients are converted back (in floats) only
     to measure it, once per evaluator.
     """
     found = _HEIGHT_SCALES.get(ev)

@@ -78,7 +78,7 @@ def surface_jet(ev: SurfaceEvaluator, x, y) -> np.ndarray:
     return out
 
 
-def newton_ball(ev, px, py, val, cx, cy, radius, box, spacing, settle):
+def newton_ball(ev, px, py, val, cx, cy, *, radius, box, spacing, settle):
     """Move each start towards the local maximum of the ball's contact height; in place.
 
     ``px, py`` are the starts (contact points), ``val`` their heights,

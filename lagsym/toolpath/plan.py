@@ -160,7 +160,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     # Worker processes on the other cores, where the plan is large enough to pay for starting them.
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
         cl = replace(cl, workers=workers)
-        path = _fine_path(cl, levels, along, raster.direction, fine, past, progress)
+        path = _fine_path(cl, levels, along, raster.direction, fine, past=past, progress=progress)
         tp = _checked(ev, cl, path, tol, raster, kappa, every, settings, progress)
     bx, by, _ = _place(settings, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     tp = Toolpath(**tp, tool=tool, raster=raster,
@@ -186,8 +186,8 @@ def _checked(ev, cl, path, tol, raster, kappa, every, settings, progress=None) -
     dense = ((chordal.crosses_box_edge(vx, vy, ev.bounds, cl.radius) & chordal.bent_moves(kept, bend))
              | corner[:-1] | corner[1:] | (sag > tol))
     with Tally(progress, "checking moves") as checks:
-        vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen, dense, tol,
-                                                    cl.radius)
+        vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen=seen,
+                                                    dense=dense, tol=tol, radius=cl.radius)
     return without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
                            _place(settings, vx, vy, vz)[2], cl.unit * cl.mm_per_unit)
 
@@ -197,10 +197,11 @@ def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSett
     fine = np.stack(_place(settings, path.x, path.y, path.z), axis=1)
     x0, x1, y0, y1 = tp.bounds_mm
     raster = tp.raster
-    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, raster.direction, kappa,
-                                     raster.chordal_tolerance_mm, settings.unit_factor, settings.digits,
-                                     settings.units, (x0, x1) if raster.direction == "x" else (y0, y1),
-                                     cl.radius * cl.mm_per_unit, settings.control.chord_mm))
+    return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, direction=raster.direction,
+                                     kappa=kappa, tol=raster.chordal_tolerance_mm,
+                                     unit_factor=settings.unit_factor, digits=settings.digits, units=settings.units,
+                                     reach_mm=(x0, x1) if raster.direction == "x" else (y0, y1),
+                                     radius_mm=cl.radius * cl.mm_per_unit, chord_mm=settings.control.chord_mm))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
@@ -361,7 +362,8 @@ class _FinePath:
     pieces: tuple[tuple[int, int, bool], ...]
 
 
-def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, past: float | None, progress=None) -> _FinePath:
+def _fine_path(cl: _Cutter, levels, along, direction: str, fine: float, *, past: float | None,
+               progress=None) -> _FinePath:
     """Drop the tool over every fine sample of every row and of the links between rows, in cutting order.
 
     With the tool ``past`` the boundary (that far, surface units), positions

@@ -52,7 +52,7 @@ from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_o
 __all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
            "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points"]
 
-MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (about 1 ms each): minutes at most
+MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (the slow part): minutes at most
 
 MILLING = ("zigzag", "climb", "conventional")
 _SPLIT_TOL_MM = 1e-3  # a checked move dipping more than this below the floor is split at its worst point
@@ -165,9 +165,9 @@ class RoughPath:
         return len(self.points_mm)
 
 
-def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings,
+def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, *,
                    evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS,
-                   max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None) -> RoughPath:
+                   max_samples: int | None = MAX_ROUGH_SAMPLES, progress: Progress | None = None) -> RoughPath:
     """Plan z-level roughing of ``stock`` down to the surface plus the stock to leave.
 
     Parameters
@@ -204,22 +204,17 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     ev = evaluator or surface_evaluator(surface)
     place = settings.placement
     box = place.box_mm(ev.bounds)
-    check_rough_request(tool, stock, spec, ev, place, max_samples, "--max-samples")
+    check_rough_request(tool, stock, spec, ev, place, max_points=max_samples, option="--max-samples")
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
+    drop = _Drop(surface, ev, place, tool, box, spec.stock_to_leave_mm)
     if spec.pattern == "offset":
         x, y = offset_line(stock, box, tool.radius_mm, spec)
-        floors = floor_at(surface, ev, place, tool, box, [x], [y], spec.stock_to_leave_mm, progress=progress)
-
-        def cl(px, py, **search):
-            return floor_at(surface, ev, place, tool, box, [np.asarray(px, float)], [np.asarray(py, float)],
-                            spec.stock_to_leave_mm, **search)[0]
-
-        x, y, floor, up = checked_line(cl, x, y, floors[0], box, tool.radius_mm, sigma)
+        floors = floor_at(drop, [x], [y], progress=progress)
+        x, y, floor, up = checked_line(drop, x, y, floors[0], sigma)
         floors, lifts = [floor], [up]
     else:
         rows = _rows(stock, box, tool.radius_mm, spec)
-        rows, floors, lifts = _checked(rows, _floors(surface, ev, place, tool, box, rows, spec, progress), surface,
-                                       ev, place, tool, box, spec, sigma, progress)
+        rows, floors, lifts = _checked(rows, _floors(drop, rows, spec, progress), drop, spec, sigma, progress)
     reachable = np.concatenate([f for f in floors])
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
@@ -230,13 +225,13 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
         raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
                             f"the tool reaches {spec.reach_mm:g} mm below its holder")
     if spec.pattern == "offset":
-        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock, spec)
+        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec)
     else:
         pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec)
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
-def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place,
+def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place, *,
                         max_points: int | None, option: str) -> None:
     """What every roughing refuses before any work: the cutter, the side step, the block, one level's size."""
     if tool.diameter_mm <= 0:
@@ -300,22 +295,42 @@ def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
     a0, a1 = (stock.x0, stock.x1) if along_x else (stock.y0, stock.y1)
     b_along, b_cross = (box[:2], box[2:]) if along_x else (box[2:], box[:2])
     out = spec.clearance_mm + radius
-    return [_Row(float(c), along_samples(a0 - out, a1 + out, float(c), b_along, b_cross, radius, spec.step_mm))
+    return [_Row(float(c), along_samples(a0 - out, a1 + out, float(c), b_along, b_cross, radius=radius,
+                                         step=spec.step_mm))
             for c in spaced(c0, c1, spec.stepover_mm)]
 
 
-def _floors(surface, ev, place, tool: Tool, box, rows, spec: RoughSpec, progress=None) -> list[np.ndarray]:
+@dataclass(frozen=True)
+class _Drop:
+    """What roughing drops its tool with, the same from the first samples to each row's check.
+
+    The surface, its evaluator and placement, the tool, the surface's box
+    on the machine (mm) and the stock to leave (mm).
+    """
+
+    surface: object
+    ev: SurfaceEvaluator
+    place: object
+    tool: Tool
+    box: tuple
+    stock_mm: float
+
+    def line(self, x, y, **search) -> np.ndarray:
+        """``CL + stock`` (mm) along one polyline (:func:`floor_at`)."""
+        return floor_at(self, [np.asarray(x, float)], [np.asarray(y, float)], **search)[0]
+
+
+def _floors(drop: _Drop, rows, spec: RoughSpec, progress=None) -> list[np.ndarray]:
     """``CL + stock`` (mm) at every sample of every row, ``-inf`` where the tool does not touch the box."""
     along_x = spec.direction == "x"
     xs, ys = [], []
     for r in rows:
         xs.append(r.along if along_x else np.full(len(r.along), r.cross))
         ys.append(np.full(len(r.along), r.cross) if along_x else r.along)
-    return floor_at(surface, ev, place, tool, box, xs, ys, spec.stock_to_leave_mm, progress=progress)
+    return floor_at(drop, xs, ys, progress=progress)
 
 
-def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progress: Progress | None = None,
-             **search) -> list[np.ndarray]:
+def floor_at(drop: _Drop, xs, ys, progress: Progress | None = None, **search) -> list[np.ndarray]:
     """``CL + stock`` (mm) at tool positions ``xs, ys`` (lists of mm arrays) anywhere on the machine.
 
     A position outside the box but within the tool radius of it takes the
@@ -324,6 +339,7 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progr
     :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``); ``progress`` is
     told the positions dropped (stage ``dropping the tool``).
     """
+    surface, ev, place, tool, box, stock_mm = drop.surface, drop.ev, drop.place, drop.tool, drop.box, drop.stock_mm
     x, y = np.concatenate(xs), np.concatenate(ys)
     px, py = np.clip(x, box[0], box[1]), np.clip(y, box[2], box[3])
     touch = np.hypot(x - px, y - py) <= tool.radius_mm * (1 + 1e-12)
@@ -337,17 +353,18 @@ def floor_at(surface, ev, place, tool: Tool, box, xs, ys, stock_mm: float, progr
     return np.split(out, np.cumsum([len(a) for a in xs])[:-1])
 
 
-def checked_line(cl, vx, vy, f, box, radius: float, sigma: float):
+def checked_line(drop: _Drop, vx, vy, f, sigma: float):
     """One polyline's samples checked where the tool meets a box edge (see :func:`_checked`).
 
     Returns the points (the check's own added), their floors and their lifts.
     """
+    cl, box, radius = drop.line, drop.box, drop.tool.radius_mm
     live = np.isfinite(f)
     dense = crosses_box_edge(vx, vy, box, radius) & live[:-1] & live[1:]
     vz = np.where(live, f, 0.0) + sigma
     zeros = np.zeros(len(f) - 1)
-    nx, ny, nz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, zeros.copy(), dense, _SPLIT_TOL_MM,
-                                     radius)
+    nx, ny, nz, _, sag = check_moves(cl, vx, vy, vz, np.zeros(len(f)), zeros, seen=zeros.copy(), dense=dense,
+                                     tol=_SPLIT_TOL_MM, radius=radius)
     floor = nz.copy()  # a point the check added has its floor there, without sigma
     k = 0
     for i in range(len(nx)):  # the first points are a subsequence of the checked ones
@@ -357,7 +374,7 @@ def checked_line(cl, vx, vy, f, box, radius: float, sigma: float):
     return nx, ny, floor, sigma + lift(sag)
 
 
-def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec, sigma: float, progress=None):
+def _checked(rows, floors, drop: _Drop, spec: RoughSpec, sigma: float, progress=None):
     """Rows whose moves are checked against the true floor where the tool meets a box edge, and each sample's lift.
 
     Away from the box edges the flat or ball end's height is semi-convex and
@@ -373,18 +390,13 @@ def _checked(rows, floors, surface, ev, place, tool: Tool, box, spec: RoughSpec,
     floors and ``sigma`` plus the lift at every sample.
     """
     along_x = spec.direction == "x"
-
-    def cl(x, y, **search):
-        return floor_at(surface, ev, place, tool, box, [np.asarray(x, float)], [np.asarray(y, float)],
-                        spec.stock_to_leave_mm, **search)[0]
-
     out_rows, out_floors, lifts = [], [], []
     checks = Tally(progress, "checking rows", len(rows))
     checks.start()
     for r, f in zip(rows, floors):
         cross = np.full(len(r.along), r.cross)
         vx, vy = (r.along, cross) if along_x else (cross, r.along)
-        vx, vy, floor, up = checked_line(cl, vx, vy, f, box, tool.radius_mm, sigma)
+        vx, vy, floor, up = checked_line(drop, vx, vy, f, sigma)
         out_rows.append(_Row(r.cross, vx if along_x else vy))
         out_floors.append(floor)
         lifts.append(up)

@@ -39,7 +39,8 @@ FEED, RAPID, PLUNGE = 0, 1, 2
 PATTERNS = ("raster", "offset")
 
 
-def along_samples(lo: float, hi: float, cross: float, box_along, box_cross, radius: float, step: float) -> np.ndarray:
+def along_samples(lo: float, hi: float, cross: float, box_along, box_cross, *, radius: float,
+                  step: float) -> np.ndarray:
     """Positions from ``lo`` to ``hi`` on a line at ``cross``: the forward step plus the corners of the
     nearest-point rule (the box edges, and where the disc under the tool starts to meet an edge or corner)."""
     b_a0, b_a1 = box_along
@@ -62,9 +63,9 @@ def along_samples(lo: float, hi: float, cross: float, box_along, box_cross, radi
 def _segment(p, q, box, radius: float, step: float):
     """Samples of the axis-parallel segment ``p -> q`` (x, y arrays), ``p`` included, ``q`` left out."""
     if p[1] == q[1]:
-        a = along_samples(p[0], q[0], p[1], box[:2], box[2:], radius, step)
+        a = along_samples(p[0], q[0], p[1], box[:2], box[2:], radius=radius, step=step)
         return a[:-1], np.full(len(a) - 1, p[1])
-    a = along_samples(p[1], q[1], p[0], box[2:], box[:2], radius, step)
+    a = along_samples(p[1], q[1], p[0], box[2:], box[:2], radius=radius, step=step)
     return np.full(len(a) - 1, p[0]), a[:-1]
 
 
@@ -101,7 +102,7 @@ def _kept_corners(x, y, z) -> np.ndarray:
     return np.flatnonzero(~flat)
 
 
-def assemble_offset(x, y, floor, up, z_levels, stock, spec):
+def assemble_offset(x, y, floor, up, z_levels, *, stock, spec):
     """The offset path's moves level by level: down beside the block, the loops, up and over to the next."""
     top = stock.top_mm + spec.clearance_mm
     pts, kinds, floors = [], [], []

@@ -189,7 +189,7 @@ def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scall
         s = max(lo, floor)
         levels.append(min(c + s, c1) if c1 - (c + s) > 1e-9 * (c1 - c0) else c1)
     levels = np.array(levels)
-    worst, at = _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit)
+    worst, at = _worst(levels, along, cross, stretch, k, radius_mm=radius_mm, mm_per_unit=mm_per_unit)
     return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight, samples=k.size)
 
 
@@ -203,7 +203,7 @@ def row_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm
     """
     along, cross, stretch, k = _samples(ev, direction, mm_per_unit, stepover_mm, radius_mm)
     levels = np.asarray(levels, dtype=float)
-    worst, at = _worst(levels, along, cross, stretch, k, radius_mm, radius_mm / mm_per_unit, mm_per_unit)
+    worst, at = _worst(levels, along, cross, stretch, k, radius_mm=radius_mm, mm_per_unit=mm_per_unit)
     return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=int(np.isnan(k).sum()), samples=k.size)
 
 
@@ -230,8 +230,9 @@ def gap_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm
     return along, out
 
 
-def _worst(levels, along, cross, stretch, k, radius_mm, r, mm_per_unit):
+def _worst(levels, along, cross, stretch, k, *, radius_mm, mm_per_unit):
     """The largest cusp predicted between the rows at ``levels``, over each gap's band, and where."""
+    r = radius_mm / mm_per_unit
     worst, at = 0.0, (float(along[0]), float(cross[0]))
     for c, nxt in zip(levels[:-1], levels[1:]):
         band = slice(int(np.searchsorted(cross, c - r)), int(np.searchsorted(cross, nxt + r, side="right")))

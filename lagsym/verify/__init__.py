@@ -209,11 +209,11 @@ def program_resolution_mm(text: str) -> float:
     return 0.5 * 10.0 ** -digits * unit
 
 
-def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Placement(),
+def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Placement(), *,
                  cell_mm: float | None = None, program_resolution_mm: float = 0.0005,
                  gouge_limit_mm: float | None = None, max_cells: int | None = MAX_CELLS,
                  max_contacts: int | None = MAX_CONTACTS, max_left_mm: float = MAX_LEFT_MM,
-                 max_scallop_mm: float | None = None, *, progress: Progress | None = None) -> CutReport:
+                 max_scallop_mm: float | None = None, progress: Progress | None = None) -> CutReport:
     """Simulate the moves with the tool on a height map over the surface's box and compare with the surface.
 
     Parameters
@@ -257,11 +257,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     if not use.any():
         raise InputError("the program has no move with a known Z to simulate (no G00/G01 after the first Z)")
     r, corner, piece, resolution = tool_grid(tool, xs, ys)
-    check_work(path[:-1][use], path[1:][use], piece, r, hx, hy, max_contacts)
+    check_work(path[:-1][use], path[1:][use], piece, r, hx, hy, max_contacts=max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
     cut = np.full((len(xs), len(ys)), np.inf)
-    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, None,
-                               progress)
+    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, max_contacts=None,
+                               progress=progress)
     crash, crash_segments = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner))
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
                      rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],

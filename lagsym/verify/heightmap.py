@@ -81,7 +81,8 @@ def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None, prog
         pad[inner] = cut[rows, cols]
         stripes = 2 * workers if workers > 1 and pad.shape[0] >= 2 * workers * (2 * kx + 1) else 1
         work = [[] for _ in range(stripes)]
-        for stripe, chunk in _chunks(a, b, (ix - i0, iy - j0), (i0, j0), (xs, ys, r), pad.shape, stripes):
+        for stripe, chunk in _chunks(a, b, (ix - i0, iy - j0), (i0, j0), (xs, ys, r), shape=pad.shape,
+                                      stripes=stripes):
             work[stripe].append(chunk)
         geometry = (hx, hy, r, kx, ky, pad.shape[1], pad.reshape(-1))
 
@@ -131,7 +132,7 @@ def _pieces(a, b, piece):
     return a[k] + t0[:, None] * d[k], a[k] + t1[:, None] * d[k]
 
 
-def _chunks(a, b, anchor, origin, grid, shape, stripes):
+def _chunks(a, b, anchor, origin, grid, *, shape, stripes):
     """Segments in groups whose nearest cells (to their middles) differ, so one offset reaches distinct cells.
 
     ``anchor`` holds each segment's nearest cell in the window ``shape``, whose first cell is ``origin`` in the map.
@@ -232,7 +233,7 @@ def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tup
     return np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
 
 
-def check_work(a, b, piece: float, r: float, hx: float, hy: float, max_contacts: int | None) -> None:
+def check_work(a, b, piece: float, r: float, hx: float, hy: float, *, max_contacts: int | None) -> None:
     """Refuse a simulation whose segments swept times cells each can reach would exceed ``max_contacts``."""
     if max_contacts is None:
         return
@@ -246,7 +247,7 @@ def check_work(a, b, piece: float, r: float, hx: float, hy: float, max_contacts:
             f"moves and the tool diameter, use a larger cell (--cell), or raise the limit (--max-contacts)")
 
 
-def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool,
+def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool, *,
                 max_contacts: int | None = MAX_CONTACTS, progress: Progress | None = None) -> tuple[int, float]:
     """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
 
@@ -257,7 +258,7 @@ def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, 
     r, corner, piece, resolution = tool_grid(tool, xs, ys)
     if not len(a):
         return 0, resolution
-    check_work(a, b, piece, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts)
+    check_work(a, b, piece, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts=max_contacts)
     return sweep(cut, a, b, xs, ys, r, corner, progress=progress), resolution
 
 
