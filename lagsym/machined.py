@@ -17,7 +17,6 @@ exact surface inside the box of the control points (beyond it lies no part):
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +24,7 @@ import numpy as np
 from ._arrays import freeze_fields
 from .errors import InputError
 from .evaluate import evaluate_grid
-from .gcode import Moves, parse_moves, tool_changes
+from .gcode import Moves, first_line_with, is_macro, macro_uses, parse_moves, program_blocks, tool_changes
 from .io import read_points
 from .job.operations import job_stock
 from .lagrange import lagrange_surface
@@ -190,22 +189,24 @@ def machine_job(spec, text: str, source: str = "<program>", **options) -> Machin
     """
     surface = lagrange_surface(read_points(spec.points))
     stock = job_stock(spec, surface)
-    # in a macro program the macro statements are blanked (the lines kept): its tool changes are plain words
-    plain = _MACRO_BLOCK.sub("", text) if _MACRO_LINE.search(text) else text
     moves = job_moves(spec, text, source, options.get("progress"))
-    return machine_part(surface, moves, tool_changes(plain, source=source),
+    if is_macro(text, _SIMULATED):
+        # the macro statements are blanked (the lines kept): the program's tool changes are plain words
+        statements = {no for no, _, block in program_blocks(text) if macro_uses(block)}
+        text = "\n".join("" if no in statements else line for no, line in enumerate(text.splitlines(), start=1))
+    return machine_part(surface, moves, tool_changes(text, source=source),
                         {t.number: t.tool for t in spec.tools.values()}, stock.box + (stock.top_mm,),
                         Placement(spec.mm_per_unit, spec.origin_mm), **options)
 
 
-_MACRO_LINE = re.compile(r"^[ \t]*(#|WHILE\b|o\d+[ \t])", re.I | re.M)
-_MACRO_BLOCK = re.compile(r"^[^\n]*(#|\[|^[ \t]*o\d+[ \t]|^[ \t]*END\d)[^\n]*$", re.I | re.M)
+# What the point-list reader cannot run and the simulator can (calls and returns neither runs).
+_SIMULATED = ("variable", "expression", "loop", "jump", "condition")
 
 
 def job_moves(spec, text: str, source: str = "<program>", progress: Progress | None = None) -> Moves:
-    """The moves of a job's program: read as a point list or, where it holds macro loops (a roughing macro,
+    """The moves of a job's program: read as a point list or, where it holds macro statements (a roughing macro,
     ``macro = true``), as lagsym's simulator runs it at the precision of the job's macros."""
-    if not _MACRO_LINE.search(text):
+    if not is_macro(text, _SIMULATED):
         return parse_moves(text, source=source)
     from .macro import DEFAULT_PRECISION
     from .simulate import simulate
@@ -213,16 +214,8 @@ def job_moves(spec, text: str, source: str = "<program>", progress: Progress | N
     precision = max(op.options.get("precision", DEFAULT_PRECISION[spec.dialect]) for op in spec.operations
                     if op.options.get("macro")) if any(op.options.get("macro") for op in spec.operations) \
         else DEFAULT_PRECISION.get(spec.dialect, 15)
-    sim = simulate(text, spec.dialect, precision, progress=progress).moves
-    n = len(sim)
-    scale = 25.4 if spec.units == "inch" else 1.0
-    pts = np.column_stack([np.frombuffer(c, dtype=float) if n else np.zeros(0) for c in (sim._x, sim._y, sim._z)])
-    line = np.frombuffer(sim._line, dtype=np.int32).astype(int) if n else np.zeros(0, int)
-    z_lines = [k for k, t in enumerate(text.splitlines(), 1) if re.search(r"Z[-+.\d#\[]", re.sub(r"\(.*?\)", "", t))]
-    return Moves(points_mm=pts.reshape(-1, 3) * scale, start_mm=np.zeros(3),
-                 rapid=np.frombuffer(sim._rapid, dtype=np.int8).astype(bool) if n else np.zeros(0, bool),
-                 feed_mm_min=np.frombuffer(sim._feed, dtype=float) * scale if n else np.zeros(0),
-                 line=line, z_known=line >= (z_lines[0] if z_lines else math.inf))
+    sim = simulate(text, spec.dialect, precision, progress=progress)
+    return sim.moves.to_moves(25.4 if spec.units == "inch" else 1.0, first_line_with(text, "Z"))
 
 
 def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from lagsym.dnc import parse_program
+from lagsym.dnc.blocks import check_drip
 from lagsym.errors import InputError
 
 
@@ -23,3 +24,16 @@ def test_blocks_are_the_non_empty_lines_inside_the_percent_framing():
 def test_programs_a_line_cannot_carry_are_refused_with_the_line(text, words):
     with pytest.raises(InputError, match=words):
         parse_program(text, "p.nc")
+
+
+@pytest.mark.parametrize("block", ["WHILE[#1LT3]DO1", "END1", "GOTO10", "IF[#1GT0]GOTO5", "N20M99", "M99P10",
+                                   "o100 endwhile"])
+def test_a_drip_feed_refuses_loops_jumps_and_returns_however_written(block):
+    with pytest.raises(InputError, match="loops or jumps"):
+        check_drip(parse_program(f"O1\n#1=0\n{block}\nM30", "p.nc"))
+
+
+@pytest.mark.parametrize("block", ["G65 P9010 A1.", "M98P100", "#1=#1+1.", "IF[#1GT0]THEN#2=1", "G1 X1. (GOTO 10)",
+                                   "5 END PGM 1 MM"])
+def test_a_drip_feed_may_call_and_compute(block):
+    check_drip(parse_program(f"O1\n{block}\nM30", "p.nc"))

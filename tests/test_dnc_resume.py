@@ -22,6 +22,10 @@ def test_resume_setup_restores_modes_retracts_and_approaches():
     (PROGRAM, 1, "outside the program"),
     (PROGRAM, 99, "outside the program"),
     ("O1\nG21 G90\n#1=5\nG0 Z#1\nG1 X1. F100.", 5, "macro variables"),
+    # calls, jumps and expressions written without spaces or without a '#' (once read as plain words)
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nM98P100\nG1 Z-1. F100.\nX3.", 6, "macro variables"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nN5G65P9010\nG1 Z-1. F100.\nX3.", 6, "macro variables"),
+    ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG0 X[1.+1.]\nG1 Z-1. F100.\nX3.", 6, "macro variables"),
     ("O1\nG90 G0 Z5.\nG1 X1. F100.", 3, "G20 or G21"),
     ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG81 Z-2. R1. F100.\nX2.", 5, "canned cycle G81 is still on"),
     ("O1\nG21 G90\nG0 X1. Y1. Z5.\nG41 D1 G1 X2. F100.\nX3.", 5, "cutter compensation G41"),

@@ -124,3 +124,22 @@ def test_verify_job_refuses_a_program_with_an_unknown_tool_or_no_tool_change(run
     prog.write_text(SLOT.replace("T1 M06\n", "").replace("T2 M06\n", ""))
     status, _, err = run_cli("verify", "--job", job, prog)
     assert status == 2 and "no tool change" in err
+
+
+def test_a_fanuc_program_number_is_not_a_macro_and_a_commented_tool_change_counts(tmp_path):
+    from lagsym.job import read_job
+    from lagsym.machined import job_moves, machine_job
+
+    job, _ = _job(tmp_path)
+    spec = read_job(job)
+    # "O1 (SLOT)" was once taken for a LinuxCNC o-word, and the point list run through the simulator.
+    text = SLOT.replace("O1\n", "O1 (SLOT)\n")
+    moves = job_moves(spec, text)
+    assert np.array_equal(moves.feed_mm_min, parse_moves(text).feed_mm_min, equal_nan=True)
+    assert np.isnan(moves.feed_mm_min[0])  # no F yet: the point-list reader's NaN, not the simulator's 0
+    # In a macro program, a '#' in a comment once blanked its block, tool change and all.
+    macro = SLOT.replace("G21 G90\n", "G21 G90\n#1=1.\n").replace("G00 Z1.", "G00 Z#1").replace(
+        "T2 M06", "T2 M06 (TOOL #2)")
+    part = machine_job(spec, macro, cell_mm=0.1)
+    assert [(s.tool_number, s.first_line) for s in part.stages] == [(1, 5), (2, 10)]
+    assert part.final_mm.min() == pytest.approx(1.0, abs=0.01)  # the ball went down to Z#1

@@ -180,6 +180,10 @@ def test_a_5_um_gouge_at_one_point_fails_under_the_default_limit(ex2_program):
 def test_program_resolution_and_limit():
     assert program_resolution_mm("(TOOL 6.00000)\nG21 G90\nG01 X1.000 Y2.000 Z-0.125 F600.0\n") == 0.0005
     assert program_resolution_mm("G20\nG01 X1.0000 Y2.0000\n") == pytest.approx(0.00127)
+    # Words are read as the point-list reader reads them: "G90G20" is inch, an unclosed comment ends at its line.
+    assert program_resolution_mm("G90G20\nG01 X1.0000 Y2.0000\n") == pytest.approx(0.00127)
+    assert program_resolution_mm("(NOTE\nG20\nG01 X1.0000 (A)\n") == pytest.approx(0.00127)
+    assert program_resolution_mm("%\nG21\nG01 X 1.000\n%\nG01 X1.00000\n") == 0.0005
     assert gouge_limit(0.0005, 0.0) == 0.0005
 
 

@@ -9,10 +9,10 @@ no part in it: many programs have none, and some repeat them.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 from ..errors import InputError
+from ..gcode.program import macro_uses
 
 __all__ = ["Program", "parse_program", "frame", "check_drip", "check_iso", "tv_padded", "ISO_840", "DC1", "DC2", "DC3",
            "DC4"]
@@ -23,8 +23,7 @@ ISO_840 = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 \t+-./%():#=[]*,&$?@;<
 """The printable characters of the ISO 840 tape code as Fanuc's ISO code table lists them (no lower case)."""
 # A control reading from tape cannot jump back: loops, jumps and M99 returns need the program in memory
 # (M98 and G65 call a program that is already in memory, which a drip feed may do).
-_JUMPS = re.compile(r"\bGOTO|\bWHILE\b|\bDO\s*\d|\bEND\s*\d|\bM99\b")
-_COMMENT = re.compile(r"\([^)]*\)|;.*$")
+_JUMPS = frozenset({"loop", "jump", "return"})
 
 
 @dataclass(frozen=True)
@@ -121,7 +120,7 @@ def check_drip(program: Program) -> None:
     lagsym.errors.InputError: m.nc: block 3 (WHILE[#1LT3]DO1) loops or jumps, which a control cannot do in a program it reads from tape; upload it (--mode upload)
     """
     for number, block in enumerate(program.blocks, start=1):
-        if _JUMPS.search(_COMMENT.sub(" ", block.upper())):
+        if macro_uses(block) & _JUMPS:
             raise InputError(f"{program.source}: block {number} ({block}) loops or jumps, which a control cannot "
                              "do in a program it reads from tape; upload it (--mode upload)")
 

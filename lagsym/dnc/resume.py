@@ -14,12 +14,11 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import InputError
-from ..gcode.words import numeric_words, strip_comments
+from ..gcode.program import macro_uses
+from ..gcode.words import numeric_words
 from .blocks import Program
 
 __all__ = ["resume_setup", "find_block", "first_resumable_block"]
-
-_MACRO = re.compile(r"#|\bGOTO\b|\bWHILE\b|\bIF\b|\bM98\b|\bM99\b|\bG65\b")
 
 
 @dataclass
@@ -235,7 +234,7 @@ def resume_setup(program: Program, start_block: int, safe_z: str | None = None) 
     for number in range(1, start_block):
         block = program.block(number)
         where = f"{program.source}: block {number}"
-        if _MACRO.search(strip_comments(block).upper()):
+        if macro_uses(block):
             raise InputError(f"{where} uses macro variables, jumps or subprogram calls; a resume cannot know the "
                              "state they leave, so send the program from the start")
         try:

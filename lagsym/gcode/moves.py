@@ -28,6 +28,7 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import ProgramError
 from .arcs import arc_points
+from .program import program_blocks
 from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
@@ -82,21 +83,6 @@ class Moves:
     def feeds(self) -> np.ndarray:
         """End points of the feed (cutting) moves only."""
         return self.points_mm[~self.rapid]
-
-
-def _blocks(text: str):
-    """``(line number, raw line, block)`` for each block a control reads: up to the closing ``%``."""
-    percent = 0
-    for no, raw in enumerate(text.splitlines(), start=1):
-        s = raw.strip()
-        if not s:
-            continue
-        if s.startswith("%"):
-            percent += 1
-            if percent == 2:
-                return  # the end of the program: anything after is not read by a control
-            continue
-        yield no, raw, s[1:] if s.startswith("/") else s  # block delete off: the block runs
 
 
 class _Modal:
@@ -164,7 +150,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     modal = _Modal()
     pts, rapid, feeds, lines, zk = [], [], [], [], []
     z_seen = False
-    for no, raw, block in _blocks(text):
+    for no, raw, block in program_blocks(text):
         where = f"{source}, line {no}"
         plain = plain_move(block)
         if plain is not None:  # most blocks of a point list: no need to go word by word
@@ -245,7 +231,7 @@ def tool_changes(text: str, source: str = "<program>") -> list[tuple[int, int]]:
     [(1, 1), (4, 2)]
     """
     out, tool = [], None
-    for no, raw, block in _blocks(text):
+    for no, raw, block in program_blocks(text):
         try:
             words = numeric_words(block)
         except WordError as e:

@@ -25,9 +25,12 @@ FUNCTIONS = ("SQRT", "ABS", "FIX", "FUP", "ROUND", "SIN", "COS", "TAN", "ATAN", 
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)"
 _NUMERIC_WORD = re.compile(r"([A-Za-z])\s*(" + _NUMBER + ")")
-# Alternatives in one pattern, so whichever comment starts first wins: "; note (x" is one comment.
-_COMMENTS = re.compile(r"\([^)]*\)|;.*")
-_PARENTHESES = re.compile(r"\([^)]*\)")
+# Alternatives in one pattern, so whichever comment starts first wins: "; note (x" is one comment, and
+# "(a;b)" another.  A comment holds no "(": LinuxCNC refuses a comment inside a comment, so "(a (b) c)" is
+# not taken for "(a (b)" and a stray " c)", but left with its unmatched "(" for a strict reader to refuse.
+_COMMENTS = re.compile(r"\([^()]*\)|;.*")
+_PARENTHESES = re.compile(r"\([^()]*\)")
+_NESTED = re.compile(r"\([^)]*\(")
 # The block a point list is made of, in one piece: an optional G0/G1, then X, Y, Z, F each at most once, in order.
 _PLAIN_MOVE = re.compile(r"(?:G0?([01])(?![0-9.])\s*)?(?:X(" + _NUMBER + r")\s*)?(?:Y(" + _NUMBER + r")\s*)?"
                          r"(?:Z(" + _NUMBER + r")\s*)?(?:F(" + _NUMBER + r")\s*)?")
@@ -41,8 +44,14 @@ class WordError(ValueError):
 def strip_comments(block: str, *, semicolon: bool = True) -> str:
     """``block`` with each ``(...)`` comment, and with ``semicolon`` a ``;`` to the end, made a space.
 
-    A comment separates the words on either side of it, as in LinuxCNC's
-    interpreter.  An unclosed ``(`` is left in the text for the reader to refuse.
+    This is the one definition of a comment in lagsym: every reader of
+    G-code (the point-list reader, the simulator, the DNC sender's checks,
+    the resume, verify's resolution and units) takes comments out here.
+    Whichever comment starts first wins (``(a;b)`` is one comment, and so is
+    ``; note (x``); a comment ends at the first ``)`` and separates the words
+    on either side of it, as in LinuxCNC's interpreter.  An unclosed ``(``,
+    and a comment inside a comment (which LinuxCNC refuses), are left in the
+    text with their ``(`` for the reader to refuse.
 
     Parameters
     ----------
@@ -58,6 +67,8 @@ def strip_comments(block: str, *, semicolon: bool = True) -> str:
     'G1 X1.   Y2.  '
     >>> strip_comments("#1=2. ; not a comment here", semicolon=False)
     '#1=2. ; not a comment here'
+    >>> strip_comments("G1 (a (b) c) X1.")
+    'G1 (a   c) X1.'
     """
     if "(" not in block and (not semicolon or ";" not in block):
         return block
@@ -89,7 +100,8 @@ def numeric_words(block: str, *, semicolon: bool = True, strict: bool = True) ->
     Raises
     ------
     WordError
-        With ``strict``, for an unclosed comment or text that is not a word.
+        With ``strict``, for an unclosed comment, a comment inside a comment,
+        or text that is not a word.
 
     Examples
     --------
@@ -102,13 +114,11 @@ def numeric_words(block: str, *, semicolon: bool = True, strict: bool = True) ->
     >>> numeric_words("G1 X#1", strict=False)
     [('G', '1')]
     """
-    text = block
-    if "(" in text or (semicolon and ";" in text):
-        text = (_COMMENTS if semicolon else _PARENTHESES).sub(" ", text)
+    text = strip_comments(block, semicolon=semicolon)
     found = _NUMERIC_WORD.findall(text)
     if strict:
         if "(" in text:
-            raise WordError("unclosed comment")
+            raise WordError("a comment inside a comment" if _NESTED.search(block) else "unclosed comment")
         rest = _NUMERIC_WORD.sub("", text).strip()
         if rest:
             raise WordError(f"cannot read {rest!r}")

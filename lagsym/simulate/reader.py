@@ -35,6 +35,9 @@ def detect_dialect(text: str) -> str:
 def read_blocks(text: str, dialect: str | Control) -> list[Block]:
     """The blocks of ``text`` in order, without blank, ``%`` and block-delete (``/``) lines.
 
+    The second ``%`` line ends the program, as for every reader of a program
+    (:func:`lagsym.gcode.program_blocks`): a control reads nothing after it.
+
     Raises
     ------
     ControlAlarm
@@ -45,12 +48,18 @@ def read_blocks(text: str, dialect: str | Control) -> list[Block]:
     parse = PARSERS[c.macro.name]
     blocks = []
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    percent = 0
     for n, raw in enumerate(lines, start=1):
+        t = raw.strip()
+        if t.startswith("%"):
+            percent += 1
+            if percent == 2:
+                break
+            continue
         if len(raw) > limit:
             raise ControlAlarm("block", f"block of {len(raw)} characters, more than the {limit} the control reads",
                                n, raw)
-        t = raw.strip()
-        if t == "%" or not t or t.startswith("/"):
+        if not t or t.startswith("/"):
             continue
         try:
             b = parse(n, raw, t)

@@ -8,6 +8,7 @@ before it starts (:data:`BYTES_PER_MOVE` times ``max_blocks``).
 
 from __future__ import annotations
 
+import math
 from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -94,6 +95,39 @@ class SimMoves(Sequence):
         keep = np.frombuffer(self._rapid, dtype=np.int8) == 0 if len(self) else np.zeros(0, bool)
         cols = [np.frombuffer(c, dtype=float) if len(self) else np.zeros(0) for c in (self._x, self._y, self._z)]
         return np.column_stack(cols)[keep].reshape(-1, 3).copy()
+
+    def to_moves(self, mm_per_unit: float = 1.0, first_z_line: int | None = 1):
+        """The moves as the one :class:`lagsym.gcode.Moves` type, in mm, for a reader of any program's moves.
+
+        Parameters
+        ----------
+        mm_per_unit : float
+            Millimetres per program unit (25.4 for a ``G20`` program).
+        first_z_line : int or None
+            The line from which the program has given a Z (:func:`lagsym.gcode.first_line_with`):
+            moves on earlier lines have ``z_known`` False.  None: no move has.
+
+        Examples
+        --------
+        >>> from lagsym.simulate import simulate
+        >>> m = simulate("G0 X1. Y2.\\nG1 Z-1. F100.\\n", "fanuc", 8).moves.to_moves(25.4, first_z_line=2)
+        >>> m.points_mm.tolist(), m.rapid.tolist(), m.feed_mm_min.tolist(), m.line.tolist(), m.z_known.tolist()
+        ([[25.4, 50.8, 0.0], [25.4, 50.8, -25.4]], [True, False], [0.0, 2540.0], [1, 2], [False, True])
+        """
+        import numpy as np
+
+        from ..gcode.moves import Moves
+
+        n = len(self)
+
+        def column(c, dtype):
+            return np.frombuffer(c, dtype=dtype) if n else np.zeros(0, dtype=dtype)
+
+        line = column(self._line, np.intc).astype(int)
+        pts = np.column_stack([column(c, float) for c in (self._x, self._y, self._z)]).reshape(-1, 3)
+        return Moves(points_mm=pts * mm_per_unit, start_mm=np.zeros(3), rapid=column(self._rapid, np.int8).astype(bool),
+                     feed_mm_min=column(self._feed, float) * mm_per_unit, line=line,
+                     z_known=line >= (math.inf if first_z_line is None else first_z_line))
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,6 @@ overstated by at most ``resolution_mm``.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,7 +44,8 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import InputError
 from ..evaluate import evaluate_grid, surface_evaluator
-from ..gcode import Moves
+from ..gcode import Moves, numeric_words, program_blocks, program_units
+from ..gcode.words import plain_move
 from ..machine import MAX_LEFT_MM, Placement, Tool
 from ..progress import Progress
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
@@ -188,13 +188,11 @@ def gouge_limit(program_resolution_mm: float, steepest_slope: float) -> float:
     return program_resolution_mm * (1.0 + math.sqrt(2.0) * steepest_slope)
 
 
-_DECIMALS = re.compile(r"[XYZ][+-]?\d*\.(\d+)", re.IGNORECASE)
-_COMMENT = re.compile(r"\([^)]*\)|;.*")
-_INCH = re.compile(r"(?<![A-Z0-9.])G0*20(?![0-9.])", re.IGNORECASE)
-
-
 def program_resolution_mm(text: str) -> float:
     r"""Half a unit of the last decimal of the program's X, Y and Z words, in mm (G20: in inches).
+
+    The words and the units are read as every reader of a program reads them
+    (:func:`lagsym.gcode.program_blocks`, :func:`lagsym.gcode.program_units`).
 
     Examples
     --------
@@ -203,9 +201,14 @@ def program_resolution_mm(text: str) -> float:
     >>> round(program_resolution_mm("G20\nG01 X1.0000 Y2.0000\n"), 8)
     0.00127
     """
-    code = _COMMENT.sub("", text)
-    digits = max((len(m.group(1)) for m in _DECIMALS.finditer(code)), default=0)
-    unit = 25.4 if _INCH.search(code) else 1.0
+    digits = 0
+    for _, _, block in program_blocks(text):
+        plain = plain_move(block)
+        values = plain[1:4] if plain is not None else [v for k, v in numeric_words(block, strict=False) if k in "XYZ"]
+        for v in values:
+            if v and "." in v:
+                digits = max(digits, len(v) - v.index(".") - 1)
+    unit = 25.4 if program_units(text) == "inch" else 1.0
     return 0.5 * 10.0 ** -digits * unit
 
 

@@ -1,0 +1,214 @@
+"""A whole program read block by block: the lines a control reads, its units, and what in it is a macro.
+
+Every reader of a whole program in lagsym asks its questions here, on top of
+the one word tokenizer (:mod:`lagsym.gcode.words`), so they read a program
+alike:
+
+* :func:`program_blocks`: the lines a control reads, up to the closing ``%``;
+* :func:`program_units`: ``G20`` or ``G21``, read as words (``G90G20`` too);
+* :func:`macro_uses` and :func:`is_macro`: what in a block or a program is
+  more than plain words (variables, expressions, loops, jumps, conditions,
+  subprogram calls and returns), with comments taken out first, so a ``#``
+  in ``(TOOL #2)`` is text and ``M98P100`` a call;
+* :func:`first_line_with`: the first block that gives a word, whatever its
+  value (a number, a variable or an expression).
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..values import choice
+from .words import WordError, numeric_words, strip_comments, words
+
+__all__ = ["MACRO_USES", "program_blocks", "program_units", "macro_uses", "is_macro", "first_line_with"]
+
+MACRO_USES = ("variable", "expression", "loop", "jump", "condition", "call", "return")
+"""What :func:`macro_uses` names: ``#`` variables; ``[..]`` expressions; loops (``WHILE .. DO``, ``END``,
+``o.. while``, ``do``, ``repeat``); jumps (``GOTO``); conditions (``IF``, ``THEN``, ``o.. if``, ``else``);
+subprogram calls (``M98``, ``G65``, ``G66``, ``o.. call``); returns and subprogram bodies (``M99``,
+``o.. sub``, ``endsub``, ``return``)."""
+
+_O_WORDS = {"while": "loop", "do": "loop", "endwhile": "loop", "repeat": "loop", "endrepeat": "loop",
+            "break": "loop", "continue": "loop", "if": "condition", "elseif": "condition", "else": "condition",
+            "endif": "condition", "call": "call", "sub": "return", "endsub": "return", "return": "return"}
+_O_WORD = re.compile(r"O\s*(?:\d+|<[^>]*>)\s*([A-Z]+)")
+_KEYWORDS = {"WHILE": "loop", "DO": "loop", "END": "loop", "GOTO": "jump", "IF": "condition", "THEN": "condition"}
+# Keywords are runs of letters (a word is one letter and a number); DO and END count with their loop number, so
+# Heidenhain's END PGM is not a loop.
+_KEYWORD = re.compile(r"(?<![A-Z])(?:(WHILE|GOTO|IF|THEN)(?![A-Z])|(DO|END)\s*\d)")
+_NAMED = re.compile(r"#<[^>]*>")
+_N_NUMBER = re.compile(r"N\s*\d+\s*")
+_CALLS = {("G", 65.0): "call", ("G", 66.0): "call", ("G", 66.1): "call", ("M", 98.0): "call", ("M", 99.0): "return"}
+_EOL = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"  # where str.splitlines ends a line
+_LINE_END = re.compile(f"[{_EOL}]")
+_SPACE = f"[^\\S{_EOL}]*"  # space within a line, as numeric_words allows between a letter and its number
+# Every block macro_uses finds something in matches this (most blocks of a point list do not), so it is a quick
+# first look: "#", "[", the O of an o-word, GOTO and DO, the W of WHILE, the I of IF, the E of THEN and END, and
+# M98, M99, G65, G66 (letter classes rather than re.I: several times faster on a block of plain words).
+_HINT = re.compile(f"[#\\[OoWwIiEe]|[Mm]{_SPACE}\\+?0*9[89]|[Gg]{_SPACE}\\+?0*6[56]")
+_UNITS_HINT = re.compile(f"[Gg]{_SPACE}\\+?0*2[01]")
+_PERCENT = re.compile(f"(?:^|(?<=[{_EOL}]))[^\\S{_EOL}]*%")
+
+
+def program_blocks(text: str):
+    """``(line number, raw line, block)`` for each block a control reads, comments still in.
+
+    Blank lines are passed over; a line starting with ``%`` is framing, and
+    the second one ends the program (a control reads nothing after it).  A
+    block-delete ``/`` is taken off and the block read (block delete off).
+    Line numbers count from 1, over every line of ``text``.
+
+    Examples
+    --------
+    >>> [(no, block) for no, _, block in program_blocks("%\\nO1 (A)\\n\\n/G0 X1.\\n%\\nG1 Z-9.\\n")]
+    [(2, 'O1 (A)'), (4, 'G0 X1.')]
+    """
+    percent = 0
+    for no, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if not s:
+            continue
+        if s.startswith("%"):
+            percent += 1
+            if percent == 2:
+                return  # the end of the program: anything after is not read by a control
+            continue
+        yield no, raw, s[1:] if s.startswith("/") else s
+
+
+def program_units(text: str) -> str | None:
+    """The units a program's coordinates are in: ``"inch"`` if any block selects ``G20``, ``"mm"`` for ``G21``.
+
+    A program that selects both writes some of its coordinates in inches, the
+    coarser unit, so it counts as inch.  None when it selects neither.
+    Macro text is passed over (:func:`~lagsym.gcode.words.numeric_words`
+    without ``strict``).
+
+    Examples
+    --------
+    >>> program_units("G21 G90\\nG1 X1.\\n"), program_units("G90G20 (INCH)\\n"), program_units("G1 X1.\\n")
+    ('mm', 'inch', None)
+    """
+    found = None
+    for block in _blocks_hinted(text, _UNITS_HINT):
+        for letter, value in numeric_words(block, strict=False):
+            if letter == "G" and round(float(value), 1) in (20.0, 21.0):
+                if round(float(value), 1) == 20.0:
+                    return "inch"
+                found = "mm"
+    return found
+
+
+def macro_uses(block: str, *, semicolon: bool = True) -> frozenset[str]:
+    """What one block uses beyond plain words, each named as in :data:`MACRO_USES`; empty for plain words.
+
+    Comments are taken out first (:func:`~lagsym.gcode.words.strip_comments`,
+    ``semicolon`` as there), letters read in either case, and calls read as
+    words, so ``N10M98P100`` is a call and ``T2 M06 (TOOL #2)`` is plain.
+
+    Examples
+    --------
+    >>> sorted(macro_uses("WHILE [#1 LT 10.] DO1")), sorted(macro_uses("o100 if [#<n> GT 2]"))
+    (['expression', 'loop', 'variable'], ['condition', 'expression', 'variable'])
+    >>> sorted(macro_uses("GOTO10")), sorted(macro_uses("N10M98P100")), macro_uses("O1000 (DEMO #1)")
+    (['jump'], ['call'], frozenset())
+    """
+    if not _HINT.search(block):
+        return frozenset()
+    t = strip_comments(block, semicolon=semicolon).strip().upper()
+    found = set()
+    if "#" in t:
+        found.add("variable")
+    if "[" in t:
+        found.add("expression")
+    head = _N_NUMBER.match(t)
+    o_word = _O_WORD.match(t, head.end() if head else 0)
+    if o_word and o_word.group(1).lower() in _O_WORDS:
+        found.add(_O_WORDS[o_word.group(1).lower()])
+    for m in _KEYWORD.finditer(_NAMED.sub("#", t)):
+        found.add(_KEYWORDS[m.group(1) or m.group(2)])
+    for letter, value in numeric_words(t, strict=False):
+        if letter in "GM":
+            use = _CALLS.get((letter, round(float(value), 1)))
+            if use:
+                found.add(use)
+    return frozenset(found)
+
+
+def is_macro(text: str, uses=MACRO_USES, *, semicolon: bool = True) -> bool:
+    """Whether a block, or any block of a program, uses any of ``uses`` (:func:`macro_uses`).
+
+    Parameters
+    ----------
+    text : str
+        One block or a whole program (read as :func:`program_blocks` does).
+    uses : sequence of str
+        Which uses count, from :data:`MACRO_USES` (all by default).
+    semicolon : bool
+        Whether ``;`` starts a comment (see :func:`~lagsym.gcode.words.strip_comments`).
+
+    Examples
+    --------
+    >>> is_macro("O1000 (DEMO)\\nG1 X1. Z#1\\n"), is_macro("O1000 (DEMO)\\nT2 M06 (TOOL #2)\\n")
+    (True, False)
+    >>> is_macro("G65 P9010 A1.", uses=("loop", "jump")), is_macro("M99", uses=("loop", "jump", "return"))
+    (False, True)
+    """
+    wanted = frozenset(choice(u, MACRO_USES, "macro use") for u in uses)
+    return any(wanted & macro_uses(block, semicolon=semicolon) for block in _blocks_hinted(text, _HINT))
+
+
+def first_line_with(text: str, letter: str) -> int | None:
+    """The line of the first block that gives a ``letter`` word, whatever its value; None if none does.
+
+    Macro statements (assignments, loops, jumps, conditions: their letters
+    are names, not words) are passed over; a value may be a number, a
+    variable or an expression (``Z#105``, ``Z[#1-2.]``).
+
+    Examples
+    --------
+    >>> first_line_with("(STOCK TOP Z73.5)\\n#1=2.\\nG0 X0 Y0\\nG1 Z#1\\n", "Z")
+    4
+    """
+    letter = letter.upper()
+    for no, _, block in program_blocks(text):
+        t = strip_comments(block).strip()
+        if letter not in t.upper() or _statement(t.upper()):
+            continue
+        try:
+            found = words(t)
+        except WordError:
+            continue  # not words: no reader of the program takes it for a move
+        if any(w == letter for w, _ in found):
+            return no
+    return None
+
+
+def _blocks_hinted(text: str, hint: re.Pattern):
+    """The blocks of :func:`program_blocks` on the lines where ``hint`` matches, found by one search of the text.
+
+    A long point list has few such lines (for most questions, its comments), so most lines are never split off.
+    """
+    frame = [m.end() - 1 for m in _PERCENT.finditer(text)][:2]
+    end = frame[1] if len(frame) == 2 else len(text)
+    pos = 0
+    while True:
+        found = hint.search(text, pos, end)
+        if found is None:
+            return
+        start = max(text.rfind(c, 0, found.start()) for c in _EOL) + 1
+        line_end = _LINE_END.search(text, found.end(), end)
+        stop = end if line_end is None else line_end.start()
+        block = text[start:stop].strip()
+        if block and not block.startswith("%"):
+            yield block[1:] if block.startswith("/") else block
+        pos = stop + 1
+
+
+def _statement(t: str) -> bool:
+    """Whether an upper-case, comment-free block is a macro statement rather than words."""
+    head = _N_NUMBER.match(t)
+    t = t[head.end():] if head else t
+    o_word = _O_WORD.match(t)
+    return t.startswith("#") or bool(o_word and o_word.group(1).lower() in _O_WORDS) or bool(_KEYWORD.match(t))
