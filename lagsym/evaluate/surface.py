@@ -14,7 +14,6 @@ throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -24,6 +23,7 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
+from .cache import ObjectCache
 from .engine import COMPILED_POINTS, choose_engine
 from .product import grid_product, readonly_view
 from .threads import block_items, run_blocks
@@ -387,9 +387,6 @@ class SurfaceEvaluator:
 
 
 
-_SURFACES: dict[int, SurfaceEvaluator] = {}
-
-
 def _exact_floats(nodes) -> np.ndarray:
     a = np.array([Fraction(float(v)) == v for v in nodes])
     a.setflags(write=False)
@@ -400,12 +397,14 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
     """The :class:`SurfaceEvaluator` of a :class:`~lagsym.lagrange.LagrangeSurface`.
 
     The exact change of basis is done once per surface object and remembered
-    while the object lives.
+    while the object lives (:class:`.cache.ObjectCache`: never handed to
+    another object, even one at the same address).
     """
-    key = id(surface)
-    found = _SURFACES.get(key)
-    if found is not None:
-        return found
+    return _SURFACES.get(surface)
+
+
+def _make_evaluator(surface) -> SurfaceEvaluator:
+    """The exact change of basis of ``surface``, rounded once to floats."""
     g = surface.grid
     xo, xh, ax = chebyshev_transform(g.x)
     yo, yh, ay = chebyshev_transform(g.y)
@@ -413,7 +412,7 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
     power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
     cheb = ax * power * ay.transpose()
     coeffs = np.array([[float(fraction(cheb[a, b])) for b in range(m)] for a in range(n)])
-    ev = SurfaceEvaluator(
+    return SurfaceEvaluator(
         x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh,
         coefficients=_readonly(coeffs),
         data_range=data_range(v for row in g.z for v in row),
@@ -424,9 +423,9 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
         y_exact=_exact_floats(g.y),
         node_values=_readonly(g.z_array),
     )
-    _SURFACES[key] = ev
-    weakref.finalize(surface, _SURFACES.pop, key, None)
-    return ev
+
+
+_SURFACES: ObjectCache[SurfaceEvaluator] = ObjectCache(_make_evaluator)
 
 
 def evaluate_points(surface, x, y) -> np.ndarray:
