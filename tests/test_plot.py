@@ -440,7 +440,8 @@ def test_a_figure_leaves_the_process_environment_as_it_was(tmp_path):
     """The offscreen backend is handed to VTK while it makes a window, not written into the process's environment:
     after a picture, the variables (and those a child process inherits) are those the process started with."""
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")}
-    code = _ENVIRONMENT_AFTER_A_FIGURE.format(points=str(EXAMPLES / "paper-example-1.json"), png=str(tmp_path / "a.png"))
+    code = _ENVIRONMENT_AFTER_A_FIGURE.format(points=str(EXAMPLES / "paper-example-1.json"),
+                                              png=str(tmp_path / "a.png"))
     done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     status, same, name, window, child = done.stdout.split()

@@ -188,7 +188,7 @@ class HelperPool:
         self._lock, self._helpers = _thread.allocate_lock(), []
 
     def threads(self, n: int, per_item: int = 1) -> int:
-        """Threads a call of ``n`` items of ``per_item`` values uses: :func:`thread_count`, at most :attr:`max_threads`."""
+        """Threads a call of ``n`` items of ``per_item`` values uses: :func:`thread_count`, at most ``max_threads``."""
         return min(self.max_threads, thread_count(n, per_item))
 
     def run_parts(self, work, cuts: list[tuple[int, int]], stop: list | None = None) -> None:
@@ -240,7 +240,7 @@ class HelperPool:
             raise errors[0]
 
     def run_blocks(self, work, n: int, block: int, per_item: int = 1) -> None:
-        """``work(start, stop)`` over ``n`` items in blocks of ``block``, each thread taking the next block when it is done.
+        """``work(start, stop)`` over ``n`` items in blocks of ``block``, each thread taking the next when it is done.
 
         The threads :meth:`threads` allows, as :meth:`run_parts` runs them;
         where fixed parts would leave the calling thread waiting for a helper
