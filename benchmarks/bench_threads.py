@@ -58,8 +58,9 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=301)
     a = p.parse_args(argv)
-    threads.run_parts(lambda lo, hi: None, [(0, 1), (1, 2)])  # the helper started, as after a first large call
-    helper = threads._helpers[0]
+    pool = threads.HelperPool()
+    pool.run_parts(lambda lo, hi: None, [(0, 1), (1, 2)])  # the helper started, as after a first large call
+    helper = pool._helpers[0]
     peer, ours = [], []
     for _ in range(a.runs):
         peer.append(_thread_start())
@@ -76,6 +77,7 @@ def main(argv=None) -> int:
     print(_row("the helper runs the part after (lagsym)", ours[:, 1]))
     print(f"\nthe caller held: the peer {np.median(peer[:, 0]) / np.median(ours[:, 0]):.1f}x as long (median); "
           f"the part started: the peer {np.median(peer[:, 1]) / np.median(ours[:, 1]):.1f}x as late (median)")
+    pool.close()
     return 0
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .evaluate import surface_evaluator
-from .evaluate.engine import use_compiled
+from .evaluate.engine import Engine, current_engine
 from .evaluate.product import grid_product
 from .values import as_exact
 
@@ -287,12 +287,14 @@ def _within(g: SampleGrid, max_points: int | None) -> SampleGrid:
 
 
 def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: SampleGrid | None = None,
-           **kwargs) -> Sample:
+           engine: Engine | None = None, **kwargs) -> Sample:
     """Sample ``surface`` on a regular grid and return ``(X, Y, Z)``.
 
     Takes the arguments of :func:`sample_grid` (see there), or a ready
     ``grid``.  The heights come from the stable evaluator, never from the
-    expanded power basis.
+    expanded power basis, run as ``engine`` rules (a
+    :class:`lagsym.evaluate.Engine`; the current one by default): the same
+    bits whichever engine runs.
 
     Examples
     --------
@@ -304,7 +306,7 @@ def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: Sampl
     [[0.0, 0.0], [1.0, 1.0], [4.0, 4.0]]
     """
     g = grid if grid is not None else sample_grid(surface, nx, ny, **kwargs)
-    z = surface_evaluator(surface).grid(g.xs, g.ys)
+    z = surface_evaluator(surface).grid(g.xs, g.ys, engine=engine)
     z.setflags(write=False)
     return Sample(_lines(g.xs, g.ny, 0), _lines(g.ys, g.nx, 1), z)
 
@@ -324,18 +326,20 @@ def _lines(values: np.ndarray, count: int, axis: int) -> np.ndarray:
     return out
 
 
-def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS) -> Iterator[Block]:
+def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS, *,
+                engine: Engine | None = None) -> Iterator[Block]:
     """Yield the sample of ``surface`` on ``grid`` a block of x-rows at a time.
 
     Each block holds about ``block_points`` points (at least one row), so the
-    memory in use does not grow with the grid.
+    memory in use does not grow with the grid.  ``engine`` as in :func:`sample`.
     """
     ev = surface_evaluator(surface)
+    engine = current_engine() if engine is None else engine
     rows = max(1, block_points // grid.ny)
-    compiled = use_compiled(min(rows, grid.nx) * grid.ny)  # the blocks may run compiled: then the factors too
+    compiled = engine.use_compiled(min(rows, grid.nx) * grid.ny)  # the blocks may run compiled: then the factors too
     w = ev.x_factor(grid.xs, compiled)  # (nx, m): small
     ty = ev.y_basis(grid.ys, compiled)  # (m, ny): small
     for start in range(0, grid.nx, rows):
         stop = min(start + rows, grid.nx)
         xs = grid.xs[start:stop]
-        yield Block(start, xs, grid.ys, ev.snap_grid(grid_product(w[start:stop], ty), xs, grid.ys))
+        yield Block(start, xs, grid.ys, ev.snap_grid(grid_product(w[start:stop], ty, engine=engine), xs, grid.ys))

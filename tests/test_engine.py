@@ -1,5 +1,6 @@
 """Grids and their engines: a grid's heights are the bits its points give, in NumPy and compiled alike,
-and a process loads the compiled kernels only once they pay for their loading."""
+a process loads the compiled kernels only once they pay for their loading, and the policy that decides
+it is an object a caller may own, turn off or scope to a block of code."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES
 
-from lagsym.evaluate import COMPILED_POINTS, surface_evaluator
+from lagsym.errors import InputError
+from lagsym.evaluate import COMPILED_POINTS, Engine, current_engine, surface_evaluator, use_engine
+from lagsym.evaluate.engine import PROCESS_ENGINE
 from lagsym.evaluate.product import grid_product
 from lagsym.grid import grid_from_table
 from lagsym.lagrange import lagrange_surface
@@ -85,12 +88,12 @@ PRELUDE = ("import sys, numpy as np; from lagsym import lagrange_surface, read_p
 
 def test_one_large_grid_runs_in_numpy_and_the_kernels_load_once_they_pay():
     out = _run(PRELUDE + (
-        "engine.LOAD_SECONDS = 0.2; first = sample(s, 600, 600).z; print(loaded()); calls = 1\n"
+        "engine.PROCESS_ENGINE.load_seconds = 0.2; first = sample(s, 600, 600).z; print(loaded()); calls = 1\n"
         "while not loaded() and calls < 5000:\n"
         "    z = sample(s, 600, 600).z; calls += 1; assert np.array_equal(z, first)\n"
-        "print(engine._spent[0] >= 0.2, calls > 2)\n"
-        "spent = engine._spent[0]; z = sample(s, 600, 600).z\n"
-        "print(np.array_equal(z, first), engine._spent[0] == spent)"))
+        "print(engine.PROCESS_ENGINE.spent >= 0.2, calls > 2)\n"
+        "spent = engine.PROCESS_ENGINE.spent; z = sample(s, 600, 600).z\n"
+        "print(np.array_equal(z, first), engine.PROCESS_ENGINE.spent == spent)"))
     assert out == ["False", "True", "True", "True", "True"]
 
 
@@ -98,15 +101,15 @@ def test_loading_the_kernels_first_runs_every_large_batch_compiled():
     out = _run(PRELUDE + (
         "from lagsym.evaluate import load_compiled, evaluate_points; load_compiled(); print(loaded())\n"
         "z = sample(s, 600, 600).z; p = evaluate_points(s, np.linspace(1, 5, 300_000), 2.5)\n"
-        "print(engine._spent[0] == 0.0, float(z[0, 0]) == 1.0 and float(z[-1, 0]) == 1.0)"))
+        "print(engine.PROCESS_ENGINE.spent == 0.0, float(z[0, 0]) == 1.0 and float(z[-1, 0]) == 1.0)"))
     assert out == ["True", "True", "True"]
 
 
 def test_small_batches_never_count_towards_loading():
     out = _run(PRELUDE + (
-        "engine.LOAD_SECONDS = 0.0\n"
+        "engine.PROCESS_ENGINE.load_seconds = 0.0\n"
         "for _ in range(5): sample(s, 400, 400)\n"
-        "print(loaded(), engine._spent[0] == 0.0)"))
+        "print(loaded(), engine.PROCESS_ENGINE.spent == 0.0)"))
     assert out == ["False", "True"]
 
 
@@ -115,7 +118,56 @@ def test_writing_one_large_sample_does_not_load_the_kernels(tmp_path):
     out = _run(PRELUDE + (
         "from lagsym.export import write_sample; from lagsym.sampling import sample_grid\n"
         f"write_sample({str(tmp_path / 'a.npy')!r}, s, sample_grid(s, 700, 700))\n"
-        "print(loaded(), engine._spent[0] > 0)"))
+        "print(loaded(), engine.PROCESS_ENGINE.spent > 0)"))
     assert out == ["False", "True"]
     z = np.load(tmp_path / "a.npy")
     assert z.shape == (490_000, 3)
+
+
+def test_an_engine_turned_off_never_loads_the_kernels_and_gives_the_same_bits():
+    """``Engine("numpy")``, given or scoped with use_engine: however long large batches take, no kernel loads."""
+    out = _run(PRELUDE + (
+        "from lagsym.evaluate import Engine, use_engine, evaluate_points\n"
+        "off = Engine('numpy', load_seconds=0.0); first = sample(s, 600, 600, engine=off).z\n"
+        "with use_engine(off):\n"
+        "    for _ in range(3): z = sample(s, 600, 600).z; p = evaluate_points(s, np.linspace(1, 5, 300_000), 2.5)\n"
+        "print(loaded(), np.array_equal(z, first), off.spent > 0, engine.PROCESS_ENGINE.spent == 0.0)\n"
+        "on = Engine('compiled'); print(np.array_equal(sample(s, 600, 600, engine=on).z, first), loaded(), on.spent)"))
+    assert out == ["False", "True", "True", "True", "True", "True", "0.0"]
+
+
+def test_each_engine_counts_its_own_time_and_the_context_chooses_the_default():
+    surface = _surface(5, 5, seed=5)
+    ev = surface_evaluator(surface)
+    xs = np.linspace(*ev.bounds[:2], 520)
+    ys = np.linspace(*ev.bounds[2:], 520)
+    mine, other = Engine("numpy"), Engine("numpy")
+    assert current_engine() is PROCESS_ENGINE
+    with use_engine(mine) as chosen:
+        assert chosen is mine and current_engine() is mine
+        z = ev.grid(xs, ys)
+        with use_engine(other):
+            assert current_engine() is other
+        assert current_engine() is mine
+    assert current_engine() is PROCESS_ENGINE
+    assert mine.spent > 0 and other.spent == 0.0
+    for policy in ("numpy", "compiled", "auto"):
+        assert np.array_equal(ev.grid(xs, ys, engine=Engine(policy)), z), policy
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        assert np.array_equal(ev.points(X, Y, engine=Engine(policy)), z), policy
+
+
+def test_the_policies_decide_by_size_and_by_what_was_spent():
+    assert not Engine("compiled").use_compiled(COMPILED_POINTS - 1)  # small batches stay in NumPy
+    assert Engine("compiled").use_compiled(COMPILED_POINTS)
+    assert not Engine("numpy", load_seconds=0.0).use_compiled(10**9)
+    cheap = Engine("auto", load_seconds=1.0)
+    cheap.record(COMPILED_POINTS - 1, 5.0)  # a small batch's time is not counted
+    assert cheap.spent == 0.0
+    cheap.record(COMPILED_POINTS, 1.0)
+    assert cheap.spent == 1.0 and cheap.use_compiled(COMPILED_POINTS)
+    with pytest.raises(InputError, match="engine policy 'fast' is not one of auto, numpy, compiled"):
+        Engine("fast")
+    with pytest.raises(TypeError):
+        with use_engine("numpy"):
+            pass

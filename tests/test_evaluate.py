@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import subprocess
@@ -300,3 +301,43 @@ def test_the_blocked_grid_product_is_the_matrix_product(shape):
     got = grid_product(w, ty, out)
     scale = np.abs(w) @ np.abs(ty)
     assert got is out and np.all(np.abs(got - w @ ty) <= 2 * k * np.finfo(float).eps * scale)
+
+
+class _Unreferable:
+    """A surface as the evaluator reads it (its grid and coefficients) that cannot be weakly referenced."""
+
+    __slots__ = ("grid", "coefficients")
+
+    def __init__(self, surface):
+        self.grid, self.coefficients = surface.grid, surface.coefficients
+
+
+@pytest.mark.parametrize("new", [copy.copy, _Unreferable], ids=["surface", "no weak references"])
+def test_a_new_surface_at_a_dead_ones_address_gets_its_own_evaluator(monkeypatch, new):
+    """The evaluators are remembered per object, never by its address alone: Python places new objects
+    where dead ones were, and such a surface must not be handed the dead one's evaluator.  Here every
+    object has the one address, so the case is met on every call rather than by chance."""
+    from lagsym.evaluate import cache
+
+    monkeypatch.setattr(cache, "id", lambda obj: 1, raising=False)
+    one = lagrange_surface(grid_from_table([0, 1], [0, 1], [[0, 0], [1, 1]]))
+    two = lagrange_surface(grid_from_table([0, 1], [0, 1], [[5, 5], [7, 7]]))
+    first = new(one)
+    assert float(surface_evaluator(first).points(1.0, 0.5)) == 1.0
+    del first
+    second = new(two)
+    assert float(surface_evaluator(second).points(1.0, 0.5)) == 7.0
+    third = new(one)  # alive beside the second, at its address
+    assert float(surface_evaluator(third).points(1.0, 0.5)) == 1.0
+    assert float(surface_evaluator(second).points(1.0, 0.5)) == 7.0
+
+
+def test_an_evaluator_is_remembered_while_its_surface_lives_and_no_longer():
+    from lagsym.evaluate.surface import _SURFACES
+
+    surface = lagrange_surface(grid_from_table([0, 1, 2], [0, 1], [[0, 0], [1, 1], [4, 3]]))
+    before = len(_SURFACES)
+    assert surface_evaluator(surface) is surface_evaluator(surface)
+    assert len(_SURFACES) == before + 1
+    del surface
+    assert len(_SURFACES) == before

@@ -1,4 +1,5 @@
-"""The helper threads kept between large evaluations: reused, parked between calls, safe to fork, never deadlocked."""
+"""The helper threads kept between large evaluations: reused, parked between calls, safe to fork, never deadlocked,
+held by a pool its owner can close or make keep nothing."""
 
 import gc
 import os
@@ -121,7 +122,7 @@ def test_nothing_of_a_call_is_kept_by_the_helpers_once_it_returns():
     try:
         s = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 3]]))
         z = sample(s, 1000, 600).z  # shared among the threads (600,000 values)
-        assert threads.thread_count(1000, 600) < 2 or threads._helpers
+        assert threads.thread_count(1000, 600) < 2 or threads.PROCESS_POOL.helpers
         assert np.isfinite(z).all()
         memory = z
         while memory.base is not None:
@@ -131,3 +132,57 @@ def test_nothing_of_a_call_is_kept_by_the_helpers_once_it_returns():
         assert gone() is None
     finally:
         gc.enable()
+
+
+def test_a_pool_of_ones_own_keeps_its_helpers_apart_and_closing_it_ends_them():
+    with threads.HelperPool() as pool:
+        seen = set()
+        pool.run_parts(lambda lo, hi: (seen.add(threading.get_ident()), time.sleep(0.01)), [(0, 1), (1, 2)])
+        assert len(seen) == 2 and pool.helpers == 1
+        assert not seen & _idents(2) - {threading.get_ident()}  # the process pool's helpers are others
+    assert pool.helpers == 0
+    again = set()
+    pool.run_parts(lambda lo, hi: (again.add(threading.get_ident()), time.sleep(0.01)), [(0, 1), (1, 2)])
+    assert len(again) == 2 and pool.helpers == 1  # a closed pool starts fresh helpers when used again
+    pool.close()
+
+
+def test_a_pool_that_keeps_nothing_or_allows_one_thread_gives_the_same_values():
+    s = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 3]]))
+    from lagsym.evaluate import Engine
+
+    shared = sample(s, 1000, 600, engine=Engine("numpy")).z
+    fleeting, alone = threads.HelperPool(keep=False), threads.HelperPool(max_threads=1)
+    for pool in (fleeting, alone):
+        for policy in ("numpy", "compiled"):
+            assert np.array_equal(sample(s, 1000, 600, engine=Engine(policy, pool=pool)).z, shared), (pool, policy)
+        assert pool.helpers == 0
+    used = set()
+    alone.run_parts(lambda lo, hi: used.add(threading.get_ident()), [(0, 1), (1, 2), (2, 3)])
+    assert used == {threading.get_ident()}
+    with pytest.raises(ValueError, match="max_threads = 0"):
+        threads.HelperPool(max_threads=0)
+
+
+_OWN_POOL_CHILD = """
+import os, threading, time
+from lagsym.evaluate import threads
+pool = threads.HelperPool()
+pool.run_parts(lambda lo, hi: time.sleep(0.01), [(0, 1), (1, 2)])
+pid = os.fork()
+if pid == 0:
+    empty = pool.helpers == 0
+    inner = set()
+    pool.run_parts(lambda lo, hi: (inner.add(threading.get_ident()), time.sleep(0.01)), [(0, 1), (1, 2)])
+    os._exit(0 if empty and len(inner) == 2 else 1)
+_, status = os.waitpid(pid, 0)
+print(pool.helpers, os.waitstatus_to_exitcode(status))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork is POSIX")
+def test_a_forked_process_finds_its_own_pools_empty():
+    out = subprocess.run([sys.executable, "-c", _OWN_POOL_CHILD], capture_output=True, text=True, timeout=60,
+                         check=False, cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["1", "0"]

@@ -423,6 +423,63 @@ def test_xvfb_fallback_renders():
     assert int(done.stdout.split()[-1]) >= 5  # a red sphere fills part of the picture
 
 
+_ENVIRONMENT_AFTER_A_FIGURE = """
+import os, subprocess, sys
+before = dict(os.environ)
+from lagsym.cli import main
+from lagsym.plot import backend
+status = main(['plot', {points!r}, '-o', {png!r}])
+p = backend.new_plotter(window_size=(64, 48)); window = p.ren_win.GetClassName(); p.close()
+child = subprocess.run([sys.executable, '-c', 'import os; print(sorted(os.environ) == {{names!r}})'.format(
+    names=sorted(before)), ], capture_output=True, text=True, env=None).stdout.strip()
+print(status, dict(os.environ) == before, backend.rendering_backend(), window, child)
+"""
+
+
+def test_a_figure_leaves_the_process_environment_as_it_was(tmp_path):
+    """The offscreen backend is handed to VTK while it makes a window, not written into the process's environment:
+    after a picture, the variables (and those a child process inherits) are those the process started with."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")}
+    code = _ENVIRONMENT_AFTER_A_FIGURE.format(points=str(EXAMPLES / "paper-example-1.json"),
+                                              png=str(tmp_path / "a.png"))
+    done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    status, same, name, window, child = done.stdout.split()
+    assert (status, same, child) == ("0", "True", "True")
+    windows = {"egl": "vtkEGLRenderWindow", "osmesa": "vtkOSOpenGLRenderWindow", "xvfb": "vtkXOpenGLRenderWindow"}
+    assert window == windows[name]  # the chosen window all the same
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+
+
+def test_the_rendering_environment_is_restored_after_an_error(monkeypatch):
+    from lagsym.plot import backend
+
+    monkeypatch.setattr(backend, "_chosen", lambda: ("xvfb", (("DISPLAY", ":97"), ("LAGSYM_TEST_WINDOW", "w"))))
+    monkeypatch.setenv("DISPLAY", ":5")
+    monkeypatch.delenv("LAGSYM_TEST_WINDOW", raising=False)
+    with pytest.raises(RuntimeError, match="midway"):
+        with backend.rendering_environment() as variables:
+            assert variables == {"DISPLAY": ":97", "LAGSYM_TEST_WINDOW": "w"}
+            assert os.environ["DISPLAY"] == ":97" and os.environ["LAGSYM_TEST_WINDOW"] == "w"
+            raise RuntimeError("midway")
+    assert os.environ["DISPLAY"] == ":5" and "LAGSYM_TEST_WINDOW" not in os.environ
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="Xvfb is the Linux fallback")
+def test_the_xvfb_fallback_leaves_the_process_environment_as_it_was(tmp_path):
+    """Where neither EGL nor OSMesa works: the private server's DISPLAY is seen by VTK's window alone."""
+    if shutil.which("Xvfb") is None:
+        missing_system_package("xvfb", "Xvfb")
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")}
+    code = ("from lagsym.plot import backend; backend._probe = lambda window_class: False\n"
+            + _ENVIRONMENT_AFTER_A_FIGURE.format(points=str(EXAMPLES / "paper-example-1.json"),
+                                                 png=str(tmp_path / "a.png")))
+    done = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0", "True", "xvfb", "vtkXOpenGLRenderWindow", "True"]
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+
+
 def test_pictures_without_ipython(tmp_path):
     """A plain install has no IPython: pictures are drawn all the same (pyvista's notebook setting is skipped)."""
     code = (

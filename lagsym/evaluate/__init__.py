@@ -23,14 +23,17 @@ The modules, one concern each:
   compensated recurrence, each value rounded once);
 * :mod:`.compiled`: the same arithmetic for large batches of scattered points
   and grids, compiled (Numba), with the same bits;
-* :mod:`.engine`: which of the two runs a large batch (the compiled kernels
-  once they have paid for their loading, about half a second);
+* :mod:`.engine`: which of the two runs a large batch, an :class:`Engine`
+  policy the caller may own (by default the compiled kernels once they have
+  paid for their loading; ``Engine("numpy")`` turns them off);
 * :mod:`.surface`: :class:`SurfaceEvaluator`, values on grids and at points,
   partial derivatives and the curvature bound (what drop-cutter needs);
 * :mod:`.curve`: :class:`CurveEvaluator`, the 1-D case;
 * :mod:`.bounds`: the rounding-error bound;
-* :mod:`.threads`: large grids and point sets shared among threads, bit for
-  bit the values of one;
+* :mod:`.threads`: large grids and point sets shared among the threads of
+  a :class:`~.threads.HelperPool`, bit for bit the values of one;
+* :mod:`.cache`: what is computed once per surface or curve object,
+  remembered while that object lives;
 * :mod:`.barycentric`: the Lagrange basis itself, in the barycentric form
   ``L_j(t) = (w_j / (t - t_j)) / sum_k (w_k / (t - t_k))``, for what needs
   the basis values (:func:`basis_matrix`, :func:`lebesgue_constant`);
@@ -44,6 +47,7 @@ from .barycentric import barycentric_weights, basis_matrix, lebesgue_constant, n
 from .bounds import EPS, EPS_BASIS
 from .chebyshev import chebyshev_basis, chebyshev_matrix, chebyshev_matrix_float64, chebyshev_transform
 from .curve import CurveEvaluator, curve_evaluator, evaluate_curve
+from .engine import Engine, current_engine, use_engine
 from .power import PARTIALS, lambdify_surface, power_partials
 from .surface import (
     CHUNK_POINTS,
@@ -65,6 +69,9 @@ __all__ = [
     "PARTIALS",
     "SurfaceEvaluator",
     "CurveEvaluator",
+    "Engine",
+    "current_engine",
+    "use_engine",
     "surface_evaluator",
     "curve_evaluator",
     "chebyshev_basis",

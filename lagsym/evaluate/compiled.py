@@ -10,8 +10,9 @@ NumPy engine in :mod:`.surface`, one for one and in the same order (no fused
 multiply-add, no reassociation: Numba's default without ``fastmath``), so the
 two give the same bits; ``tests/test_evaluate.py`` and ``tests/test_engine.py``
 check it.  This module is loaded only with the compiled engine
-(:mod:`.engine`: Numba's import and the cached kernels take about 0.5 s,
-once per process).
+(:mod:`.engine`: Numba's import and the cached kernels take long enough,
+once per process, that a process evaluating one large batch never loads
+them).
 """
 
 from __future__ import annotations

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import flint
 import numpy as np
 
 from .._arrays import readonly as _readonly
+from .cache import ObjectCache
 from .chebyshev import chebyshev_basis, chebyshev_transform, data_range, fmpq, fraction
 
 __all__ = ["CurveEvaluator", "curve_evaluator", "evaluate_curve"]
@@ -30,24 +30,22 @@ class CurveEvaluator:
         return (self.coefficients @ basis).reshape(x.shape)
 
 
-_CURVES: dict[int, CurveEvaluator] = {}
-
-
 def curve_evaluator(curve) -> CurveEvaluator:
     """The :class:`CurveEvaluator` of a :class:`~lagsym.lagrange.LagrangeCurve` (remembered like :func:`surface_evaluator`)."""
-    key = id(curve)
-    found = _CURVES.get(key)
-    if found is not None:
-        return found
+    return _CURVES.get(curve)
+
+
+def _make_evaluator(curve) -> CurveEvaluator:
+    """The exact change of basis of ``curve``, rounded once to floats."""
     off, scale, a = chebyshev_transform(curve.points.x)
     n = len(curve.coefficients)
     d = a * flint.fmpq_mat(n, 1, [fmpq(c) for c in curve.coefficients])
-    ev = CurveEvaluator(offset=off, scale=scale,
-                        coefficients=_readonly([float(fraction(d[k, 0])) for k in range(n)]),
-                        data_range=data_range(curve.points.y))
-    _CURVES[key] = ev
-    weakref.finalize(curve, _CURVES.pop, key, None)
-    return ev
+    return CurveEvaluator(offset=off, scale=scale,
+                          coefficients=_readonly([float(fraction(d[k, 0])) for k in range(n)]),
+                          data_range=data_range(curve.points.y))
+
+
+_CURVES: ObjectCache[CurveEvaluator] = ObjectCache(_make_evaluator)
 
 
 def evaluate_curve(curve, x) -> np.ndarray:

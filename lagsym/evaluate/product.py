@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .engine import choose_engine
-from .threads import block_items, run_blocks
+from .engine import Engine, current_engine
+from .threads import block_items
 
 __all__ = ["PRODUCT_BLOCK", "aligned_empty", "grid_product", "readonly_view"]
 
@@ -39,32 +39,34 @@ def readonly_view(a: np.ndarray) -> np.ndarray:
 
 
 def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
-                 compiled: bool | None = None) -> np.ndarray:
+                 compiled: bool | None = None, engine: Engine | None = None) -> np.ndarray:
     """``out = w @ ty`` for a tall ``w`` and a wide ``ty`` with a short inner dimension, its terms added left to right.
 
     ``out[i, j] = w[i, 0] ty[0, j] + w[i, 1] ty[1, j] + ...``, each product
     rounded and then added in that order: the sum :meth:`.surface.SurfaceEvaluator.points`
     forms at a point, so a grid and the same points give the same bits.
-    ``compiled`` (by default as :mod:`.engine` rules for the size) runs
-    :func:`.compiled.product_kernel`, which writes each output row once from
-    cache; NumPy computes blocks of :data:`PRODUCT_BLOCK` values, with the
-    same bits.  A large grid's blocks of rows are shared among threads
-    (:func:`.threads.run_blocks`).
+    ``compiled`` (by default as ``engine`` rules for the size: an
+    :class:`.engine.Engine`, the :func:`.engine.current_engine` by default)
+    runs :func:`.compiled.product_kernel`, which writes each output row once
+    from cache; NumPy computes blocks of :data:`PRODUCT_BLOCK` values, with
+    the same bits.  A large grid's blocks of rows are shared among the
+    threads of the engine's pool (:meth:`.threads.HelperPool.run_blocks`).
     """
     n, m = w.shape[0], ty.shape[1]
     out = aligned_empty(n, m) if out is None else out
     if w.shape[1] == 0:
         out[...] = 0.0
         return out
+    engine = current_engine() if engine is None else engine
     if compiled is None:
-        with choose_engine(n * m) as compiled:
-            return grid_product(w, ty, out, compiled)
+        with engine.choose(n * m) as compiled:
+            return grid_product(w, ty, out, compiled, engine)
     if compiled:
         from .compiled import product_kernel  # Numba loads with the compiled engine, not with lagsym
 
         target = out if out.flags.c_contiguous and out.flags.aligned else np.empty((n, m))
         wv, tv = (readonly_view(np.ascontiguousarray(a, dtype=float)) for a in (w, ty))
-        run_blocks(lambda lo, hi: product_kernel(wv, tv, lo, hi, target), n, block_items(m, 4), m)
+        engine.pool.run_blocks(lambda lo, hi: product_kernel(wv, tv, lo, hi, target), n, block_items(m, 4), m)
         if target is not out:
             out[...] = target
         return out
@@ -80,5 +82,5 @@ def grid_product(w: np.ndarray, ty: np.ndarray, out: np.ndarray | None = None,
                 np.multiply(w[r:e, b:b + 1], ty[b], out=t)
                 z += t
 
-    run_blocks(work, n, block_items(m, rows), m)
+    engine.pool.run_blocks(work, n, block_items(m, rows), m)
     return out

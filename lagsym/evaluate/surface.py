@@ -14,7 +14,6 @@ throughout, and :meth:`SurfaceEvaluator.curvature_bound`.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -24,9 +23,10 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from .bounds import chebyshev_error_bound
-from .engine import COMPILED_POINTS, choose_engine
+from .cache import ObjectCache
+from .engine import COMPILED_POINTS, Engine, current_engine
 from .product import grid_product, readonly_view
-from .threads import block_items, run_blocks
+from .threads import block_items
 from .chebyshev import (
     CompensatedBasis,
     chebyshev_basis,
@@ -58,10 +58,13 @@ def load_compiled() -> None:
     """Load the compiled kernels now, so that every large batch after runs compiled (:mod:`.engine`).
 
     For a process that will evaluate many large batches (a notebook, a
-    benchmark): about half a second once, then a few milliseconds for each
-    10**6 points or 2000 x 2000 grid.  The values are the same either way.
+    benchmark), which would otherwise first spend :data:`.engine.LOAD_SECONDS`
+    in NumPy; under an ``"auto"`` :class:`.engine.Engine` every large batch
+    after runs compiled.  The values are the same either way.
     """
-    ev = _WARM_UP
+    nodes, exact = _readonly(np.array([-1.0, 0.0, 1.0])), _readonly([True] * 3, bool)
+    ev = SurfaceEvaluator(0.0, 1.0, 0.0, 1.0, _readonly(np.eye(3)), 1.0, (-1.0, 1.0, -1.0, 1.0), nodes, nodes,
+                          exact, exact, _readonly(np.eye(3)))  # a small surface: its evaluation loads every kernel
     xs = np.linspace(-1.0, 1.0, 5)
     grid_product(ev.x_factor(xs, True), ev.y_basis(xs, True), compiled=True)
     ev._grid_hits(xs, xs, True)
@@ -153,11 +156,12 @@ class SurfaceEvaluator:
         basis_kernel(readonly_view(v), np.array(axis), n, out)
         return out
 
-    def grid(self, xs, ys) -> np.ndarray:
+    def grid(self, xs, ys, *, engine: Engine | None = None) -> np.ndarray:
         """``Z[i, j] = F(xs[i], ys[j])`` on the grid ``xs`` x ``ys``: the bits :meth:`points` gives at each.
 
         A grid of :data:`COMPILED_POINTS` values or more may run compiled, as
-        :mod:`.engine` rules, with the same bits.
+        ``engine`` rules (an :class:`.engine.Engine`; the
+        :func:`.engine.current_engine` by default), with the same bits.
 
         Examples
         --------
@@ -171,9 +175,11 @@ class SurfaceEvaluator:
         """
         xs = np.asarray(xs, dtype=float).ravel()
         ys = np.asarray(ys, dtype=float).ravel()
-        with choose_engine(xs.size * ys.size) as compiled:
+        engine = current_engine() if engine is None else engine
+        with engine.choose(xs.size * ys.size) as compiled:
             at, heights = self._grid_hits(xs, ys, compiled)  # while the small arrays are in cache, before the grid
-            z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled)
+            z = grid_product(self.x_factor(xs, compiled), self.y_basis(ys, compiled), compiled=compiled,
+                             engine=engine)
         if heights is not None:
             z[at] = heights
         return z
@@ -222,7 +228,7 @@ class SurfaceEvaluator:
             z[at] = heights
         return z
 
-    def points(self, x, y, chunk: int = CHUNK_POINTS) -> np.ndarray:
+    def points(self, x, y, chunk: int = CHUNK_POINTS, *, engine: Engine | None = None) -> np.ndarray:
         """``F(x, y)`` at scattered points; ``x`` and ``y`` broadcast together.
 
         Each point's basis values come from the compensated recurrence of
@@ -230,10 +236,11 @@ class SurfaceEvaluator:
         ``sum_b (sum_a C[a, b] Tx[a]) Ty[b]`` adds its terms left to right, so
         :meth:`error_bound` holds; where ``(x, y)`` is a control point exactly
         its height is returned exactly.  A batch of :data:`COMPILED_POINTS` or
-        more may run the compiled kernel of :mod:`.compiled`, as :mod:`.engine`
-        rules; otherwise the same operations run in NumPy, in blocks of
+        more may run the compiled kernel of :mod:`.compiled`, as ``engine``
+        rules (an :class:`.engine.Engine`; the :func:`.engine.current_engine`
+        by default); otherwise the same operations run in NumPy, in blocks of
         ``chunk`` points whose scratch stays in cache.  The two give the same
-        bits, and many points are shared among threads (:mod:`.threads`), so
+        bits, and many points are shared among the engine's threads (:mod:`.threads`), so
         the values do not depend on the engine, the batch, the block or the
         threads.
         """
@@ -241,9 +248,10 @@ class SurfaceEvaluator:
         shape = x.shape
         xf, yf = x.ravel(), y.ravel()  # contiguous: copies of broadcast or strided inputs
         out = np.empty(xf.size)
-        with choose_engine(xf.size) as compiled:
+        engine = current_engine() if engine is None else engine
+        with engine.choose(xf.size) as compiled:
             into = self._compiled_into if compiled else self._numpy_into
-            run_blocks(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), xf.size, block_items(1, chunk))
+            engine.pool.run_blocks(lambda lo, hi: into(out, xf, yf, lo, hi, chunk), xf.size, block_items(1, chunk))
         return out.reshape(shape)
 
     def _axes(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -387,9 +395,6 @@ class SurfaceEvaluator:
 
 
 
-_SURFACES: dict[int, SurfaceEvaluator] = {}
-
-
 def _exact_floats(nodes) -> np.ndarray:
     a = np.array([Fraction(float(v)) == v for v in nodes])
     a.setflags(write=False)
@@ -400,12 +405,14 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
     """The :class:`SurfaceEvaluator` of a :class:`~lagsym.lagrange.LagrangeSurface`.
 
     The exact change of basis is done once per surface object and remembered
-    while the object lives.
+    while the object lives (:class:`.cache.ObjectCache`: never handed to
+    another object, even one at the same address).
     """
-    key = id(surface)
-    found = _SURFACES.get(key)
-    if found is not None:
-        return found
+    return _SURFACES.get(surface)
+
+
+def _make_evaluator(surface) -> SurfaceEvaluator:
+    """The exact change of basis of ``surface``, rounded once to floats."""
     g = surface.grid
     xo, xh, ax = chebyshev_transform(g.x)
     yo, yh, ay = chebyshev_transform(g.y)
@@ -413,7 +420,7 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
     power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
     cheb = ax * power * ay.transpose()
     coeffs = np.array([[float(fraction(cheb[a, b])) for b in range(m)] for a in range(n)])
-    ev = SurfaceEvaluator(
+    return SurfaceEvaluator(
         x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh,
         coefficients=_readonly(coeffs),
         data_range=data_range(v for row in g.z for v in row),
@@ -424,9 +431,9 @@ def surface_evaluator(surface) -> SurfaceEvaluator:
         y_exact=_exact_floats(g.y),
         node_values=_readonly(g.z_array),
     )
-    _SURFACES[key] = ev
-    weakref.finalize(surface, _SURFACES.pop, key, None)
-    return ev
+
+
+_SURFACES: ObjectCache[SurfaceEvaluator] = ObjectCache(_make_evaluator)
 
 
 def evaluate_points(surface, x, y) -> np.ndarray:
@@ -437,11 +444,3 @@ def evaluate_points(surface, x, y) -> np.ndarray:
 def evaluate_grid(surface, xs, ys) -> np.ndarray:
     """Evaluate a surface on the grid ``xs`` x ``ys``; result ``Z[i, j] = F(xs[i], ys[j])``."""
     return surface_evaluator(surface).grid(xs, ys)
-
-
-_WARM_UP = SurfaceEvaluator(
-    x_offset=0.0, x_scale=1.0, y_offset=0.0, y_scale=1.0,
-    coefficients=_readonly(np.eye(3)), data_range=1.0, bounds=(-1.0, 1.0, -1.0, 1.0),
-    x_nodes=_readonly(np.array([-1.0, 0.0, 1.0])), y_nodes=_readonly(np.array([-1.0, 0.0, 1.0])),
-    x_exact=_readonly([True] * 3, bool), y_exact=_readonly([True] * 3, bool), node_values=_readonly(np.eye(3)),
-)  # a small surface whose evaluation loads every compiled kernel (load_compiled)

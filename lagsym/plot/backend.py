@@ -5,6 +5,15 @@ Rendering needs no display.  Where there is none (no ``DISPLAY`` on Linux),
 VTK's EGL window on Mesa, else OSMesa, else a private Xvfb server that lives
 as long as the process.  :func:`new_plotter` asks for that choice before it
 makes a plotter, so every figure renders wherever lagsym runs.
+
+VTK learns the choice from two environment variables,
+``VTK_DEFAULT_OPENGL_WINDOW`` (the window class, read when a render window
+is made) and, for the private server, ``DISPLAY`` (read when the window
+opens its X connection).  Neither is written for the whole process: they
+are set only inside :func:`rendering_environment`, around the making of a
+plotter's window, and restored as they were on leaving it, so the
+process's environment, and every program it starts, stay as the user left
+them.
 """
 
 from __future__ import annotations
@@ -16,11 +25,14 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 from ..errors import RenderError
 from .checks import check_window_size
 
-__all__ = ["DEFAULT_WINDOW_SIZE", "rendering_backend", "new_plotter"]
+__all__ = ["DEFAULT_WINDOW_SIZE", "rendering_backend", "rendering_environment", "new_plotter"]
 
 DEFAULT_WINDOW_SIZE = (1280, 960)  # sharp in the docs, and text still legible scaled to a notebook's width
 
@@ -90,10 +102,30 @@ def _start_xvfb() -> str:
 
 
 @functools.cache
+def _chosen() -> tuple[str, tuple[tuple[str, str], ...]]:
+    """The backend's name, and the environment variables VTK must see to make a window on it (name, value)."""
+    if _has_display():
+        return "display", ()
+    if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW"):
+        return os.environ["VTK_DEFAULT_OPENGL_WINDOW"], ()
+    for name, window_class in _OFFSCREEN_WINDOWS:
+        if _probe(window_class):
+            # Name the window outright: otherwise VTK tries X first and warns on stderr.
+            return name, (("VTK_DEFAULT_OPENGL_WINDOW", window_class),)
+    if shutil.which("Xvfb"):
+        return "xvfb", (("DISPLAY", _start_xvfb()),)
+    raise RenderError(
+        "no display, and VTK cannot render offscreen here: install Mesa's EGL "
+        "(Debian: libegl1 libgl1-mesa-dri) or Xvfb (Debian: xvfb)"
+    )
+
+
 def rendering_backend() -> str:
     """Make sure VTK can render in this process, and say how.
 
-    Called by every figure function; the choice is made once per process.
+    Called by every figure function; the choice is made once per process,
+    and changes nothing in the process's environment
+    (:func:`rendering_environment` hands it to VTK).
 
     Returns
     -------
@@ -108,22 +140,46 @@ def rendering_backend() -> str:
     RenderError
         When nothing here can render.
     """
-    if _has_display():
-        return "display"
-    if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW"):
-        return os.environ["VTK_DEFAULT_OPENGL_WINDOW"]
-    for name, window_class in _OFFSCREEN_WINDOWS:
-        if _probe(window_class):
-            # Name the window outright: otherwise VTK tries X first and warns on stderr.
-            os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = window_class
-            return name
-    if shutil.which("Xvfb"):
-        os.environ["DISPLAY"] = _start_xvfb()
-        return "xvfb"
-    raise RenderError(
-        "no display, and VTK cannot render offscreen here: install Mesa's EGL "
-        "(Debian: libegl1 libgl1-mesa-dri) or Xvfb (Debian: xvfb)"
-    )
+    return _chosen()[0]
+
+
+_ENVIRONMENT = threading.Lock()  # one block at a time changes the process's variables
+
+
+@contextmanager
+def rendering_environment() -> Iterator[dict[str, str]]:
+    """Inside the block, the environment variables VTK reads to make a render window on the chosen backend.
+
+    ``VTK_DEFAULT_OPENGL_WINDOW`` for EGL or OSMesa, ``DISPLAY`` for the
+    private Xvfb server (nothing where there is a display, or the variable
+    was set already) are set in :data:`os.environ` on entering and restored
+    to what they were (or removed) on leaving, also after an error.  Make the
+    render window, and open its display, inside the block: VTK reads the
+    variables then and not later.  Blocks in several threads take turns;
+    another thread reading the environment meanwhile sees the variables.
+
+    Yields
+    ------
+    dict
+        The variables set, by name.
+
+    Raises
+    ------
+    RenderError
+        When nothing here can render (:func:`rendering_backend`).
+    """
+    variables = dict(_chosen()[1])
+    with _ENVIRONMENT:
+        before = {name: os.environ.get(name) for name in variables}
+        try:
+            os.environ.update(variables)
+            yield variables
+        finally:
+            for name, value in before.items():
+                if value is None:
+                    os.environ.pop(name, None)
+                else:
+                    os.environ[name] = value
 
 
 def _has_ipython() -> bool:
@@ -166,5 +222,9 @@ def new_plotter(shape=(1, 1), window_size=DEFAULT_WINDOW_SIZE, off_screen: bool 
         theme.jupyter_backend = "static"
     theme.font.color = "black"
     theme.font.family = "arial"
-    return pv.Plotter(shape=shape, window_size=list(size), off_screen=off_screen, theme=theme,
-                      lighting="three lights", border=False, col_weights=col_weights)
+    with rendering_environment() as variables:
+        plotter = pv.Plotter(shape=shape, window_size=list(size), off_screen=off_screen, theme=theme,
+                             lighting="three lights", border=False, col_weights=col_weights)
+        if "DISPLAY" in variables and hasattr(plotter.ren_win, "EnsureDisplay"):
+            plotter.ren_win.EnsureDisplay()  # its X connection opened now, while DISPLAY names the private server
+    return plotter
