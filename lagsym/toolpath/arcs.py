@@ -154,7 +154,7 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, *, direction: str, kappa: float
         The box's extent along the rows (machine mm): an arc stays a tool
         radius ``radius_mm`` inside it.
     chord_mm : float
-        How far inside its arcs the control's chords may lie (:data:`CHORD_MM`), mm.
+        How far inside its arcs the control's chords may lie (:attr:`lagsym.controls.Control.chord_mm`), mm.
     """
     ax, cx = (0, 1) if direction == "x" else (1, 0)
     unit_mm = 10.0 ** -digits / unit_factor
