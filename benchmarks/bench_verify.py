@@ -133,7 +133,7 @@ def main(argv=None) -> int:
             times["verify command"].append(command_time(args.program))
             for name, workers in (("exact segments, 2 threads", 2), ("exact segments, 1 thread", 1)):
                 cut = np.full((len(xs), len(ys)), np.inf)
-                times[name].append(timed(lambda: sweep(cut, a, b, xs, ys, 3.0, 3.0, workers=workers)))
+                times[name].append(timed(lambda: sweep(cut, a, b, xs, ys, r=3.0, corner=3.0, workers=workers)))
                 maps["exact"] = cut
         if k < args.peer_runs:
             cut = np.full((len(xs), len(ys)), np.inf)

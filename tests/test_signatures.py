@@ -35,16 +35,9 @@ KERNELS = {
     "evaluate/compiled.py:_four_more_terms",
 }
 
-# Being split in issue 33 by another change (the evaluator, the cutter as a value, the settings split by concern).
-SPLIT_ELSEWHERE = {
-    "evaluate/chebyshev.py:CompensatedBasis._product_error",  # the evaluator's own change
-    "toolpath/dropcutter.py:_drop_chunk",  # the kernel's one wrapper; radius and corner become the cutter
-    "toolpath/plan.py:_checked",  # takes the whole MachineSettings, which the plan stops taking
-    "toolpath/plan.py:_pattern",  # takes the Tool, which becomes the cutter
-    "verify/heightmap.py:sweep",  # radius and corner become the cutter
-    "macro/clearance.py:clearance_tables",  # takes the Tool and asks its shape
-    "macro/ballend.py:ball_tips",  # the ball end's tips: the cutter's macro support
-    "macro/rounding.py:tips_on_grid",  # called only by ball_tips, with its tips
+# A kernel's one wrapper called with a task tuple by the worker pool (workers.map), so by position.
+WRAPPERS = {
+    "toolpath/dropcutter.py:_drop_chunk",
 }
 
 
@@ -74,12 +67,12 @@ def _long_signatures() -> dict[str, int]:
 
 
 def test_no_function_takes_more_than_six_positional_parameters():
-    long = {k: n for k, n in _long_signatures().items() if k not in KERNELS | SPLIT_ELSEWHERE}
+    long = {k: n for k, n in _long_signatures().items() if k not in KERNELS | WRAPPERS}
     assert not long, "more than six positional parameters (make the tail keyword-only with `*,` or group " \
         "what travels together in a frozen value): " + ", ".join(f"{k} ({n})" for k, n in sorted(long.items()))
 
 
 def test_the_allow_lists_name_only_long_signatures():
     """An entry whose function was split, renamed or removed leaves the lists."""
-    stale = (KERNELS | SPLIT_ELSEWHERE) - set(_long_signatures())
+    stale = (KERNELS | WRAPPERS) - set(_long_signatures())
     assert not stale, "allowed but no longer long (remove from the list): " + ", ".join(sorted(stale))

@@ -119,7 +119,7 @@ class CompensatedBasis:
         np.divide(d, h, out=sh)
         self._split(sh, shi, slo, t1)
         np.multiply(sh, h, out=p)
-        self._product_error(shi, slo, hhi, hlo, p, pe, t1)
+        self._product_error(shi, slo, hhi, hlo, p, out=pe, t=t1)
         sl = self.e[1, :k]
         np.subtract(d, p, out=sl)
         sl -= pe
@@ -135,7 +135,7 @@ class CompensatedBasis:
             # p + pe = sh * u[j-1] exactly
             np.multiply(u[j - 1], sh, out=p)
             self._split(u[j - 1], d, b, t1)
-            self._product_error(shi, slo, d, b, p, pe, t1)
+            self._product_error(shi, slo, d, b, p, out=pe, t=t1)
             # u[j] + sigma = 2 p - u[j-2] exactly (p + p is exact)
             np.add(p, p, out=d)
             np.subtract(d, u[j - 2], out=u[j])
@@ -164,7 +164,7 @@ class CompensatedBasis:
         np.subtract(v, hi, out=lo)
 
     @staticmethod
-    def _product_error(ahi, alo, bhi, blo, p, out, t) -> None:
+    def _product_error(ahi, alo, bhi, blo, p, *, out, t) -> None:
         """``out = a b - p`` exactly for ``p = fl(a b)``: Dekker's product from the two splits."""
         np.multiply(ahi, bhi, out=out)
         out -= p

@@ -77,7 +77,7 @@ def offset_points(form: RowForm, radius: float, offset: float, p, r):
     return np.asarray(p) - q * f["zp"], np.asarray(r) - q * f["zr"], f["z"] + q - radius
 
 
-def ball_tips(form: RowForm, radius: float, offset: float, p, r, resolution: Fraction = Fraction(0),
+def ball_tips(form: RowForm, radius: float, offset: float, p, r, *, resolution: Fraction = Fraction(0),
               lift: Fraction = Fraction(0)):
     """The tips the program moves to for contact points (p, r): offset, then rounded as on the control.
 
@@ -88,7 +88,7 @@ def ball_tips(form: RowForm, radius: float, offset: float, p, r, resolution: Fra
     if not resolution:
         return pt, rt, zt
     f = derivatives(form, p, r)
-    return tips_on_grid(pt, rt, zt, f["zp"], f["zr"], float(resolution), float(lift))
+    return tips_on_grid(pt, rt, zt, f["zp"], f["zr"], unit=float(resolution), lift=float(lift))
 
 
 def offset_statements(radius: float, offset: float) -> tuple:

@@ -173,7 +173,7 @@ def _fine(ev, mm_per_unit: float) -> dict[str, np.ndarray]:
             "g": np.sqrt(gx ** 2 + gy ** 2)}
 
 
-def clearance_tables(ev, place, tool, step_mm: float, stock_mm: float, edges_x, edges_y, unit_mm: float,
+def clearance_tables(ev, place, tool, step_mm: float, stock_mm: float, *, edges_x, edges_y, unit_mm: float,
                      arithmetic_mm: float, direction: str = "x") -> Clearance:
     """The tables for ``tool`` with row samples ``step_mm`` apart, over the tiles between ``edges_x`` and
     ``edges_y`` (machine mm, the box's edges first and last).

@@ -179,7 +179,7 @@ def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: Ma
     finish = tip_statements(unit, lift) if unit else (
         (Assign(var("zt"), add(var("zt"), const(raise_z))),) if raise_z else ())
     p0, r0, z0 = ball_tips(rf, radius, offset, np.array([float(counted.points.start)]),
-                           np.array([float(counted.rows.start)]), unit, lift)
+                           np.array([float(counted.rows.start)]), resolution=unit, lift=lift)
     z0 = z0 + float(raise_z)
     return MacroLoops(body=zigzag_loops(counted, row_code, point_code, TIP_OUTPUTS, finish), raster=counted, form=rf,
                       start=_in_xyz(counted, float(p0[0]), float(r0[0]), float(z0[0])),

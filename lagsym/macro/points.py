@@ -64,6 +64,6 @@ def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: 
     form = contact_form(surface, settings, counted.direction)
     lift = checked_tip_lift(form, counted, offset, unit)
     p, r = (x, y) if counted.direction == "x" else (y, x)
-    pt, rt, zt = ball_tips(form, radius, offset, p, r, unit, lift)
+    pt, rt, zt = ball_tips(form, radius, offset, p, r, resolution=unit, lift=lift)
     zt = zt + float(0 if unit else slope_lift(surface, settings))
     return np.column_stack([pt, rt, zt] if counted.direction == "x" else [rt, pt, zt])

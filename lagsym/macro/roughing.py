@@ -301,8 +301,9 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     edges = [np.array([float(v / per_mm) for v in (lo, *inner, hi)])
              for lo, inner, hi in ((lay.a0, lay.p_edges, lay.a1), (lay.b0, lay.r_edges, lay.b1))]
     ex, ey = edges if spec.direction == "x" else edges[::-1]
-    clear = clearance_tables(ev, place, tool, float(lay.dp / per_mm), settings.stock_to_leave_mm, ex, ey,
-                             10.0 ** -settings.digits / float(per_mm), arith, spec.direction)
+    clear = clearance_tables(ev, place, tool, float(lay.dp / per_mm), settings.stock_to_leave_mm, edges_x=ex,
+                             edges_y=ey, unit_mm=10.0 ** -settings.digits / float(per_mm), arithmetic_mm=arith,
+                             direction=spec.direction)
     a = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.a_mm]
     b = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.b_mm]
     rows, pts, tip = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a=a, b=b,

@@ -137,7 +137,7 @@ def tip_statements(unit: Fraction, lift: Fraction) -> tuple:
     return tuple(out)
 
 
-def tips_on_grid(pt, rt, zt, zp, zr, unit: float, lift: float):
+def tips_on_grid(pt, rt, zt, zp, zr, *, unit: float, lift: float):
     """The PC's model of :func:`tip_statements`: rounded tip positions and their heights (floats)."""
     pr, rr = round_half_away(pt, unit), round_half_away(rt, unit)
     return pr, rr, np.asarray(zt) + lift + zp * (pr - pt) + zr * (rr - rt)

@@ -151,7 +151,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
         if raster.boundary == "past" else None
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
-    scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step, fine, max_points)
+    scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step=step, fine=fine, max_points=max_points)
     if scallop is None and tool.is_ball and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     kappa = ev.curvature_bound() / mm_per_unit
@@ -161,7 +161,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
         cl = replace(cl, workers=workers)
         path = _fine_path(cl, levels, along, raster.direction, fine, past=past, progress=progress)
-        tp = _checked(ev, cl, path, tol, raster, kappa, every, settings, progress)
+        tp = _checked(ev, cl, path, tol, raster, kappa=kappa, every=every, settings=settings, progress=progress)
     bx, by, _ = _place(settings, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     tp = Toolpath(**tp, tool=tool, raster=raster,
                   stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1
@@ -171,7 +171,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
 
 
-def _checked(ev, cl, path, tol, raster, kappa, every, settings, progress=None) -> dict:
+def _checked(ev, cl, path, tol, raster, *, kappa, every, settings, progress=None) -> dict:
     """The emitted points of the fine path, its moves checked and lifted: the point fields of a :class:`Toolpath`."""
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
@@ -204,7 +204,7 @@ def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSett
                                      radius_mm=cl.radius * cl.mm_per_unit, chord_mm=settings.control.chord_mm))
 
 
-def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, step: float, fine: float,
+def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, *, step: float, fine: float,
              max_points: int | None):
     """The rows over the reach: ``(scallop, levels, along, every)``, checked for size first.
 

@@ -316,7 +316,7 @@ def _rapids(surf, path, use, lines, grid):
     if not k.size:
         return none, 0
     cut = np.full(surf.shape, np.inf)
-    segments = sweep(cut, path[k], path[k + 1], xs, ys, r, corner)
+    segments = sweep(cut, path[k], path[k + 1], xs, ys, r=r, corner=corner)
     depth = np.where(np.isfinite(cut), surf - cut, -np.inf)
     i = int(np.argmax(depth))
     if not depth.flat[i] > 0.0:
@@ -328,7 +328,7 @@ def _rapids(surf, path, use, lines, grid):
         lo, hi = np.minimum(path[m], path[m + 1]), np.maximum(path[m], path[m + 1])
         if lo[0] - r <= px <= hi[0] + r and lo[1] - r <= py <= hi[1] + r:
             one = np.full(surf.shape, np.inf)
-            sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r, corner)
+            sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r=r, corner=corner)
             if one[a, b] <= cut[a, b]:
                 line = int(lines[m])
                 break

@@ -37,7 +37,7 @@ MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB
 MAX_CONTACTS = 20_000_000_000  # segments (all, before those far from the box are dropped) times cells under the tool
 
 
-def sweep(cut, a_all, b_all, xs, ys, r, corner, workers: int | None = None, progress: Progress | None = None) -> int:
+def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, progress: Progress | None = None) -> int:
     """Lower ``cut`` to the tool's lowest surface along every move (in place); the number of segments swept.
 
     Moves are split into segments no longer sideways than ``_PIECE_CELLS``
@@ -259,7 +259,7 @@ def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, 
     if not len(a):
         return 0, resolution
     check_work(a, b, piece, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts=max_contacts)
-    return sweep(cut, a, b, xs, ys, r, corner, progress=progress), resolution
+    return sweep(cut, a, b, xs, ys, r=r, corner=corner, progress=progress), resolution
 
 
 def tool_grid(tool: Tool, xs: np.ndarray, ys: np.ndarray) -> tuple[float, float, float, float]:
