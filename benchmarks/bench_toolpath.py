@@ -82,7 +82,7 @@ def main(argv=None) -> int:
     settings = MachineSettings(mm_per_unit=SCALE)
     tool = Tool("ball", DIAMETER)
     drop_cutter(surface, 3.0, 3.0, DIAMETER / 2 / SCALE, evaluator=ev)  # the compiled kernel loaded, untimed
-    best, median, cbest, cmedian, tp = _times(lambda: plan_toolpath(surface, tool, raster, settings, evaluator=ev),
+    best, median, cbest, cmedian, tp = _times(lambda: plan_toolpath(surface, tool, raster, settings.placement, settings.program, evaluator=ev, stock_to_leave_mm=settings.stock_to_leave_mm),
                                               args.runs)
     n = len(tp)
     print(f"Example 4 at scale {SCALE:g}, ball D{DIAMETER:g} mm, side step {stepover:g} mm, step {STEP:g} mm: "

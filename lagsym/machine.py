@@ -8,7 +8,7 @@ the one :class:`Placement` (``mm_per_unit`` and ``origin_mm``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from fractions import Fraction
 
 import numpy as np
@@ -19,7 +19,7 @@ from .cutter import TOOL_SHAPES, Cutter, Tool, cutter_profile
 from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
-__all__ = ["Placement", "Cutter", "Tool", "MachineSettings", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
+__all__ = ["Placement", "Cutter", "Tool", "MachineSettings", "ProgramFormat", "CuttingData", "ToolSlot", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
            "program_units_per_mm", "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
@@ -141,9 +141,130 @@ class Placement:
         return scale, origin
 
 
+def _whole(value, what: str) -> None:
+    if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer))):
+        raise InputError(f"{what} {value!r} must be a whole number")
+
+
+@dataclass(frozen=True)
+class ProgramFormat:
+    """How a program is written: the control, its units and decimals, line ending, program number, work offset.
+
+    The positions a program can write (its resolution) follow from these
+    alone; nothing here says where the surface is or how the tool cuts.
+
+    Examples
+    --------
+    >>> f = ProgramFormat("haas", units="inch")
+    >>> f.digits, f.control.framing.program_word.format(f.program_number), f.resolution_mm
+    (4, 'O01000', 0.00254)
+    """
+
+    dialect: str = "fanuc"
+    units: str = "mm"
+    decimals: int | None = None  # None: 3 for mm, 4 for inch
+    line_ending: str = "lf"
+    program_number: int = 1000
+    work_offset: str = "G54"
+
+    def __post_init__(self):
+        c = control(self.dialect)
+        choice(self.units, UNITS, "units")
+        if self.line_ending not in PROGRAM_LINE_ENDINGS:
+            raise InputError(f"line ending {self.line_ending!r} is not one of {', '.join(PROGRAM_LINE_ENDINGS)}: "
+                             "with CR alone rs274 and ISO readers see the whole program as one block")
+        _whole(self.program_number, "program number")
+        _whole(self.decimals, "decimals")
+        low, high = c.program_numbers
+        if not (low <= int(self.program_number) <= high):
+            raise ToolpathError(f"program number {self.program_number} must be {low} to {high} for a {c.name} program")
+        if self.decimals is not None and not (0 <= self.decimals <= 6):
+            raise ToolpathError(f"decimals {self.decimals} must be 0 to 6")
+        work_offset(self.work_offset, exact=True)
+
+    @property
+    def control(self) -> Control:
+        """The control the program is for (:data:`lagsym.controls.CONTROLS`)."""
+        return control(self.dialect)
+
+    @property
+    def eol(self) -> str:
+        """The end-of-block characters."""
+        return LINE_ENDINGS[self.line_ending]
+
+    @property
+    def digits(self) -> int:
+        """Decimals written after the point in coordinates."""
+        if self.decimals is not None:
+            return self.decimals
+        return 3 if self.units == "mm" else 4
+
+    @property
+    def unit_factor(self) -> float:
+        """Program units per millimetre (:func:`program_units_per_mm`, as a float)."""
+        return float(program_units_per_mm(self.units))
+
+    @property
+    def resolution_mm(self) -> float:
+        """One unit of the last decimal written, in millimetres: the spacing of the positions the program writes."""
+        return 10.0 ** -self.digits / self.unit_factor
+
+
+@dataclass(frozen=True)
+class CuttingData:
+    """How the tool cuts: feeds, spindle speed, the clearance and feed heights, stock to leave, coolant (all mm)."""
+
+    feed_mm_min: float = 600.0
+    plunge_feed_mm_min: float = 200.0
+    spindle_rpm: float = 3000.0
+    safe_z_mm: float = 50.0
+    feed_height_mm: float = 2.0
+    stock_to_leave_mm: float = 0.0
+    coolant: str = "off"
+
+    def __post_init__(self):
+        choice(self.coolant, COOLANTS, "coolant")
+        positive(self.feed_mm_min, "feed")
+        positive(self.plunge_feed_mm_min, "plunge feed")
+        positive(self.spindle_rpm, "spindle speed", allow_zero=True)
+        positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
+        positive(self.feed_height_mm, "feed height")
+        finite(self.safe_z_mm, "safe Z")
+
+
+@dataclass(frozen=True)
+class ToolSlot:
+    """Where the cutter sits on the machine: its tool number and the length offset ``G43 H`` takes."""
+
+    tool_number: int = 1
+    length_offset: int | None = None  # None: the tool number
+
+    def __post_init__(self):
+        _whole(self.tool_number, "tool number")
+        _whole(self.length_offset, "length offset")
+        if self.tool_number < 1:
+            raise InputError(f"tool number {self.tool_number} must be 1 or more")
+        if self.length_offset is not None and self.length_offset < 1:
+            raise InputError(f"length offset H{self.length_offset} must be 1 or more")
+
+    @property
+    def length_offset_number(self) -> int:
+        """The H number of ``G43``: the length offset, by default the tool number."""
+        return self.tool_number if self.length_offset is None else int(self.length_offset)
+
+
+_CONCERNS = {"program": ProgramFormat, "cutting": CuttingData, "slot": ToolSlot}
+
+
 @dataclass(frozen=True)
 class MachineSettings:
-    """How a program talks to one machine.
+    """Everything a program for one machine needs, as one set of keyword arguments: four values by concern.
+
+    The fields are the command line's options; each is checked once, by the
+    value of its concern, and the values travel apart to the code that needs
+    only one: :attr:`placement` (surface to machine), :attr:`program`
+    (:class:`ProgramFormat`), :attr:`cutting` (:class:`CuttingData`) and
+    :attr:`slot` (:class:`ToolSlot`).  :meth:`of` puts four such values together.
 
     Attributes
     ----------
@@ -158,6 +279,14 @@ class MachineSettings:
         ``mm_per_unit`` it is the :attr:`placement`.
     units : str
         ``mm`` (G21) or ``inch`` (G20) in the program; internal values stay in mm.
+
+    Examples
+    --------
+    >>> s = MachineSettings(dialect="linuxcnc", mm_per_unit=20.0, feed_mm_min=1500.0, tool_number=2)
+    >>> s.program.dialect, s.cutting.feed_mm_min, s.slot.length_offset_number, s.placement.mm_per_unit
+    ('linuxcnc', 1500.0, 2, 20.0)
+    >>> MachineSettings.of(s.placement, s.program, s.cutting, s.slot) == s
+    True
     """
 
     dialect: str = "fanuc"
@@ -178,48 +307,36 @@ class MachineSettings:
     feed_height_mm: float = 2.0
     coolant: str = "off"
     surface_units: str = "mm"
+    program: ProgramFormat = field(init=False, repr=False, compare=False)
+    cutting: CuttingData = field(init=False, repr=False, compare=False)
+    slot: ToolSlot = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        c = control(self.dialect)
-        choice(self.units, UNITS, "units")
+        for name, kind in _CONCERNS.items():  # each concern checks its own fields, once
+            values = {f.name: getattr(self, f.name) for f in fields(kind)}
+            object.__setattr__(self, name, kind(**values))
         choice(self.surface_units, UNITS, "surface units")
-        choice(self.coolant, COOLANTS, "coolant")
-        if self.line_ending not in PROGRAM_LINE_ENDINGS:
-            raise InputError(f"line ending {self.line_ending!r} is not one of {', '.join(PROGRAM_LINE_ENDINGS)}: "
-                             "with CR alone rs274 and ISO readers see the whole program as one block")
-        positive(self.feed_mm_min, "feed")
-        positive(self.plunge_feed_mm_min, "plunge feed")
-        positive(self.spindle_rpm, "spindle speed", allow_zero=True)
-        positive(self.stock_to_leave_mm, "stock to leave", allow_zero=True)
-        positive(self.feed_height_mm, "feed height")
-        finite(self.safe_z_mm, "safe Z")
         place = Placement(self.mm_per_unit, self.origin_mm)  # checks both, once
         object.__setattr__(self, "mm_per_unit", place.mm_per_unit)
         object.__setattr__(self, "origin_mm", place.origin_mm)
-        for name in ("program_number", "tool_number", "length_offset", "decimals"):
-            v = getattr(self, name)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))):
-                raise InputError(f"{name.replace('_', ' ')} {v!r} must be a whole number")
-        low, high = c.program_numbers
-        if not (low <= int(self.program_number) <= high):
-            raise ToolpathError(f"program number {self.program_number} must be {low} to {high} for a {c.name} program")
-        if self.tool_number < 1:
-            raise InputError(f"tool number {self.tool_number} must be 1 or more")
-        if self.length_offset is not None and self.length_offset < 1:
-            raise InputError(f"length offset H{self.length_offset} must be 1 or more")
-        if self.decimals is not None and not (0 <= self.decimals <= 6):
-            raise ToolpathError(f"decimals {self.decimals} must be 0 to 6")
-        work_offset(self.work_offset, exact=True)
+
+    @classmethod
+    def of(cls, placement: Placement = Placement(), program: ProgramFormat = ProgramFormat(),
+           cutting: CuttingData = CuttingData(), slot: ToolSlot = ToolSlot(), surface_units: str = "mm"):
+        """The settings of four values by concern."""
+        flat = {f.name: getattr(v, f.name) for v in (program, cutting, slot) for f in fields(v)}
+        return cls(mm_per_unit=placement.mm_per_unit, origin_mm=placement.origin_mm, surface_units=surface_units,
+                   **flat)
 
     @property
     def control(self) -> Control:
         """The control the program is for (:data:`lagsym.controls.CONTROLS`)."""
-        return control(self.dialect)
+        return self.program.control
 
     @property
     def length_offset_number(self) -> int:
         """The H number of ``G43``: the length offset, by default the tool number."""
-        return self.tool_number if self.length_offset is None else int(self.length_offset)
+        return self.slot.length_offset_number
 
     @property
     def placement(self) -> Placement:
@@ -229,19 +346,17 @@ class MachineSettings:
     @property
     def eol(self) -> str:
         """The end-of-block characters."""
-        return LINE_ENDINGS[self.line_ending]
+        return self.program.eol
 
     @property
     def digits(self) -> int:
         """Decimals written after the point in coordinates."""
-        if self.decimals is not None:
-            return self.decimals
-        return 3 if self.units == "mm" else 4
+        return self.program.digits
 
     @property
     def unit_factor(self) -> float:
         """Program units per millimetre (:func:`program_units_per_mm`, as a float)."""
-        return float(program_units_per_mm(self.units))
+        return self.program.unit_factor
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,7 @@ def plan(name, direction, dialect):
         path, _, _, scale, stepover = CASES[name]
         s = lagrange_surface(read_points(EXAMPLES / path))
         settings = MachineSettings(mm_per_unit=scale, dialect=dialect, safe_z_mm=100.0)
-        tp = plan_toolpath(s, Tool("ball", 6.0), RasterSpec(direction, stepover, None, None, TOL, arcs=True), settings)
+        tp = plan_toolpath(s, Tool("ball", 6.0), RasterSpec(direction, stepover, None, None, TOL, arcs=True), settings.placement, settings.program, stock_to_leave_mm=settings.stock_to_leave_mm)
         _PLANS[key] = tp, settings, write_program(point_program(tp, settings, title=name))
     return _PLANS[key]
 

@@ -21,7 +21,7 @@ from cutters import surfaces
 
 def plan(surf, tool=Tool("ball", 6.0), raster=RasterSpec("x", 2.0, 1.0), **kw):
     settings = MachineSettings(mm_per_unit=kw.pop("scale", 20.0), **kw)
-    return plan_toolpath(surf, tool, raster, settings)
+    return plan_toolpath(surf, tool, raster, settings.placement, settings.program, stock_to_leave_mm=settings.stock_to_leave_mm)
 
 
 def cl_above_moves(surf, tp, scale, per_move=50, moves=None):

@@ -16,7 +16,7 @@ from lagsym.controls import CONTROLS, Control, control, names, work_offset
 from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.post.program import point_program, write_program
 from lagsym.simulate import simulate
 from lagsym.toolpath import plan_toolpath
@@ -130,7 +130,7 @@ _PATHS = {}
 def _path():
     if not _PATHS:
         surf = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
-        _PATHS["p"] = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), MachineSettings(mm_per_unit=20.0))
+        _PATHS["p"] = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), Placement(20.0))
     return _PATHS["p"]
 
 

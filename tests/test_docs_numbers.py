@@ -258,7 +258,7 @@ def arc_figures(name: str, rs274, tmp_path):
     f, box = {"paper-example-2": (example2, (1.0, 4.0, 1.0, 4.0)), "paper-example-4": (example4, (1.0, 5.0, 1.0, 5.0))}[name]
     settings = MachineSettings(mm_per_unit=20.0, dialect="fanuc", safe_z_mm=80.0)
     s = lagrange_surface(read_points(ROOT / "examples" / f"{name}.json"))
-    tp = plan_toolpath(s, Tool("ball", 6.0), RasterSpec("x", 0.4, 0.2, arcs=True), settings)
+    tp = plan_toolpath(s, Tool("ball", 6.0), RasterSpec("x", 0.4, 0.2, arcs=True), settings.placement, settings.program, stock_to_leave_mm=settings.stock_to_leave_mm)
     path = tmp_path / f"{name}.nc"
     path.write_text(write_program(point_program(tp, settings)))
     r = rs274.run(path)

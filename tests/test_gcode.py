@@ -44,7 +44,7 @@ def test_reads_what_rs274_does(rs274):
 def test_reads_every_dialect_lagsym_writes(rs274, dialect):
     surf = lagrange_surface(read_points(EXAMPLES / "paper-example-2.json"))
     s = MachineSettings(dialect=dialect, mm_per_unit=10.0, safe_z_mm=300.0, units="inch", line_ending="crlf")
-    tp = plan_toolpath(surf, Tool("ball", 4.0), RasterSpec("x", 5.0, 2.0), s)
+    tp = plan_toolpath(surf, Tool("ball", 4.0), RasterSpec("x", 5.0, 2.0), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     text = write_program(point_program(tp, s))
     moves = parse_moves(text)
     feeds, _ = interpret(rs274, text)

@@ -16,7 +16,7 @@ from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
-from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.controls import names
 from lagsym.post.program import PointProgram, format_moves, iso_comment, point_program, write_program
 from lagsym.toolpath import plan_toolpath
@@ -31,7 +31,7 @@ NUMBER_WORD = re.compile(r"([XYZF])(-?[0-9.]+)")
 @pytest.fixture(scope="module")
 def path4():
     surf = lagrange_surface(read_points(EXAMPLES / "paper-example-4.json"))
-    return plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), MachineSettings(mm_per_unit=20.0))
+    return plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 4.0, 2.0), Placement(20.0))
 
 
 def program_text(tp, **kw):
@@ -130,7 +130,7 @@ def small_surfaces(draw):
 def test_every_emitted_program_passes_rs274(rs274, surf, dialect, units, diameter, shape, oz, number):
     s = MachineSettings(dialect=dialect, units=units, mm_per_unit=10.0, origin_mm=(1.5, -2.25, oz), safe_z_mm=200.0,
                         program_number=number)
-    tp = plan_toolpath(surf, Tool(shape, diameter), RasterSpec("y", 4.0, None, None, 0.05), s)
+    tp = plan_toolpath(surf, Tool(shape, diameter), RasterSpec("y", 4.0, None, None, 0.05), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     text = write_program(point_program(tp, s, title="hypothesis"))
     feeds, _ = interpret(rs274, text)
     check_feeds(feeds, tp.points_mm, s)
@@ -222,7 +222,7 @@ def test_every_written_z_is_at_or_above_the_cutter_location_at_the_written_x_y(r
 
     surf, f = steep_flank()
     s = MachineSettings(units=units, safe_z_mm=60.0)
-    tp = plan_toolpath(surf, Tool("ball", 2.0), RasterSpec("y", 0.35, None, None, 0.002), s)
+    tp = plan_toolpath(surf, Tool("ball", 2.0), RasterSpec("y", 0.35, None, None, 0.002), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     feeds, _ = interpret(rs274, write_program(point_program(tp, s)))
     unit = 10.0 ** -s.digits / s.unit_factor
     assert np.abs(feeds[:, :2] / unit - np.rint(feeds[:, :2] / unit)).max() < 1e-6  # on the grid: nothing to round

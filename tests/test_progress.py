@@ -114,10 +114,10 @@ def test_nobody_listening_costs_nothing_and_prefixes_name_the_stage():
 
 
 def test_plan_toolpath_reports_the_fine_samples_then_the_checks(surface):
-    from lagsym.machine import MachineSettings, RasterSpec, Tool
+    from lagsym.machine import Placement, RasterSpec, Tool
     from lagsym.toolpath import plan_toolpath
 
-    args = (surface, Tool("ball", 4.0), RasterSpec("x", 2.0, 1.0), MachineSettings(mm_per_unit=1.0, safe_z_mm=40))
+    args = (surface, Tool("ball", 4.0), RasterSpec("x", 2.0, 1.0), Placement(1.0))
     rec = Recorder()
     tp = plan_toolpath(*args, progress=rec)
     totals = check_stages(rec)
@@ -150,7 +150,7 @@ def test_simulate_cut_reports_every_segment_swept(surface):
     from lagsym.verify import simulate_cut
 
     st = MachineSettings(mm_per_unit=1.0, safe_z_mm=40)
-    tp = plan_toolpath(surface, Tool("ball", 4.0), RasterSpec("x", 2.0, 1.0), st)
+    tp = plan_toolpath(surface, Tool("ball", 4.0), RasterSpec("x", 2.0, 1.0), st.placement, st.program, stock_to_leave_mm=st.stock_to_leave_mm)
     moves = parse_moves(write_program(point_program(tp, st, title="dome")))
     rec = Recorder()
     report = simulate_cut(surface, moves, Tool("ball", 4.0), st.placement, progress=rec)

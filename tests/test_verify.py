@@ -34,7 +34,7 @@ def valley():
 def ex2_program():
     surf = lagrange_surface(read_points(EX2))
     s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0)
-    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     return surf, tp, s, write_program(point_program(tp, s))
 
 
@@ -82,7 +82,7 @@ def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
     bad = parse_moves(write_program(PointProgram(offset[inside], s)))
     tool = Tool("ball", 2 * r)
     assert simulate_cut(surf, bad, tool, Placement(scale), cell_mm=0.25).gouge_mm > 1.0
-    tp = plan_toolpath(surf, tool, RasterSpec("x", 20.0, 0.25), s)
+    tp = plan_toolpath(surf, tool, RasterSpec("x", 20.0, 0.25), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     good = parse_moves(write_program(point_program(tp, s)))
     assert not simulate_cut(surf, good, tool, Placement(scale), cell_mm=0.25).gouges
 
@@ -208,7 +208,7 @@ def test_a_rapid_into_the_part_is_a_rapid_crash_with_its_line(ex2_program, run_c
 def test_material_left_is_reported_apart_from_the_gouge(run_cli, tmp_path):
     surf = lagrange_surface(read_points(EX2))
     s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0, stock_to_leave_mm=0.3)
-    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, 0.5), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     text = write_program(point_program(tp, s))
     report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.3)
     assert not report.gouges and not report.crashes and report.leaves_material
@@ -278,7 +278,7 @@ def test_verify_simulates_a_program_with_arcs(run_cli, tmp_path):
     """An arc program (G18 arcs) is simulated: no gouge, and its cut within the tolerance of the same plan's lines."""
     surf = lagrange_surface(read_points(EX2))
     s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0)
-    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, None, None, 0.005, arcs=True), s)
+    tp = plan_toolpath(surf, Tool("ball", 6.0), RasterSpec("x", 1.0, None, None, 0.005, arcs=True), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
     text = write_program(point_program(tp, s))
     assert "G18 G0" in text and len(tp.arcs) > 50
     f = tmp_path / "arcs.ngc"

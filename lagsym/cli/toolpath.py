@@ -93,8 +93,8 @@ def run(args, out, err) -> int:
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary, args.arcs)
     with progress_bar(err) as progress:
-        tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings, max_points=args.max_points,
-                           progress=progress)
+        tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings.placement, settings.program,
+                           max_points=args.max_points, stock_to_leave_mm=settings.stock_to_leave_mm, progress=progress)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
     if args.output and args.output != "-":

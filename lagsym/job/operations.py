@@ -146,8 +146,9 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
         raster = RasterSpec(o.get("direction", default_dir), stepover, step, o.get("scallop"), o.get("tolerance"))
     except LagsymError as e:
         raise ToolpathError(str(e)) from None
-    tp = plan_toolpath(surface, tool.tool, raster, _settings(spec, op, o.get("stock_to_leave", 0.0)), ev,
-                       max_points=limits[0], progress=progress)
+    s = _settings(spec, op, o.get("stock_to_leave", 0.0))
+    tp = plan_toolpath(surface, tool.tool, raster, s.placement, s.program, evaluator=ev, max_points=limits[0],
+                       stock_to_leave_mm=s.stock_to_leave_mm, progress=progress)
     _check_reach(tool, stock, tp.points_mm[:, 2].min())
     p = tp.points_mm
     above = stock.top_mm + 2.0

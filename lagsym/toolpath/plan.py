@@ -17,8 +17,9 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
-from ..machine import MachineSettings, RasterSpec, Tool
+from ..machine import Placement, ProgramFormat, RasterSpec, Tool
 from ..progress import Progress, Tally
+from ..values import positive
 from . import chordal
 from .arcs import Arcs, fit_arcs
 from .dropcutter import drop_cutter
@@ -104,26 +105,32 @@ class Toolpath:
         return self.points_mm[:, 2] - self.exact_mm
 
 
-def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSettings,
-                  evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS, *,
+def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement = Placement(),
+                  program: ProgramFormat = ProgramFormat(), *, evaluator: SurfaceEvaluator | None = None,
+                  max_points: int | None = MAX_PLAN_POINTS, stock_to_leave_mm: float = 0.0,
                   progress: Progress | None = None) -> Toolpath:
     """Plan a zig-zag raster of gouge-free cutter locations over the surface.
 
     Parameters
     ----------
     surface : LagrangeSurface
-        The exact surface; lengths in its units become mm by ``settings.mm_per_unit``.
-    tool : Tool
+        The exact surface; lengths in its units become mm by ``placement.mm_per_unit``.
+    tool : Cutter
         Cutter shape and diameter (mm).
     raster : RasterSpec
         Direction and steps (mm), or scallop height and chordal tolerance.
-    settings : MachineSettings
-        Scale, work offset and stock to leave.
+    placement : Placement
+        Where the surface sits on the machine: scale and work offset.
+    program : ProgramFormat
+        How the program is written: its units and decimals are the positions
+        the plan may use (its resolution), its control the chordal limit of arcs.
     evaluator : SurfaceEvaluator, optional
         The surface's evaluator (by default :func:`lagsym.evaluate.surface_evaluator`).
     max_points : int or None
         Refuse, before any work, a plan of more fine drop-cutter samples than
         this (``--max-points``); None for no limit.
+    stock_to_leave_mm : float
+        Material left above the surface, mm: the cutter is grown by it.
     progress : Progress, optional
         Told the fine samples dropped, then the checks' (:mod:`lagsym.progress`).
 
@@ -136,16 +143,17 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     >>> from lagsym.grid import grid_from_points
     >>> from lagsym.lagrange import lagrange_surface
     >>> s = lagrange_surface(grid_from_points([(0, 0, 1), (0, 1, 1), (1, 0, 1), (1, 1, 1)]))
-    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), MachineSettings(mm_per_unit=1.0))
+    >>> tp = plan_toolpath(s, Tool("ball", 0.0), RasterSpec("x", 0.5, 0.5), Placement(1.0))
     >>> tp.points_mm[:, :2].tolist()  # zig-zag: along x, up the edge, back
     [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5], [0.0, 1.0], [0.5, 1.0], [1.0, 1.0]]
     >>> bool((tp.points_mm[:, 2] == 1.0).all()), tp.rows.tolist()
     (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
     """
     ev = evaluator or surface_evaluator(surface)
-    mm_per_unit = settings.mm_per_unit
+    stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
+    mm_per_unit = placement.mm_per_unit
     tol = raster.chordal_tolerance_mm
-    cl = _Cutter.of(surface, ev, tool, settings)
+    cl = _Cutter.of(surface, ev, tool, stock, ResolutionGrid.of(placement, program, ev.bounds))
     # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
     past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
         if raster.boundary == "past" else None
@@ -161,17 +169,17 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, settings: MachineSett
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
         cl = replace(cl, workers=workers)
         path = _fine_path(cl, levels, along, raster.direction, fine, past=past, progress=progress)
-        tp = _checked(ev, cl, path, tol, raster, kappa=kappa, every=every, settings=settings, progress=progress)
-    bx, by, _ = _place(settings, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
+        tp = _checked(ev, cl, path, tol, raster, kappa=kappa, every=every, placement=placement, progress=progress)
+    bx, by, _ = _place(placement, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     tp = Toolpath(**tp, tool=tool, raster=raster,
                   stepover_mm=float(np.diff(levels).max() * mm_per_unit) if len(levels) > 1
                   else float(_side_step(tool, raster)),
                   step_mm=float(step), bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])),
-                  fine_points=len(path.x), **_cusp(scallop, raster.direction, settings))
-    return _with_arcs(tp, path, cl, settings, kappa) if raster.arcs else tp
+                  fine_points=len(path.x), **_cusp(scallop, raster.direction, placement))
+    return _with_arcs(tp, path, cl, placement, program, kappa) if raster.arcs else tp
 
 
-def _checked(ev, cl, path, tol, raster, *, kappa, every, settings, progress=None) -> dict:
+def _checked(ev, cl, path, tol, raster, *, kappa, every, placement, progress=None) -> dict:
     """The emitted points of the fine path, its moves checked and lifted: the point fields of a :class:`Toolpath`."""
     bend = np.concatenate([chordal.bends(path.z[lo:hi + 1])[:-1] for lo, hi, _ in path.pieces] + [[0.0]])
     kept = _emitted(path, tol, np.maximum(bend, chordal.semi_convex_sag(path.s_mm, kappa)), raster.step_mm, every)
@@ -188,20 +196,21 @@ def _checked(ev, cl, path, tol, raster, *, kappa, every, settings, progress=None
     with Tally(progress, "checking moves") as checks:
         vx, vy, vz, vrow, sag = chordal.check_moves(checks.counting(cl), vx, vy, vz, vrow, sag, seen=seen,
                                                     dense=dense, tol=tol, radius=cl.radius)
-    return without_repeats(np.stack(_place(settings, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
-                           _place(settings, vx, vy, vz)[2], cl.unit * cl.mm_per_unit)
+    return without_repeats(np.stack(_place(placement, vx, vy, vz + chordal.lift(sag)), axis=1), vrow,
+                           _place(placement, vx, vy, vz)[2], cl.unit * cl.mm_per_unit)
 
 
-def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, settings: MachineSettings, kappa: float) -> Toolpath:
+def _with_arcs(tp: Toolpath, path: _FinePath, cl: _Cutter, placement: Placement, program: ProgramFormat,
+               kappa: float) -> Toolpath:
     """The toolpath with the arcs fitted along its rows from the fine samples (:func:`.arcs.fit_arcs`)."""
-    fine = np.stack(_place(settings, path.x, path.y, path.z), axis=1)
+    fine = np.stack(_place(placement, path.x, path.y, path.z), axis=1)
     x0, x1, y0, y1 = tp.bounds_mm
     raster = tp.raster
     return replace(tp, arcs=fit_arcs(tp.points_mm, tp.rows, tp.exact_mm, fine, direction=raster.direction,
                                      kappa=kappa, tol=raster.chordal_tolerance_mm,
-                                     unit_factor=settings.unit_factor, digits=settings.digits, units=settings.units,
+                                     unit_factor=program.unit_factor, digits=program.digits, units=program.units,
                                      reach_mm=(x0, x1) if raster.direction == "x" else (y0, y1),
-                                     radius_mm=cl.radius * cl.mm_per_unit, chord_mm=settings.control.chord_mm))
+                                     radius_mm=cl.radius * cl.mm_per_unit, chord_mm=program.control.chord_mm))
 
 
 def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, *, step: float, fine: float,
@@ -235,23 +244,22 @@ def _span(bounds, direction: str) -> float:
     return y1 - y0 if direction == "x" else x1 - x0
 
 
-def _cusp(scallop, direction: str, settings: MachineSettings) -> dict:
+def _cusp(scallop, direction: str, placement: Placement) -> dict:
     """The worst predicted cusp, where it is on the machine and the share of hollows too tight for the ball."""
     if scallop is None:
         return {}
     p, c = scallop.worst_at
-    x, y = settings.placement.to_machine(*((p, c) if direction == "x" else (c, p)))
+    x, y = placement.to_machine(*((p, c) if direction == "x" else (c, p)))
     return {"cusp_mm": scallop.worst_mm, "cusp_at_mm": (float(x), float(y)),
             "hollow_share": scallop.tight / max(scallop.samples, 1)}
 
 
-def _place(settings: MachineSettings, x, y, z_mm):
+def _place(place: Placement, x, y, z_mm):
     """Surface positions ``x, y`` (surface units) and tip heights ``z_mm`` (mm) on the machine.
 
     The heights are already in mm because the chordal tolerances apply to
     them; only the work offset is added.
     """
-    place = settings.placement
     x_mm, y_mm = place.to_machine(x, y)
     return x_mm, y_mm, np.asarray(z_mm) + place.origin_mm[2]
 
@@ -315,11 +323,10 @@ class _Cutter:
     workers: Workers | None = None
 
     @classmethod
-    def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, settings: MachineSettings) -> _Cutter:
-        stock, mm_per_unit = settings.stock_to_leave_mm, settings.mm_per_unit
+    def of(cls, surface, ev: SurfaceEvaluator, tool: Tool, stock: float, grid: ResolutionGrid) -> _Cutter:
+        mm_per_unit = grid.mm_per_unit
         r_mm, corner_mm = tool.grown_mm(stock)
-        return cls(surface, ev, r_mm / mm_per_unit, corner_mm / mm_per_unit, stock / mm_per_unit, mm_per_unit,
-                   ResolutionGrid.of(settings, ev.bounds))
+        return cls(surface, ev, r_mm / mm_per_unit, corner_mm / mm_per_unit, stock / mm_per_unit, mm_per_unit, grid)
 
     def __call__(self, x, y, **search) -> np.ndarray:
         z = drop_cutter(self.surface, x, y, self.radius, corner=self.corner, evaluator=self.ev,

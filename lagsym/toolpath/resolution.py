@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..machine import MachineSettings
+from ..machine import Placement, ProgramFormat
 
 __all__ = ["ResolutionGrid", "without_repeats"]
 
@@ -45,11 +45,10 @@ class ResolutionGrid:
     bounds: tuple[float, float, float, float]
 
     @classmethod
-    def of(cls, settings: MachineSettings, bounds) -> ResolutionGrid:
-        """The grid of a program written with ``settings``, over the box ``bounds``."""
-        unit_mm = 10.0 ** -settings.digits / settings.unit_factor
-        ox, oy, _ = settings.placement.origin_mm
-        return cls(unit_mm, settings.mm_per_unit, (ox, oy), tuple(float(v) for v in bounds))
+    def of(cls, placement: Placement, program: ProgramFormat, bounds) -> ResolutionGrid:
+        """The grid of a program written as ``program`` for the surface at ``placement``, over the box ``bounds``."""
+        ox, oy, _ = placement.origin_mm
+        return cls(program.resolution_mm, placement.mm_per_unit, (ox, oy), tuple(float(v) for v in bounds))
 
     def snap(self, x, y) -> tuple[np.ndarray, np.ndarray]:
         """Surface positions moved to the nearest ones the program writes, never across a box edge.
