@@ -21,7 +21,7 @@ from .values import as_exact, choice, finite, positive
 
 __all__ = ["Placement", "Cutter", "Tool", "MachineSettings", "ProgramFormat", "CuttingData", "ToolSlot", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
            "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
-           "program_units_per_mm", "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
+           "program_units_per_mm", "mm_per_program_unit", "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
 DIALECTS = names()
 """The names of the registered controls (:data:`lagsym.controls.CONTROLS`)."""
@@ -67,6 +67,15 @@ def bits_per_char(bytesize: int, parity: str, stopbits: float) -> float:
     11.0
     """
     return 1 + bytesize + (0 if parity == "none" else 1) + float(stopbits)
+
+
+def mm_per_program_unit(units: str) -> float:
+    """Millimetres per program unit: 1 for ``mm`` (G21), 25.4 for ``inch`` (G20).
+
+    The one conversion every reader of a program uses, beside its exact
+    inverse :func:`program_units_per_mm` that the writers use.
+    """
+    return float(MM_PER[choice(units, UNITS, "units")])
 
 
 def program_units_per_mm(units: str) -> Fraction:

@@ -28,7 +28,7 @@ from .gcode import Moves, first_line_with, is_macro, macro_uses, parse_moves, pr
 from .io import read_points
 from .job.operations import job_stock
 from .lagrange import lagrange_surface
-from .machine import Placement, Tool
+from .machine import Placement, Tool, mm_per_program_unit
 from .progress import Progress, Tally
 from .verify import MAX_CELLS, height_map_axes, press_moves
 from .verify.heightmap import segments, tool_grid
@@ -215,7 +215,7 @@ def job_moves(spec, text: str, source: str = "<program>", progress: Progress | N
                     if op.options.get("macro")) if any(op.options.get("macro") for op in spec.operations) \
         else DEFAULT_PRECISION.get(spec.dialect, 15)
     sim = simulate(text, spec.dialect, precision, progress=progress)
-    return sim.moves.to_moves(25.4 if spec.units == "inch" else 1.0, first_line_with(text, "Z"))
+    return sim.moves.to_moves(mm_per_program_unit(spec.units), first_line_with(text, "Z"))
 
 
 def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:

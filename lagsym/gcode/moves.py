@@ -27,6 +27,7 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ProgramError
+from ..machine import mm_per_program_unit
 from .arcs import arc_points
 from .program import program_blocks
 from .words import WordError, numeric_words, plain_move
@@ -121,7 +122,7 @@ class _Modal:
         elif g in (17, 18, 19):
             self.plane = int(g)
         elif g in (20, 21):
-            self.factor = 25.4 if g == 20 else 1.0
+            self.factor = mm_per_program_unit("inch" if g == 20 else "mm")
         elif g in (90, 91):
             self.absolute = g == 90
         elif g not in _IGNORED_G:

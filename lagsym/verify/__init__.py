@@ -46,7 +46,7 @@ from ..errors import InputError
 from ..evaluate import evaluate_grid, surface_evaluator
 from ..gcode import Moves, numeric_words, program_blocks, program_units
 from ..gcode.words import plain_move
-from ..machine import MAX_LEFT_MM, Placement, Tool
+from ..machine import MAX_LEFT_MM, Placement, Tool, mm_per_program_unit
 from ..progress import Progress
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
 
@@ -208,7 +208,7 @@ def program_resolution_mm(text: str) -> float:
         for v in values:
             if v and "." in v:
                 digits = max(digits, len(v) - v.index(".") - 1)
-    unit = 25.4 if program_units(text) == "inch" else 1.0
+    unit = mm_per_program_unit(program_units(text) or "mm")
     return 0.5 * 10.0 ** -digits * unit
 
 
