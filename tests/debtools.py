@@ -86,7 +86,9 @@ class RS274:
             tbl.write_text(tool_table)
             return subprocess.run(
                 [str(self.binary), "-t", str(tbl), "-g", str(program)],
-                capture_output=True, text=True, env=self.env, cwd=d, timeout=600,
+                # rs274 keeps its tool table in a memory-mapped file $HOME/.tool.mmap: a HOME of its own
+                # per run, or two runs at once (test workers, other checkouts) read each other's tools.
+                capture_output=True, text=True, env={**self.env, "HOME": d}, cwd=d, timeout=600,
             )
 
 
