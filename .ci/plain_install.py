@@ -23,10 +23,24 @@ def quick_start() -> list[str]:
     return [line for line in block.splitlines() if line.strip()]
 
 
-def shown_commands() -> list[str]:
+ACTIVATE = ". .venv/bin/activate"
+
+
+def shell_block() -> list[str]:
+    """The README's first use from the shell: the activation, then the commands, one a line."""
     text = (ROOT / "README.md").read_text()
-    block = text.split("## What it does", 1)[1].split("```", 2)[1].replace("\\\n", " ")
-    return [line.split("  #")[0].strip() for line in block.splitlines() if line.strip().startswith("lagsym ")]
+    block = text.split("## First use from the shell", 1)[1].split("```", 2)[1].replace("\\\n", " ")
+    return [line.split("  #")[0].strip() for line in block.splitlines() if line.strip()]
+
+
+def shown_commands() -> list[str]:
+    return [line for line in shell_block() if line.startswith("lagsym ")]
+
+
+def python_block() -> str:
+    """The README's first use from Python."""
+    text = (ROOT / "README.md").read_text()
+    return text.split("## First use from Python", 1)[1].split("```python", 1)[1].split("```", 1)[0]
 
 
 def main() -> int:
@@ -36,18 +50,30 @@ def main() -> int:
         first = quick_start()[0]
         print(f"plain install: {first}", flush=True)
         subprocess.run(["bash", "-c", first], cwd=clone, check=True)
-        env = {**os.environ, "PATH": f"{clone / '.venv' / 'bin'}{os.pathsep}{os.environ['PATH']}"}
+        # As the README says: activate the environment, then the commands (each in a shell of its own).
+        if shell_block()[0] != ACTIVATE:
+            print(f"FAILED: the README's shell block starts {shell_block()[0]!r}, not {ACTIVATE!r}")
+            return 1
+        env = dict(os.environ)
         for command in shown_commands():
             if any(p in command for p in NEEDS_A_MACHINE):
                 print(f"not run (needs a machine on a serial port): {command}")
                 continue
             print(f"$ {command}", flush=True)
-            done = subprocess.run(["bash", "-c", command], cwd=clone, env=env, capture_output=True, text=True)
+            done = subprocess.run(["bash", "-c", f"{ACTIVATE} && {command}"], cwd=clone, env=env,
+                                  capture_output=True, text=True)
             if done.returncode != 0:
                 print(done.stdout[-2000:], done.stderr[-2000:], sep="\n")
                 print(f"FAILED with exit status {done.returncode} after the plain install: {command}")
                 return 1
-    print("every README command ran after the plain install")
+        print("$ the README's Python example", flush=True)
+        done = subprocess.run([str(clone / ".venv" / "bin" / "python"), "-c", python_block()], cwd=clone,
+                              capture_output=True, text=True)
+        if done.returncode != 0 or "x**2 + 3*y" not in done.stdout:
+            print(done.stdout[-2000:], done.stderr[-2000:], sep="\n")
+            print("FAILED after the plain install: the README's Python example")
+            return 1
+    print("every README command and the Python example ran after the plain install")
     return 0
 
 

@@ -24,6 +24,8 @@ import sys
 import time
 from pathlib import Path
 
+import results as recorded
+
 ROOT = Path(__file__).resolve().parent.parent
 
 SYMPY_ROUTE = ("import sys; from lagsym import read_points, lagrange_surface; "
@@ -37,7 +39,7 @@ def _run(argv: list[str]) -> tuple[float, str]:
     return time.perf_counter() - t, done.stdout
 
 
-def table(commands: dict[str, list[str]], runs: int, base: str) -> None:
+def table(commands: dict[str, list[str]], runs: int, base: str) -> dict[str, list[float]]:
     """Time each command ``runs`` times in fresh processes, alternating; print min, median and the ratios to ``base``."""
     times: dict[str, list[float]] = {k: [] for k in commands}
     for _ in range(runs):
@@ -49,12 +51,14 @@ def table(commands: dict[str, list[str]], runs: int, base: str) -> None:
     for k, ts in times.items():
         lo, med = min(ts), statistics.median(ts)
         print(f"| {k} | {lo:.3f} | {med:.3f} | {lo / base_min:.2f}x / {med / base_med:.2f}x |")
+    return times
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=9)
     p.add_argument("--file", default="examples/paper-example-4.json")
+    recorded.add_option(p)
     a = p.parse_args(argv)
     commands = {
         "lagsym equation": [sys.executable, "-m", "lagsym", "equation", a.file],
@@ -65,7 +69,11 @@ def main(argv=None) -> int:
     if ours != theirs:
         raise SystemExit("the two routes printed different text")
     print(f"## `lagsym equation {a.file}`, fresh processes, {a.runs} runs each (same text checked)\n")
-    table(commands, a.runs, "lagsym equation")
+    times = table(commands, a.runs, "lagsym equation")
+    ours, peer = statistics.median(times["lagsym equation"]), statistics.median(times["SymPy route, same text"])
+    recorded.record("equation", task="`lagsym equation` of Example 4, a fresh process",
+                   peer="printing the same text through SymPy", ratio=peer / ours,
+                   detail=f"medians of {a.runs} runs: {ours:.3f} s against {peer:.3f} s", argv=argv, path=a.results)
     return 0
 
 

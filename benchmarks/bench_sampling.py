@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+import results as recorded
+
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from lagsym.evaluate import (basis_matrix, evaluate_grid, evaluate_points, lambdify_surface,  # noqa: E402
@@ -71,7 +73,7 @@ def alternating(fns: dict, runs: int) -> dict[str, list[float]]:
     return times
 
 
-def speed(n: int = 2000, runs: int = 21) -> None:
+def speed(n: int = 2000, runs: int = 21) -> dict:
     from scipy.interpolate import BarycentricInterpolator
 
     surface = lagrange_surface(read_points(ROOT / "examples" / "paper-example-4.json"))
@@ -131,12 +133,14 @@ def speed(n: int = 2000, runs: int = 21) -> None:
     print(f"| `lambdify` of the expanded expression, on `meshgrid` arrays | {t_lamb_mesh * 1e3:.1f} | "
           f"{t_lamb_mesh / t_grid:.0f}x slower |")
     print()
+    out = {"grid": t_grid, "scipy": t_scipy, "runs": runs, "n": n}
     print("| scattered points | time (ms) | ratio |")
     print("|---|---:|---:|")
     print(f"| **lagsym** `evaluate_points(surface, x, y)`, 10^6 random points | {t_scatter * 1e3:.1f} | 1 |")
     print(f"| `lambdify` of the expanded expression, same points | {t_scatter_lamb * 1e3:.1f} | "
           f"{t_scatter_lamb / t_scatter:.1f}x |")
     print()
+    return out
 
 
 def _chebyshev_like(n: int, a: float, b: float) -> list[Fraction]:
@@ -203,10 +207,16 @@ def main(argv=None) -> int:
     p.add_argument("--accuracy", action="store_true")
     p.add_argument("--points", type=int, default=60, help="random points per accuracy case")
     p.add_argument("--runs", type=int, default=21, help="runs of the sample and of np.full, alternating")
+    recorded.add_option(p)
     a = p.parse_args(argv)
     both = not (a.speed or a.accuracy)
     if a.speed or both:
-        speed(runs=a.runs)
+        got = speed(runs=a.runs)
+        recorded.record("sampling", task=f"a {got['n']}x{got['n']} grid of Example 4 (`evaluate_grid`)",
+                        peer="SciPy's `BarycentricInterpolator` along both axes, vectorized",
+                        ratio=got["scipy"] / got["grid"],
+                        detail=f"best times: {got['grid'] * 1e3:.2f} ms against {got['scipy'] * 1e3:.2f} ms",
+                        argv=argv, path=a.results)
     if a.accuracy or both:
         accuracy(a.points)
     return 0

@@ -36,6 +36,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import results as recorded
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
@@ -173,6 +175,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--peer-blocks", type=int, default=300_000, help="blocks the peer runs (0: all)")
+    recorded.add_option(p)
     a = p.parse_args(argv)
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
@@ -206,6 +209,11 @@ def main(argv=None) -> int:
         ratio_med = statistics.median(tp) * per_peer / (statistics.median(ts) * per_ours)
         print(f"\n{kind}: the interpreter takes {ratio_min:.1f}x (min) / {ratio_med:.1f}x (median) as long per block; "
               f"at its rate the whole program would take {statistics.median(tp) / done * sim.blocks:.1f} s.")
+    cpu_ours, cpu_peer = statistics.median(r[1] for r in ours), statistics.median(r[1] for r in peer)
+    recorded.record("simulate", task=f"simulating the README's 4 mm ball macro ({sim.blocks:,} blocks), per block",
+                    peer="the block-by-block interpreter it replaced", ratio=cpu_peer * per_peer / (cpu_ours * per_ours),
+                    detail=f"CPU medians of {a.runs} runs: {cpu_ours * per_ours:.0f} against {cpu_peer * per_peer:.0f} ns "
+                    f"a block; the whole command {statistics.median(r[0] for r in cli):.2f} s", argv=argv, path=a.results)
     return 0
 
 

@@ -17,12 +17,16 @@ import argparse
 import os
 import sys
 
+import statistics
+
+import results as recorded
 from bench_equation import table
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=9)
+    recorded.add_option(p)
     a = p.parse_args(argv)
     commands = {
         "lagsym --version": [sys.executable, "-m", "lagsym", "--version"],
@@ -32,7 +36,11 @@ def main(argv=None) -> int:
         'python -c "import sympy"': [sys.executable, "-c", "import sympy"],
     }
     print(f"## start-up, fresh processes, {a.runs} runs each, load average {os.getloadavg()[0]:.1f}\n")
-    table(commands, a.runs, "lagsym --version")
+    times = table(commands, a.runs, "lagsym --version")
+    ours, peer = statistics.median(times["lagsym --version"]), statistics.median(times['python -c "import sympy"'])
+    recorded.record("startup", task="`lagsym --version`, a fresh process", peer="`python -c \"import sympy\"`",
+                   ratio=peer / ours, detail=f"medians of {a.runs} runs: {ours:.3f} s against {peer:.3f} s",
+                   argv=argv, path=a.results)
     return 0
 
 

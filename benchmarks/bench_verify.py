@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+import results as recorded
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
@@ -114,6 +116,7 @@ def main(argv=None) -> int:
     p.add_argument("--program", type=Path, default=Path("/tmp/lagsym-bench-O1000.nc"))
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--peer-runs", type=int, default=2)
+    recorded.add_option(p)
     args = p.parse_args(argv)
     if not args.program.exists():
         print(f"making {args.program} (the README's toolpath command) ...", flush=True)
@@ -158,6 +161,13 @@ def main(argv=None) -> int:
               f"{sag + 0.005:.4f} mm); cells reached by the exact sweep only: {int((np.isfinite(ex) & ~both).sum())}, "
               f"by the sampled press only: {int((np.isfinite(sa) & ~both).sum())}")
     print(f"load average at the end {os.getloadavg()[0]:.1f}")
+    if times["sampled press (peer)"]:
+        cpu_peer = statistics.median(t[1] for t in times["sampled press (peer)"])
+        recorded.record("verify", task=f"simulating the README's finishing program ({len(a):,} feed moves) on "
+                        f"{len(xs)}x{len(ys)} cells, exact swept ball", peer="the sampled press it replaced",
+                        ratio=cpu_peer / ref[1], detail=f"CPU medians: {ref[1]:.2f} s against {cpu_peer:.2f} s; the "
+                        f"whole command {statistics.median(t[0] for t in times['verify command']):.2f} s wall",
+                        argv=argv, path=args.results)
     return 0
 
 

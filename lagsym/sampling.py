@@ -210,7 +210,8 @@ def sample_grid(
     control : ControlGrid or LagrangeSurface
         Whose control box is the default domain and the interpolation range.
     nx, ny : int, optional
-        Number of grid lines in x and y (edges included), at least 2.
+        Number of grid lines in x and y (edges included), at least 2; one
+        alone stands for both, as ``--nx`` alone does on the command line.
     step, dx, dy : number, optional
         Largest spacing instead of counts: ``step`` for both directions or
         ``dx`` and ``dy``.  The count is the smallest that keeps the spacing
@@ -252,8 +253,9 @@ def sample_grid(
         sy = as_exact(step if step is not None else dy, nyname)
         counts = _count_for(sx, region.x1 - region.x0, nxname), _count_for(sy, region.y1 - region.y0, nyname)
         return _within(SampleGrid(region, *counts), max_points)
-    if nx is None or ny is None:
-        raise InputError("give both nx and ny (or a spacing)")
+    if nx is None and ny is None:
+        raise InputError("give nx (and ny, if it differs) or a spacing")
+    nx, ny = (nx, ny) if nx is not None and ny is not None else (nx or ny, nx or ny)
     return _within(SampleGrid(region, _count(nx, "nx"), _count(ny, "ny")), max_points)
 
 

@@ -48,11 +48,25 @@ def _download(package: str, debs: Path) -> Path:
 
 
 def unpack(packages: tuple[str, ...]) -> Path:
-    """Download and unpack ``packages`` into the cache; return the root they were unpacked into."""
+    """Download and unpack ``packages`` into the cache; return the root they were unpacked into.
+
+    Test processes running side by side (``pytest -n``) take turns: one unpacks while the others wait
+    on a lock file, then find its stamp; none replaces a tree another is running programs from."""
+    import fcntl
+
     root = CACHE / "root"
     stamp = CACHE / ("unpacked-" + "-".join(packages))
     if stamp.exists():
         return root
+    CACHE.mkdir(parents=True, exist_ok=True)
+    with open(CACHE / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if stamp.exists():
+            return root
+        return _unpack(packages, root, stamp)
+
+
+def _unpack(packages: tuple[str, ...], root: Path, stamp: Path) -> Path:
     debs = CACHE / "debs"
     debs.mkdir(parents=True, exist_ok=True)
     # Unpack into a fresh folder and move it into place, so two test runs never see half a tree.

@@ -181,37 +181,45 @@ def test_xoff_stops_the_sender_within_its_limit(line):
 
 @pytest.mark.parametrize("late_s", [0.0, 0.02], ids=["prompt", "late-writes"])
 def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line, monkeypatch, late_s):
-    # What the sender controls: it keeps at most its window on the way and writes nothing once it has read
-    # the DC3, so what the control receives after its DC3 (counted by the control, on a kernel pty pair)
-    # stays within a headroom twice the window: the window on the way, and at most one write that left
-    # before the DC3 was read.  The sender's own count of characters in flight at each XOFF is checked too.
+    # What the sender promises with a wide window: at most its window on the way when it reads a DC3, and
+    # no write at all from then until it reads the DC1; the program arrives whole and exact.  How many
+    # characters the control then counts past its DC3 also holds how late the simulated control's own
+    # process took them from the line, which a loaded machine stretches at will: bench_dnc.py reports
+    # that figure, a test cannot promise it.
     # "late-writes" holds every other write back 20 ms (17 characters of line), as a busy computer does to
     # a sender between its look at the clock and its write; the next write then follows at once.
+    from lagsym.dnc.port import Port
+
     baud, window, headroom = 9600, 32, 64
-    if late_s:
-        from lagsym.dnc.port import Port
+    write, calls, events = Port.write, [], []
 
-        write, calls = Port.write, []
+    def recorded_write(self, data):
+        calls.append(len(data))
+        if late_s and len(calls) % 2:
+            time.sleep(late_s)
+        written = write(self, data)
+        events.append(f"write {written}")
+        return written
 
-        def late_write(self, data):
-            calls.append(len(data))
-            if len(calls) % 2:
-                time.sleep(late_s)
-            return write(self, data)
-
-        monkeypatch.setattr(Port, "write", late_write)
+    monkeypatch.setattr(Port, "write", recorded_write)
     prog = parse_program(program_text(200))
     settings = profile("fanuc", baud=baud, overrun_chars=window)
     pair, sim = line(kernel=True, baud=baud, drain_cps=0.5 * chars_per_s(baud), buffer_chars=256, high_water=192,
                      low_water=64, tolerance=headroom)
     expected = b"".join(b for _, b in transfer_segments(prog, settings, "drip"))
-    result = send_program(pair.near, prog, settings, "drip")
+    result = send_program(pair.near, prog, settings, "drip", log=events.append)
     assert sim.wait_for(len(expected))
     assert bytes(sim.received) == expected
     assert sim.xoffs >= 5 and result.xoff_count == sim.xoffs
     assert result.max_in_flight_at_xoff <= window
-    assert sim.pending_at_xoff <= window  # written but not yet carried by the line when the DC3 went out
-    assert sim.overflow == 0
+    # In the sender's own order of events: after each XOFF it read, nothing was written until the XON.
+    kinds = [e.split()[0] for e in events if e.startswith(("write", "XOFF", "XON"))]
+    paused = False
+    for kind in kinds:
+        assert not (paused and kind == "write"), "a write between XOFF and XON"
+        paused = {"XOFF": True, "XON": False}.get(kind, paused)
+    assert kinds.count("XOFF") == kinds.count("XON") == sim.xoffs
+    assert sum(int(e.split()[1]) for e in events if e.startswith("write")) == len(expected)
 
 
 @needs_socat

@@ -322,7 +322,6 @@ def test_the_sampling_page_quotes_when_the_kernels_load():
     text = " ".join(page("sampling.md").split())
     assert LOAD_SECONDS == 0.5 and "(`LOAD_SECONDS`, 0.5 s)" in text and "have taken 0.5 s" in text
     assert "once such batches have taken half a second in NumPy" in " ".join(page("architecture.md").split())
-    assert "until they have taken 0.5 s together" in " ".join((ROOT / "README.md").read_text().split())
 
 
 def test_the_pages_quote_the_compiled_threshold():
@@ -330,5 +329,3 @@ def test_the_pages_quote_the_compiled_threshold():
 
     assert f"A batch of {COMPILED_POINTS:,} scattered points or more (`COMPILED_POINTS`)" in page("sampling.md")
     assert f"a batch of {COMPILED_POINTS:,} scattered points or more" in page("architecture.md")
-    assert f"a batch of {COMPILED_POINTS:,} points or more runs it compiled" in " ".join(
-        (ROOT / "README.md").read_text().split())

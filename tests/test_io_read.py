@@ -71,3 +71,17 @@ def test_a_program_over_the_limit_is_refused_by_its_size(tmp_path):
         fh.truncate(MAX_BYTES + 1)
     with pytest.raises(InputError, match=rf"big.nc: {MAX_BYTES + 1} bytes is too large for a program \(at most"):
         read_program(big)
+
+
+@pytest.mark.parametrize("reader, maker", [("read_points", "grid_from_points"),
+                                           ("read_curve_points", "curve_from_points")])
+def test_points_in_memory_are_sent_to_the_function_for_them(reader, maker):
+    import lagsym
+
+    points = [[0, 0, 1], [0, 1, 2], [1, 0, 3], [1, 1, 4]]
+    with pytest.raises(lagsym.InputError) as e:
+        getattr(lagsym, reader)(points)
+    assert "no such file" not in str(e.value)
+    assert f"not list [[0, 0, 1]" in str(e.value) and f"use lagsym.{maker}(points)" in str(e.value)
+    # and the function it names takes them
+    assert lagsym.grid_from_points(points).z_array.shape == (2, 2)

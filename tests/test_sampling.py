@@ -57,7 +57,7 @@ def test_grid_lines_are_correctly_rounded(num, width, den, n):
     ("kwargs", "words"),
     [
         ({"nx": 1, "ny": 5}, "nx = 1 is too few"),
-        ({"nx": 5}, "both nx and ny"),
+        ({}, "give nx \\(and ny, if it differs\\) or a spacing"),
         ({"nx": 5, "ny": 5, "step": "0.1"}, "not both"),
         ({"step": "0.1", "dx": "0.2"}, "not both"),
         ({"dx": "0.1"}, "both dx and dy"),
@@ -119,3 +119,20 @@ def test_blocks_add_up_to_the_whole_sample(surface, block_points):
     tol = surface_evaluator(surface).error_bound()
     assert np.abs(z - sample(surface, grid=g).z).max() <= tol
     assert np.abs(z - evaluate_grid(surface, g.xs, g.ys)).max() <= tol
+
+
+def test_one_count_stands_for_both_as_on_the_command_line(run_cli, tmp_path):
+    """``sample(s, 3)`` is the 3 x 3 grid ``lagsym sample --nx 3`` writes."""
+    import csv
+
+    s = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
+    d = sample(s, 3)
+    assert np.asarray(d.z).shape == (3, 3)
+    status, _, err = run_cli("sample", EXAMPLES / "paper-example-1.json", "--nx", "3", "-o", tmp_path / "s.csv")
+    assert status == 0, err
+    rows = list(csv.DictReader((tmp_path / "s.csv").open()))
+    assert len(rows) == 9
+    # Example 1 is z = x**2 + 3*y, exactly, at the corners and the middle of its box [1, 5] x [2, 4].
+    for x, y in ((1, 2), (3, 3), (5, 4)):
+        assert any(float(r["x"]) == x and float(r["y"]) == y and float(r["z"]) == x * x + 3 * y for r in rows)
+    assert sorted(np.asarray(d.z).ravel().tolist()) == sorted(float(r["z"]) for r in rows)

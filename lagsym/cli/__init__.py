@@ -135,6 +135,9 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         return ExitStatus.BAD_INPUT
     keep_freed_memory()  # large temporaries reused rather than faulted in afresh (lagsym.allocator)
     try:
+        from ._common import in_program_units
+
+        in_program_units(args)
         with _signals_as_interrupts():
             return int(args._run(args, out, err))
     except LagsymError as e:

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from fractions import Fraction
 from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
 from ..controls import CONTROLS, work_offset
-from ..values import as_exact, in_range, whole
+from ..values import as_exact, finite, in_range, whole
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:
@@ -73,6 +74,67 @@ def number(low: float, high: float, unit: str = "", *, above: bool = False):
     return parse
 
 
+# Lengths and feeds are read in the program's units (``--units``: a machinist with an inch control thinks
+# in inches and inches a minute) unless the number carries its own: ``5mm``, ``0.2in``, ``600mm/min``,
+# ``24in/min``.  The range is checked once the number is in millimetres.
+MM_PER_INCH = 25.4
+LENGTH_UNITS = {"mm": 1.0, "in": MM_PER_INCH}
+FEED_UNITS = {"mm/min": 1.0, "in/min": MM_PER_INCH}
+
+
+@dataclass(frozen=True)
+class Given:
+    """A length or feed as the command line gave it: the number, and the factor to millimetres if it named a unit."""
+
+    text: str
+    value: float
+    factor: float | None
+    low: float
+    high: float
+    above: bool
+    unit: str
+
+    def mm(self, option: str, program_units: str) -> float:
+        factor = self.factor if self.factor is not None else (MM_PER_INCH if program_units == "inch" else 1.0)
+        value = self.value if factor == 1.0 else self.value * factor
+        try:
+            return in_range(value, "", self.low, self.high, above=self.above, unit=self.unit)
+        except InputError:
+            span = f"above {self.low:g}, up to {self.high:g}" if self.above else f"from {self.low:g} to {self.high:g}"
+            shown = f" ({value:g} mm)" if factor != 1.0 else ""
+            raise InputError(f"{option} = {self.text!r}{shown} is out of range: give {span} {self.unit}") from None
+
+
+def measure(low: float, high: float, unit: str, *, above: bool = False):
+    """An argparse ``type=`` for a length (``unit`` "mm") or feed ("mm/min"): a :class:`Given`, in range once in mm."""
+    units = FEED_UNITS if unit == "mm/min" else LENGTH_UNITS
+
+    def parse(text: str) -> Given:
+        s = text.strip()
+        factor = None
+        for name in sorted(units, key=len, reverse=True):
+            if s.endswith(name):
+                s, factor = s[:-len(name)].strip(), units[name]
+                break
+        try:
+            value = finite(s, "")
+        except InputError:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a number: give one, in the program's units or with {' or '.join(units)}") from None
+        return Given(text, value, factor, low, high, above, unit)
+    parse.__name__ = "number"
+    return parse
+
+
+def in_program_units(args) -> None:
+    """Every :class:`Given` of ``args`` into millimetres: in the program's units where the command writes a
+    program (``--units``), else in millimetres, unless it named its own unit."""
+    units = getattr(args, "units", "mm") if getattr(args, "_program_units", False) else "mm"
+    for name, value in vars(args).items():
+        if isinstance(value, Given):
+            setattr(args, name, value.mm("--" + name.replace("_", "-"), units))
+
+
 def count(low: int, high: int):
     """An argparse ``type=`` for a whole-number option from ``low`` to ``high``."""
     def parse(text: str) -> int:
@@ -106,19 +168,19 @@ def exact(low: float | None = None, high: float | None = None, *, above: bool = 
 # narrow enough that every figure fits a program word and a float with room to spare.
 LENGTH_MM = 100_000.0  # 100 m: no machine travels further
 SCALE = number(1e-6, 1e6, "(a scale factor)", above=True)
-STEP_MM = number(1e-4, LENGTH_MM, "mm")
-SMALL_MM = number(1e-6, 1_000.0, "mm", above=True)  # tolerances and cusp heights
-TOOL_MM = number(0.0, 1_000.0, "mm")
-CORNER_MM = number(0.0, 500.0, "mm", above=True)
-FEED_MM_MIN = number(1.0, 100_000.0, "mm/min")
+STEP_MM = measure(1e-4, LENGTH_MM, "mm")
+SMALL_MM = measure(1e-6, 1_000.0, "mm", above=True)  # tolerances and cusp heights
+TOOL_MM = measure(0.0, 1_000.0, "mm")
+CORNER_MM = measure(0.0, 500.0, "mm", above=True)
+FEED_MM_MIN = measure(1.0, 100_000.0, "mm/min")
 _RPM = number(1.0, 200_000.0, "rpm, or 0 for the spindle off")
 
 
 def SPINDLE_RPM(text: str) -> float:  # noqa: N802 - named as the other option types
     """0 (spindle off) or a speed an S word can say: a fraction of a turn a minute would be written S0."""
     return 0.0 if text.strip() in ("0", "0.0", "0.") else _RPM(text)
-HEIGHT_MM = number(-LENGTH_MM, LENGTH_MM, "mm")
-STOCK_MM = number(0.0, 100.0, "mm")
+HEIGHT_MM = measure(-LENGTH_MM, LENGTH_MM, "mm")
+STOCK_MM = measure(0.0, 100.0, "mm")
 DECIMALS = count(0, 6)
 PROGRAM_NUMBER = count(1, max(c.program_numbers[1] for c in CONTROLS.values()))  # the control's own range is checked
 TOOL_NUMBER = count(0, 9999)

@@ -50,7 +50,10 @@ def add_arguments(p) -> None:
                    help="the control's variable ranges: full (Fanuc #100-#199, #500-#999; default) or small "
                         "(#100-#149, #500-#531, smaller Fanuc controls); a program that does not fit is refused")
     p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added, mm")
-    p.add_argument("--units", choices=("mm", "inch"), default="mm", help="program units (default mm)")
+    p.add_argument("--units", choices=("mm", "inch"), default="mm",
+                   help="program units (default mm); lengths and feeds given without a unit (5mm, 0.2in, "
+                        "600mm/min, 24in/min) are read in these units")
+    p.set_defaults(_program_units=True)
     p.add_argument("--direction", choices=("x", "y"), default="x", help="rows run along x (default) or y")
     p.add_argument("--stepover", type=STEP_MM, default=0.5, metavar="MM", help="side step between rows, mm (default 0.5)")
     p.add_argument("--step", type=STEP_MM, default=0.2, metavar="MM", help="forward step along a row, mm (default 0.2)")

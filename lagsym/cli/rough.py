@@ -77,7 +77,10 @@ def add_arguments(p) -> None:
     m = p.add_argument_group("machine")
     m.add_argument("--scale", type=SCALE, default=1.0, help="millimetres per surface unit (default 1)")
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
-    m.add_argument("--units", choices=UNITS, default="mm", help="program units: mm (G21, default) or inch (G20)")
+    m.add_argument("--units", choices=UNITS, default="mm",
+                   help="program units: mm (G21, default) or inch (G20); lengths and feeds given without a unit "
+                        "(5mm, 0.2in, 600mm/min, 24in/min) are read in these units")
+    p.set_defaults(_program_units=True)
     m.add_argument("--feed", type=FEED_MM_MIN, default=600.0, metavar="MM/MIN", help="cutting feed (default 600)")
     m.add_argument("--plunge-feed", type=FEED_MM_MIN, default=200.0, metavar="MM/MIN", help="plunge feed (default 200)")
     m.add_argument("--rapid", type=FEED_MM_MIN, default=5000.0, metavar="MM/MIN", help="rapid rate for the cycle time (default 5000)")

@@ -179,6 +179,11 @@ def _json_points(name: str, text: str, arity: int | None):
     return points, arity, layout, units
 
 
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None, snap=None) -> PointsFile:
     """Read a points file of any accepted layout; say how it was read and what ``snap`` moved.
 
@@ -199,6 +204,10 @@ def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None
     """
     choice(what, ("surface", "curve", "any"), "what")
     arity = {"surface": 3, "curve": 2, "any": None}[what]
+    if not isinstance(path, (str, os.PathLike)):
+        maker = "curve_from_points" if what == "curve" else "grid_from_points"
+        raise InputError(f"a points file's path, not {type(path).__name__} {_shown(path)}: for points in memory "
+                         f"use lagsym.{maker}(points)")
     name, text = read_text(path)
     cols = parse_columns(columns, arity) if columns else None
     if _kind(name, text) == "json":
