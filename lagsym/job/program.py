@@ -117,7 +117,7 @@ def _operation(op, s: MachineSettings, spec, changed: bool) -> list[str]:
     out.append(f"G00 G43 H{t.number} Z{num(spec.safe_z_mm)}" if c.length_offsets else f"G00 Z{num(spec.safe_z_mm)}")
     out.append(f"G00 X{num(p[0, 0])} Y{num(p[0, 1])}")
     if isinstance(op.path, RoughMacro):
-        out += rough_macro_blocks(op.path, s)
+        out += rough_macro_blocks(op.path, s, variables=spec.variables)
     else:
         out += _moves(op, s, (p[0, 0], p[0, 1], spec.safe_z_mm))
     out.append(f"G00 Z{num(spec.safe_z_mm)}")
