@@ -55,7 +55,7 @@ def test_reads_every_dialect_lagsym_writes(rs274, dialect):
 
 @pytest.mark.parametrize("text, match", [
     ("G0 X1\nG2 X2 Y2 R1\n", "by its radius"),
-    ("G0 X1\nG28\n", "G28 is not a straight or circular move"),
+    ("G0 X1\nG28\n", "G28 moves through the reference point"),
     ("G0 X1 (open comment\n", "unclosed comment"),
     ("X1 Y2\n", "before any G00"),
     ("G0 X1 X2\n", "X given twice"),
@@ -78,3 +78,45 @@ def test_moves_are_read_only():
     moves = parse_moves("G1 X1 F1\n")
     with pytest.raises(ValueError):
         moves.points_mm[0, 0] = 3.0
+
+
+# A main program and its subprogram in one file, as LinuxCNC (2.9) and a Fanuc run it: M98 moves the tool to the
+# subprogram's X5 Y5 Z0, which a reader that skipped the call would never see.
+CALLED = "G21 G90\nG1 X1. Y1. Z1. F100.\nM98 P2000\nM30\nO2000\nG1 X5. Y5. Z0.\nM99\n%\n"
+
+
+def test_a_subprogram_call_moves_the_tool_and_is_refused_naming_its_line(rs274):
+    feeds, _ = interpret(rs274, CALLED)
+    assert [5.0, 5.0, 0.0] in feeds.tolist()  # the call moves the tool: skipping it would report another path
+    with pytest.raises(ProgramError, match=r"part.nc, line 3: M98 calls a subprogram") as info:
+        parse_moves(CALLED, source="part.nc")
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("block, words", [
+    ("M98 P2000", "M98 calls a subprogram"), ("M97 P20", "M97 calls a subprogram"),
+    ("M198 P2000", "M198 calls a subprogram"), ("M99", "M99 returns from a subprogram"),
+    ("G65 P9010 A1.", "G65 calls a macro"), ("G66 P9010", "G66 calls a macro"),
+    ("G81 X1. Y1. Z-1. R1.", "G81 is a canned cycle"), ("G83 X1. Y1. Z-1. R1. Q1.", "G83 is a canned cycle"),
+    ("G04 X1.", "G04 dwells"), ("G53 G0 Z0.", "G53 moves in machine coordinates"),
+    ("G52 X10.", "G52 shifts the coordinates"), ("G68 X0 Y0 R30.", "G68 rotates the coordinates"),
+    ("G51 X0 Y0 P2", "G51 scales the coordinates"), ("G41 D1", "G41 offsets the path"),
+    ("G10 L2 P1 X5.", "G10 sets offsets"), ("M47", "M47 may call a subprogram or move the tool"),
+])
+def test_calls_cycles_shifts_and_unknown_m_codes_are_refused(block, words):
+    with pytest.raises(ProgramError, match=words) as info:
+        parse_moves(f"G21 G90\nG1 X1. Y1. Z1. F100.\n{block}\nG1 X2.\nM30\n", source="part.nc")
+    assert "part.nc, line 3:" in str(info.value)
+
+
+def test_a_move_after_the_end_is_refused_and_set_up_words_pass(rs274):
+    with pytest.raises(ProgramError, match="line 4: a move after the end of the program .M02 or M30 on line 3."):
+        parse_moves("G21 G90\nG1 X1. Y1. Z1. F100.\nM30\nG1 X5.\n", source="part.nc")
+    # the set-up words a program may hold (tool, length offset, work offsets, path control, spindle, coolant,
+    # stops) move nothing: read as rs274 reads them, and a move on the M30 block is made
+    text = ("G21 G90 G17 G40 G49 G80 G94 G64 P0.01\nT1 M06\nG59.1\nG00 G43 H1 Z50.\nS1000 M03\nM08\n"
+            "G0 X1. Y2.\nM01\nG1 Z-1. F100.\nM00\nX3. M09\nG61\nM05\nG0 Z60. M30\n")
+    moves = parse_moves(text)
+    feeds, travs = interpret(rs274, text)
+    assert moves.points_mm[moves.rapid].tolist() == travs.tolist()
+    assert moves.points_mm[~moves.rapid].tolist() == feeds.tolist()

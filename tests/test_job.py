@@ -234,3 +234,44 @@ def test_the_job_leaves_at_most_the_finishing_guarantee(machined, job_run):
     at = np.unravel_index(np.argmax(np.where(box, left, -np.inf)), left.shape)
     assert round(float((left / w)[box].max()), 2) == 0.1 and round(float(left[at]), 2) == 0.32, left[at]
     assert fy[at] < 30 and np.degrees(np.arctan(np.gradient(f, cell, axis=1)[at])) == pytest.approx(72, abs=1)
+
+
+def _sideways_after_changes(calls, safe_z: float):
+    """Check rs274's canonical calls: after every CHANGE_TOOL, the tool's length offset comes before any move,
+    and the first move is straight up at the X and Y where the tool was, to ``safe_z``; the number of changes."""
+    pos, pending, changes = (0.0, 0.0, 0.0), None, 0
+    for name, argv in calls:
+        if name == "CHANGE_TOOL":
+            pending, changes = {"offset": False, "at": pos}, changes + 1
+        elif name == "USE_TOOL_LENGTH_OFFSET" and pending is not None:
+            pending["offset"] = True
+        elif name in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE"):
+            xyz = tuple(float(v) for v in argv.split(",")[:3])
+            if pending is not None:
+                assert pending["offset"], f"{name}{xyz} after tool change {changes} before its length offset"
+                assert name == "STRAIGHT_TRAVERSE" and xyz[:2] == pending["at"][:2] and xyz[2] == safe_z, \
+                    f"the first move after tool change {changes} is {name}{xyz}, from {pending['at']}"
+                pending = None
+            pos = xyz
+    return changes
+
+
+@pytest.mark.parametrize("kind", ["job", "rough", "rough --macro"])
+def test_after_every_tool_change_the_length_offset_and_safe_z_come_before_any_sideways_move(
+        kind, rs274, tmp_path, run_cli):
+    """A control whose M06 does not retract must not cross the block sideways with the new tool at the old
+    height: rs274's canonical output shows the length offset, then the move up, then X and Y."""
+    out = tmp_path / "part.ngc"
+    if kind == "job":
+        job = tmp_path / "job.toml"
+        job.write_text(job_text(**{"stepover = 5": "stepover = 8\nstep = 2", "stepdown = 2": "stepdown = 20",
+                                   "stepover = 0.5": "stepover = 4", "step = 0.2": "step = 2"}))
+        status, _, err = run_cli("job", job, "-o", out)
+        safe, changes = 90.0, 2
+    else:
+        status, _, err = run_cli("rough", EX4, "--scale", "20", "--stock-above", "2", "--safe-z", "90",
+                                 "--dialect", "linuxcnc", "--tool-diameter", "10", "--stepdown", "20",
+                                 "--stepover", "8", "--step", "2", "-o", out, *kind.split()[1:])
+        safe, changes = 90.0, 1
+    assert status == 0, err
+    assert _sideways_after_changes(_calls(rs274, out.read_text()), safe) == changes

@@ -192,7 +192,8 @@ def test_a_constant_the_control_cannot_read_is_refused():
 @pytest.mark.parametrize("n", [3, 5, 7])
 def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
     s = rough_grid(n, seed=n, zmax=10)
-    sizes = [macro_program(s, machine(dialect=dialect), RasterSpec("x", step, step / 2), FLAT).size
+    # the finest raster is 72 million points, past the default --max-points: lifted, as the size is the question
+    sizes = [macro_program(s, machine(dialect=dialect), RasterSpec("x", step, step / 2), FLAT, max_points=None).size
              for step in (5.0, 0.5, 0.01)]
     assert max(sizes) < 4096
     assert max(sizes) - min(sizes) <= 40  # only the loop counts and steps change
@@ -494,9 +495,87 @@ def test_ball_end_slopes_on_the_control_are_the_exact_derivatives():
 
 def test_ball_end_gouge_is_refused_with_a_suggestion():
     s = surface("paper-example-4")
-    expected = r"concave with a radius of curvature of 2.61 mm.*at most 5.2\d mm.*toolpath"
+    expected = r"concave with a radius of curvature of 2.5971 mm.*at most 5.194 mm.*toolpath"
     with pytest.raises(ToolpathError, match=expected):
         macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0), RasterSpec("x", 0.5, 0.2), Tool("ball", 6.0))
+
+
+def _tightest_radius_ex4() -> tuple[float, float, float]:
+    """Brute force on the interpolating polynomial by its Lagrange basis (test_rough's, not lagsym's evaluator):
+    the smallest concave radius of curvature of Example 4 at scale 20 (mm) and where, from a 401 x 401 lattice
+    refined by zooming around its 40 best points, the derivatives by central differences."""
+    from test_rough import EX4, exact_heights
+
+    def kmax(x, y, h=1e-3):
+        f = lambda a, b: exact_heights(EX4, a, b)  # noqa: E731
+        z0 = f(x, y)
+        fx, fy = (f(x + h, y) - f(x - h, y)) / (2 * h), (f(x, y + h) - f(x, y - h)) / (2 * h)
+        fxx, fyy = (f(x + h, y) - 2 * z0 + f(x - h, y)) / h ** 2, (f(x, y + h) - 2 * z0 + f(x, y - h)) / h ** 2
+        fxy = (f(x + h, y + h) - f(x + h, y - h) - f(x - h, y + h) + f(x - h, y - h)) / (4 * h * h)
+        g = 1 + fx ** 2 + fy ** 2
+        mean = ((1 + fx ** 2) * fyy - 2 * fx * fy * fxy + (1 + fy ** 2) * fxx) / (2 * g ** 1.5)
+        return mean + np.sqrt(np.maximum(mean ** 2 - (fxx * fyy - fxy ** 2) / g ** 2, 0))
+
+    xs = np.linspace(20, 100, 401)
+    gx, gy = np.meshgrid(xs, xs, indexing="ij")
+    k = kmax(gx, gy)
+    best = (0.0, 0.0, 0.0)
+    for i in np.argsort(k.ravel())[::-1][:40]:
+        x, y, step = gx.ravel()[i], gy.ravel()[i], 0.2
+        for _ in range(14):
+            g = np.linspace(-step, step, 9)
+            ax, ay = np.meshgrid(np.clip(x + g, 20, 100), np.clip(y + g, 20, 100))
+            kk = kmax(ax, ay)
+            j = int(np.argmax(kk))
+            x, y, step = ax.ravel()[j], ay.ravel()[j], step / 3
+        best = max(best, (float(kmax(np.array(x), np.array(y))), float(x), float(y)))
+    return 1.0 / best[0], best[1], best[2]
+
+
+def test_the_largest_ball_is_stated_from_the_safe_side_and_never_contradicts_the_refusal():
+    """Example 4's tightest hollow, 2.5971 mm by brute force at the box edge, lies between the 1001 x 1001
+    samples (2.61 mm there): the ball allowed is 2 x 2.5971 rounded down, a 5.2 mm ball is refused, and the
+    figures of the refusal are below the refused ones."""
+    rc, x, y = _tightest_radius_ex4()
+    assert 2.597 < rc < 2.5972 and x == 100.0 and abs(y - 20.19) < 0.01
+    s = surface("paper-example-4")
+    raster = RasterSpec("x", 0.5, 0.2)
+    for diameter, stock in ((5.2, 0.0), (5.0, 0.2), (6.0, 0.0)):
+        with pytest.raises(ToolpathError) as e:
+            macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0, safe_z_mm=90.0, stock_to_leave_mm=stock),
+                          raster, Tool("ball", diameter))
+        text = str(e.value)
+        shown = float(re.search(r"radius of curvature of ([\d.]+) mm", text).group(1))
+        offset = float(re.search(r"below the offset radius ([\d.]+) mm", text).group(1))
+        allowed = float(re.search(r"diameter at most ([\d.]+) mm", text).group(1))
+        assert shown <= rc and rc - shown < 1e-4, (shown, rc)
+        assert offset == diameter / 2 + stock and shown < offset
+        assert allowed <= 2 * (rc - stock) and 2 * (rc - stock) - allowed < 1e-3 and allowed < diameter, text
+    # the ball stated is accepted, one a thousandth larger is not
+    ok = np.floor(2 * rc * 1000) / 1000
+    macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0, safe_z_mm=90.0), raster, Tool("ball", ok))
+    with pytest.raises(ToolpathError, match="at most 5.194 mm"):
+        macro_program(s, machine(dialect="fanuc", mm_per_unit=20.0, safe_z_mm=90.0), raster, Tool("ball", ok + 0.001))
+
+
+def test_a_raster_the_control_would_run_for_days_is_refused_with_its_figures(run_cli):
+    """``--step 0.001 --stepover 0.001`` on Example 4 at scale 20: the box is 80 mm a side (the points file
+    spans 1 to 5 units), so 80,001 rows of 80,001 points, 6.4 billion points and 6,400 km... of path at
+    600 mm/min: refused before anything is planned, with the figures and the option that lifts the limit."""
+    pts = np.array(json.loads((EXAMPLES / "paper-example-4.json").read_text())["points"], dtype=float)
+    side = float(np.ptp(pts[:, 0])) * 20
+    n = round(side / 0.001) + 1
+    length_m = (n * side + side) / 1000
+    hours = length_m * 1000 / 600 / 60
+    status, out, err = run_cli("macro", EXAMPLES / "paper-example-4.json", "--scale", "20", "--tool-diameter", "5",
+                               "--safe-z", "90", "--step", "0.001", "--stepover", "0.001")
+    assert status == 2 and not out and err.count("\n") == 1, err
+    assert f"{n:,} rows of {n:,} points, {n * n:,} points, more than the limit of 20,000,000" in err, err
+    assert f"{length_m:,.2f} m of path, about {hours:,.1f} hours at the feed 600 mm/min" in err, err
+    assert "--max-points" in err
+    status, _, err = run_cli("macro", EXAMPLES / "paper-example-4.json", "--scale", "20", "--tool-diameter", "5",
+                             "--safe-z", "90", "--max-points", "1000")
+    assert status == 2 and "161 rows of 401 points, 64,561 points, more than the limit of 1,000" in err, err
 
 
 # ---------------------------------------------------------------- issue 13: programs a machinist can trust

@@ -141,6 +141,38 @@ def test_roughing_example_4_is_gouge_free_and_clears_the_block(rs274, program):
     assert excess.max() <= STEPDOWN + tol, excess.max()
 
 
+def test_raster_roughing_leaves_at_most_a_step_down_at_the_box_edges_too(rs274, program):
+    """rs274's moves swept through a height map of the block (0.25 mm cells): nowhere, the start edge x = 20
+    included, is more than one step-down left above what the flat end reaches from the rows (the lowest
+    lattice drop-cutter height over the row centres covering a cell, tool centres beside the box included),
+    and nowhere less than the stock.  A tool beside the box rests on what is under it, not on the height at the
+    box edge: that rule left 3.84 mm at X20 Y100 above a surface rising 9 mm over the first 5 mm."""
+    text, _ = program
+    cell = 0.25
+    gx = gy = np.arange(10.0, 110.0 + cell / 2, cell)
+    fx, fy = np.meshgrid(gx, gy, indexing="ij")
+    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    f = np.where(inbox, exact_heights(EX4, np.clip(fx, 20, 100), np.clip(fy, 20, 100)), -np.inf)
+    h = np.where(inbox, float(f.max()) + 2, -np.inf)
+    pos = None
+    for _, x, y, z in moves(rs274, text):
+        if pos is not None:
+            sweep_flat(h, gx, gy, pos, (x, y, z), R)
+        pos = (x, y, z)
+    k = int(round(R / cell))
+    off = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1) if (i * i + j * j) * cell * cell <= R * R]
+    pad = np.pad(f, k, constant_values=-np.inf)
+    cl = np.max([pad[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    on_row = np.isclose((gy - 20) % STEPOVER, 0) & (gy >= 20) & (gy <= 100)
+    padc = np.pad(np.where(on_row[None, :], cl, np.inf), k, constant_values=np.inf)
+    reach = np.min([padc[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    left = h[inbox] - f[inbox]
+    excess = h[inbox] - (np.maximum(reach[inbox], f[inbox]) + STOCK)
+    worst = int(np.argmax(excess))
+    assert excess[worst] <= STEPDOWN, (excess[worst], fx[inbox][worst], fy[inbox][worst])
+    assert left.min() >= STOCK - 0.002
+
+
 def test_every_roughing_position_is_above_the_flat_drop_cutter_height(rs274, program):
     """Each feed end point over the box is at least stock above the dense lattice drop-cutter height (a lower bound)."""
     text, _ = program

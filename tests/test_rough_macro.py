@@ -199,7 +199,8 @@ def test_a_job_with_a_roughing_macro_runs_in_rs274(rs274, tmp_path, run_cli):
     # verify --job runs the macro through the simulator: every move of both tools, no gouge, no crash
     status, report, err = run_cli("verify", "--job", job, out, "--cell", "2")
     assert status == 0, report + err
-    assert f"T1 FLAT END D10 MM from line 9: {len(rough.points_mm) + 3} moves" in report
+    # the climb to the safe Z right after the tool change is a move of its own, before X and Y
+    assert f"T1 FLAT END D10 MM from line 9: {len(rough.points_mm) + 4} moves" in report
 
 
 @pytest.mark.parametrize("args, words", [
@@ -258,3 +259,47 @@ def test_a_safe_z_below_the_highest_tip_the_control_moves_to_is_refused():
         with pytest.raises(ToolpathError, match=r"safe Z .* less than the feed height 2 mm above the highest tip "
                                                 r"of the roughing macro .*: raise --safe-z to at least"):
             rough_macro(surface, tool, stock, spec, low, precision=8)
+
+
+def test_rough_macro_is_refused_where_the_control_cannot_hold_its_variables(run_cli, tmp_path):
+    """The variables are counted in the program text itself; a small Fanuc (#100-#149, #500-#531) cannot hold
+    them, which the simulator confirms with alarm 115, so --variables small is refused naming them."""
+    import re
+
+    from lagsym.simulate import ControlAlarm
+
+    args = ("rough", EX4, "--scale", "20", "--stock-above", "2", "--safe-z", "90", "--dialect", "fanuc", "--macro",
+            "--stepdown", "20", "--stepover", "8", "--step", "2", "-o")
+    full = tmp_path / "full.nc"
+    status, _, err = run_cli(*args, full)
+    assert status == 0, err
+    text = full.read_text()
+    used = sorted({int(n) for n in re.findall(r"#(\d+)", text)})
+    small = ((100, 149), (500, 531))
+    outside = [n for n in used if not any(lo <= n <= hi for lo, hi in small)]
+    assert outside and used[0] == 100 and used[-1] == 627 and len(used) == 176, (used[:3], used[-3:], len(used))
+    with pytest.raises(ControlAlarm, match="alarm 115"):
+        simulate(text, "fanuc", 8, variable_ranges=small)
+    status, out, err = run_cli(*args, tmp_path / "small.nc", "--variables", "small")
+    assert status == 2 and not out and err.count("\n") == 1, err
+    loops = sorted(n for n in used if n < 500)
+    assert f"needs #{loops[0]}-#{loops[-1]} and #500-#{used[-1]} ({len(used)} variables)" in err, err
+    assert "#100-#149, #500-#531" in err and not (tmp_path / "small.nc").exists()
+    # the same check for --variables full passes, and without --macro the option is refused rather than ignored
+    status, _, err = run_cli(*args, tmp_path / "again.nc", "--variables", "full")
+    assert status == 0 and (tmp_path / "again.nc").read_text() == text, err
+    status, _, err = run_cli(*args[:10], "--variables", "small")
+    assert status == 2 and "--variables small applies to a macro only" in err
+
+
+def test_a_job_file_variables_profile_is_checked_for_its_roughing_macro(run_cli, tmp_path):
+    from test_job import job_text
+
+    job = tmp_path / "small.toml"
+    job.write_text(job_text(**{"stepover = 5": "stepover = 8\nstep = 2\nmacro = true", "stepdown = 2": "stepdown = 20",
+                               'dialect = "linuxcnc"': 'dialect = "fanuc"\nvariables = "small"'}))
+    status, _, err = run_cli("job", job, "-o", tmp_path / "job.nc")
+    assert status == 2 and "#500-#627 is outside the small variable profile of a fanuc control" in err, err
+    job.write_text(job_text(**{'dialect = "linuxcnc"': 'dialect = "fanuc"\nvariables = "small"'}))
+    status, _, err = run_cli("job", job, "-o", tmp_path / "job.nc")
+    assert status == 2 and "variables = 'small' applies to a roughing macro only" in err, err

@@ -374,3 +374,47 @@ def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
 
     macros = " ".join((ROOT / "docs" / "macros.md").read_text().split())
     assert "ball macro at 8 digits (2,525,622 blocks executed, 64,566 moves)" in macros
+
+
+@pytest.mark.parametrize("text, words", [
+    ("G1 X1. Y1. Z1. F100.\nM98 P1000\nM30\n", "line 2: 'M98 P1000'"),
+    ("G1 X1. Y1. Z1. F100.\nG65 P9010 A1.\nM30\n", "G65 calls a macro"),
+    ("#1=98.\nG1 X1. Z0. F1.\nM#1\nM30\n", "M98 calls a subprogram"),  # a computed M code, refused as it runs
+    ("G1 X1. Z0. F1.\nG[60+5] P1.\nM30\n", "G65 calls a macro"),
+    ("G1 X1. Y1. Z1. F100.\nM99\n", "M99 returns from a subprogram"),
+    ("G1 X1. F100.\nG28 X0. Y0.\nM30\n", "G28 moves through the reference point"),
+    ("G1 X1. F100.\nG81 X1. Y1. Z-1. R1.\nM30\n", "G81 is a canned cycle"),
+    ("G1 X1. A30. F100.\nM30\n", "address A"),
+    ("G1 X1. F100.\nG04 X1.\nM30\n", "G4 dwells"),
+])
+def test_calls_returns_cycles_and_other_axes_are_refused_not_skipped(text, words):
+    with pytest.raises(ControlAlarm, match="alarm not-run") as e:
+        simulate(text, "fanuc", 8)
+    assert words in str(e.value) and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("1 L X+1 Y+2 Z+3 R0 FMAX M3\n2 L IX+5 R0 F100\n", "'IX+5' in a straight move"),
+    ("1 L X+1 Y+2 Z+3 RL F100\n", "'RL' in a straight move"),
+    ("1 CYCL DEF 7.0 DATUM SHIFT\n", "cycles"),
+    ("1 CYCL CALL\n", "cycles"),
+    ("1 L X+1 Y+2 Z+3 R0 FMAX M99\n", "M99"),
+    ("1 L Z+5 R0 FMAX M91\n", "M91"),
+])
+def test_heidenhain_cycles_increments_and_machine_positions_are_refused(text, words):
+    with pytest.raises(ControlAlarm, match="alarm not-run") as e:
+        simulate("0 BEGIN PGM 1 MM\n" + text + "9 END PGM 1 MM\n", "heidenhain", 8)
+    assert words in str(e.value)
+
+
+def test_a_called_program_moves_the_tool_in_rs274_where_the_simulator_refuses(rs274, tmp_path):
+    """The independent side: LinuxCNC runs the call and moves to X5 Y5 Z0, a move a skipping reader never saw."""
+    from gcheck import interpret
+
+    text = "G21 G90\nG1 X1. Y1. Z1. F100.\nM98 P2000\nM30\nO2000\nG1 X5. Y5. Z0.\nM99\n%\n"
+    feeds, _ = interpret(rs274, text)
+    assert feeds.tolist() == [[1.0, 1.0, 1.0], [5.0, 5.0, 0.0]]
+    with pytest.raises(ControlAlarm, match="line 3"):
+        simulate(text, "linuxcnc", 15)
+    with pytest.raises(ControlAlarm, match="line 3"):
+        simulate(text, "fanuc", 8)

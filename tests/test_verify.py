@@ -291,3 +291,21 @@ def test_verify_simulates_a_program_with_arcs(run_cli, tmp_path):
     assert arcs.gouge_mm <= 0.0005 and not arcs.gouges
     both = np.isfinite(arcs.cut_mm) & np.isfinite(lines.cut_mm)
     assert np.abs(arcs.cut_mm - lines.cut_mm)[both].max() <= 0.005 + 0.001
+
+
+def test_a_finishing_program_with_a_subprogram_call_is_refused_not_verified(run_cli, tmp_path, ex2_program, rs274):
+    """``M98 P2000`` inserted into a good program: the call moves the tool (rs274 runs the subprogram after the
+    end), so verify refuses it in one line naming the block instead of passing the program without it."""
+    from gcheck import interpret
+
+    _, _, _, text = ex2_program
+    lines = text.splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("G01")) + 5
+    called = lines[:k] + ["M98 P2000"] + lines[k:] + ["O2000", "G01 Z-20. F100.", "M99"]
+    doctored = tmp_path / "called.ngc"
+    doctored.write_text("\n".join(called) + "\n")
+    feeds, _ = interpret(rs274, doctored.read_text())
+    assert feeds[:, 2].min() == -20.0  # the subprogram's move, deep in the part
+    status, out, err = run_cli("verify", EX2, doctored, "--scale", "10", "--tool-diameter", "6", "--cell", "0.3")
+    assert status == 2 and not out, out
+    assert err.count("\n") == 1 and f"called.ngc, line {k + 1}: M98 calls a subprogram" in err, err

@@ -8,6 +8,7 @@ from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
+from ..macro.program import MAX_MACRO_POINTS
 from ._common import (dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
@@ -72,6 +73,9 @@ def add_arguments(p) -> None:
     add_program_arguments(p.add_argument_group("machine and program"))
     p.add_argument("--stats", action="store_true",
                    help="compare the program's size with the equivalent point list, and their 9600-baud transfer times")
+    p.add_argument("--max-points", type=count(1, 10**13), default=MAX_MACRO_POINTS, metavar="N",
+                   help=f"refuse a raster of more than N points, with its size, path length and cutting time "
+                        f"(default {MAX_MACRO_POINTS:.0e})")
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
 
 
@@ -86,7 +90,8 @@ def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.file))
     settings, raster, tool = settings_from(args, surface.grid)
     program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,
-                            variable_base=args.variable_base, form=args.form, variables=args.variables)
+                            variable_base=args.variable_base, form=args.form, variables=args.variables,
+                            max_points=args.max_points)
     emit(program.text, args.output, out)
     if args.stats:
         counted = program.loops.raster

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..controls import control, names
+from ..controls import VARIABLE_PROFILES, control, names
 from pathlib import Path
 
 from ..io import write_text
@@ -48,6 +48,10 @@ def add_arguments(p) -> None:
     p.add_argument("--precision", type=int, choices=(8, 15), metavar="N",
                    help="with --macro: significant digits of the control's arithmetic, 8 or 15 "
                         "(default 8 for fanuc, 15 for linuxcnc)")
+    p.add_argument("--variables", choices=VARIABLE_PROFILES, metavar="PROFILE",
+                   help="with --macro: the control's variable ranges, full (default; Fanuc #100-#199, #500-#999) "
+                        "or small (#100-#149, #500-#531); a macro whose loops or clearance tables do not fit is "
+                        "refused with the variables it needs")
     s = p.add_argument_group("stock")
     top = s.add_mutually_exclusive_group(required=True)
     top.add_argument("--stock-top", type=HEIGHT_MM, metavar="MM", help="machine Z of the block's top")
@@ -115,10 +119,13 @@ def job_data(args) -> dict:
         op["macro"] = True
     if args.precision is not None:
         op["precision"] = args.precision
-    return {"points": str(Path(args.file).resolve()), "dialect": args.dialect, "units": args.units,
+    job = {"points": str(Path(args.file).resolve()), "dialect": args.dialect, "units": args.units,
             "scale": args.scale, "origin": list(origin(args.origin)), "safe_z": args.safe_z, "rapid": args.rapid,
             "program_number": args.program, "title": Path(args.file).name, "stock": stock,
             "tools": {"cutter": tool}, "operations": [op]}
+    if args.variables is not None:
+        job["variables"] = args.variables
+    return job
 
 
 def origin_list(text: str):
@@ -136,6 +143,8 @@ def _refuse(args) -> None:
     """Options that do not apply with or without --macro, refused rather than ignored."""
     from ..errors import InputError
 
+    if args.variables is not None and not args.macro:
+        raise InputError(f"--variables {args.variables} applies to a macro only: add --macro or leave it out")
     if args.precision is not None and not args.macro:
         raise InputError(f"--precision {args.precision} applies to a macro only: add --macro or leave it out")
     if args.macro and control(args.dialect).macro is None:

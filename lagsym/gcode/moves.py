@@ -8,11 +8,17 @@ and arcs: ``G02``/``G03`` with ``I J K`` centre offsets in the ``G17``,
 ``G18`` or ``G19`` plane, each read as fine straight moves
 (:func:`lagsym.gcode.arcs.arc_points`, within a hundredth of a micrometre of
 the arc), all with the arc's line.
-Set-up words that do not move the tool (``G40 G43 G49 G54..G59 G80 G94``,
-``S T M H D``) are passed over.  Anything that would move the tool in another
-way (``R``-format arcs, absolute arc centres ``G90.1``, canned cycles,
-``G28``, ``G92``) is refused with the line it is on, so a reader of the
-result never silently sees a different path.
+Set-up words that do not move the tool (the ``G`` codes of
+:data:`~lagsym.gcode.program.PASSED_G`: ``G40 G43 G49 G54..G59 G80 G94`` and
+the like; ``S T H D``; the ``M`` codes of
+:data:`~lagsym.gcode.program.PLAIN_M`: stops, spindle, tool change, coolant,
+end) are passed over.  Anything that would move the tool in another way
+(``R``-format arcs, absolute arc centres ``G90.1``, canned cycles, ``G28``,
+``G92``, subprogram and macro calls ``M98``/``M97``/``G65``, returns
+``M99``, any other ``M`` code, which a machine builder may map to a program;
+:func:`~lagsym.gcode.program.unrun_code`), and a move after the program's
+end (``M02``/``M30``), which a control never makes, is refused with the line
+it is on, so a reader of the result never silently sees a different path.
 
 The tool starts at ``(0, 0, 0)``, as in LinuxCNC's interpreter; a number
 without a decimal point is read as a whole number of units (LinuxCNC's
@@ -29,13 +35,12 @@ from .._arrays import freeze_fields
 from ..errors import ProgramError
 from ..machine import mm_per_program_unit
 from .arcs import arc_points
-from .program import program_blocks
+from .program import END_M, program_blocks, unrun_code
 from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
 
-_IGNORED_G = {40, 43, 49, 54, 55, 56, 57, 58, 59, 61, 64, 80, 91.1, 94, 97}
-_IGNORED_LETTERS = set("NSTMHDP")
+_IGNORED_LETTERS = set("NSTHDP")
 
 
 @dataclass(frozen=True)
@@ -95,14 +100,22 @@ class _Modal:
         self.motion = None
         self.plane = 17
         self.feed = float("nan")
+        self.ended = 0  # the line of the M02 or M30 that ended the program
 
-    def read(self, words, where: str) -> dict[str, float]:
+    def read(self, words, where: str, line: int) -> dict[str, float]:
         """Apply a block's modal words; its X, Y, Z targets and I, J, K arc offsets (program units)."""
         target = {}
         for letter, value in words:
             v = float(value)
-            if letter == "G":
-                self._g(round(v, 1), value, where)
+            if letter in "GM":
+                why = unrun_code(letter, v)
+                if why is not None:
+                    raise ProgramError(f"{where}: {letter}{value} {why}, which this reader does not run; "
+                                       "only point-list programs (G00/G01, G02/G03 with I J K) can be read")
+                if letter == "G":
+                    self._g(round(v, 1))
+                elif v in END_M and not self.ended:
+                    self.ended = line
             elif letter in "XYZIJK":
                 if letter in target:
                     raise ProgramError(f"{where}: {letter} given twice")
@@ -116,7 +129,7 @@ class _Modal:
                 raise ProgramError(f"{where}: word {letter}{value} is not part of a point-list program")
         return target
 
-    def _g(self, g: float, value: str, where: str) -> None:
+    def _g(self, g: float) -> None:
         if g in (0, 1, 2, 3):
             self.motion = int(g)
         elif g in (17, 18, 19):
@@ -125,9 +138,6 @@ class _Modal:
             self.factor = mm_per_program_unit("inch" if g == 20 else "mm")
         elif g in (90, 91):
             self.absolute = g == 90
-        elif g not in _IGNORED_G:
-            raise ProgramError(f"{where}: G{value} is not a straight or circular move; "
-                               "only point-list programs (G00/G01, G02/G03 with I J K) can be read")
 
 
 def parse_moves(text: str, source: str = "<program>") -> Moves:
@@ -153,6 +163,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     z_seen = False
     for no, raw, block in program_blocks(text):
         where = f"{source}, line {no}"
+        ended = modal.ended  # a move on the M30 block itself is made
         plain = plain_move(block)
         if plain is not None:  # most blocks of a point list: no need to go word by word
             if plain[0] is not None:
@@ -165,9 +176,12 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
                 words = numeric_words(block)
             except WordError as e:
                 raise ProgramError(f"{where}: {e} in {raw.strip()!r}") from None
-            target = modal.read(words, where)
+            target = modal.read(words, where, no)
         if not target:
             continue
+        if ended:
+            raise ProgramError(f"{where}: a move after the end of the program (M02 or M30 on line {ended}), "
+                               "which a control never makes")
         if modal.motion is None:
             raise ProgramError(f"{where}: a coordinate before any G00, G01, G02 or G03")
         offset = [target.pop(letter, 0.0) * modal.factor for letter in "IJK"]

@@ -11,7 +11,11 @@ alike:
   subprogram calls and returns), with comments taken out first, so a ``#``
   in ``(TOOL #2)`` is text and ``M98P100`` a call;
 * :func:`first_line_with`: the first block that gives a word, whatever its
-  value (a number, a variable or an expression).
+  value (a number, a variable or an expression);
+* :func:`unrun_code`: why a ``G`` or ``M`` word moves the tool in a way a
+  reader of straight moves does not follow (a subprogram call, a return, a
+  canned cycle, a reference return, a shift of the coordinates), so every
+  reader refuses the same words.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import re
 from ..values import choice
 from .words import WordError, numeric_words, strip_comments, words
 
-__all__ = ["MACRO_USES", "program_blocks", "program_units", "macro_uses", "is_macro", "first_line_with"]
+__all__ = ["MACRO_USES", "PASSED_G", "PLAIN_M", "END_M", "unrun_code", "program_blocks", "program_units", "macro_uses", "is_macro", "first_line_with"]
 
 MACRO_USES = ("variable", "expression", "loop", "jump", "condition", "call", "return")
 """What :func:`macro_uses` names: ``#`` variables; ``[..]`` expressions; loops (``WHILE .. DO``, ``END``,
@@ -40,6 +44,60 @@ _KEYWORD = re.compile(r"(?<![A-Z])(?:(WHILE|GOTO|IF|THEN)(?![A-Z])|(DO|END)\s*\d
 _NAMED = re.compile(r"#<[^>]*>")
 _N_NUMBER = re.compile(r"N\s*\d+\s*")
 _CALLS = {("G", 65.0): "call", ("G", 66.0): "call", ("G", 66.1): "call", ("M", 98.0): "call", ("M", 99.0): "return"}
+PASSED_G = frozenset({17.0, 18.0, 19.0, 20.0, 21.0, 40.0, 43.0, 49.0, 54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1,
+                      59.2, 59.3, 61.0, 64.0, 80.0, 90.0, 91.0, 91.1, 94.0, 97.0})
+"""``G`` codes that set a mode without moving the tool or changing where a later move goes: plane, units,
+cutter-compensation and canned-cycle cancel, tool length offset (the program gives tool-tip positions),
+work offsets, path control, absolute and incremental, feed per minute, spindle speed mode.  With ``G00`` to
+``G03`` they are all a reader of straight moves needs; any other ``G`` code is refused (:func:`unrun_code`)."""
+PLAIN_M = frozenset({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30})
+"""``M`` codes that move no axis: stops, program end, spindle, tool change (the program's next moves say where
+the tool goes), coolant.  Any other ``M`` code may call a subprogram or a macro (``M98``, ``M97``, ``M198``,
+or one a machine builder maps to a program) and is refused (:func:`unrun_code`)."""
+END_M = frozenset({2, 30})
+"""The ``M`` codes that end a program: a control runs nothing after them."""
+_UNRUN = {("M", 98.0): "calls a subprogram", ("M", 97.0): "calls a subprogram", ("M", 198.0): "calls a subprogram",
+          ("M", 99.0): "returns from a subprogram (in a main program: jumps back)",
+          ("G", 65.0): "calls a macro", ("G", 66.0): "calls a macro at every move", ("G", 66.1): "calls a macro",
+          ("G", 90.1): "gives arc centres as absolute positions", ("G", 4.0): "dwells (its X or P is a time, not a position)", ("G", 28.0): "moves through the reference point",
+          ("G", 30.0): "moves through a reference point", ("G", 53.0): "moves in machine coordinates",
+          ("G", 10.0): "sets offsets", ("G", 52.0): "shifts the coordinates", ("G", 92.0): "shifts the coordinates",
+          ("G", 68.0): "rotates the coordinates", ("G", 51.0): "scales the coordinates",
+          ("G", 51.1): "mirrors the coordinates", ("G", 16.0): "reads polar coordinates",
+          ("G", 41.0): "offsets the path (cutter compensation)", ("G", 42.0): "offsets the path (cutter compensation)"}
+_CYCLES = frozenset({73.0, 74.0, 76.0, *(float(g) for g in range(81, 90))})
+
+
+def unrun_code(letter: str, value: float) -> str | None:
+    """What a ``G`` or ``M`` word does that a reader of straight moves does not follow; None when it may pass.
+
+    ``G00`` to ``G03`` (read by the reader itself), :data:`PASSED_G` and
+    :data:`PLAIN_M` pass; every other ``G`` or ``M`` code is named here, with
+    what it does where it is a known one, so the point-list reader and the
+    simulator refuse the same words rather than skip a call, a cycle or a
+    shift and report a path the machine would not take.
+
+    Examples
+    --------
+    >>> unrun_code("M", 98), unrun_code("G", 81), unrun_code("M", 3), unrun_code("G", 43)
+    ('calls a subprogram', 'is a canned cycle', None, None)
+    >>> unrun_code("M", 47)
+    'may call a subprogram or move the tool (a code of the machine builder)'
+    """
+    v = round(float(value), 1)
+    if letter == "G":
+        if v in (0.0, 1.0, 2.0, 3.0) or v in PASSED_G:
+            return None
+        if v in _CYCLES:
+            return "is a canned cycle"
+        return _UNRUN.get(("G", v), "moves the tool or changes where it goes in a way not read here")
+    if letter == "M":
+        if v in PLAIN_M:
+            return None
+        return _UNRUN.get(("M", v), "may call a subprogram or move the tool (a code of the machine builder)")
+    return None
+
+
 _EOL = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"  # where str.splitlines ends a line
 _LINE_END = re.compile(f"[{_EOL}]")
 _SPACE = f"[^\\S{_EOL}]*"  # space within a line, as numeric_words allows between a letter and its number

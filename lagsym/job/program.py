@@ -5,7 +5,9 @@ words left out), rapids as ``G00``.  The framing is the control's
 (:class:`~lagsym.controls.Framing`): a control with a tool changer changes
 tools with ``T M06`` and takes each tool's length with ``G43 H``; one without
 (Grbl) stops the program (``M00``) for the operator to change the tool and set
-its length.  The cycle-time estimate counts feed moves at their
+its length.  After every tool change the spindle starts, the length offset is
+taken with the move up to the safe height, and only then does the tool move
+sideways over the operation's first point.  The cycle-time estimate counts feed moves at their
 feeds and rapids at the job's rapid rate, along straight lines.
 """
 
@@ -110,10 +112,12 @@ def _operation(op, s: MachineSettings, spec, changed: bool) -> list[str]:
     coolant = COOLANTS[op.spec.coolant]
     if coolant:
         out.append(coolant)
+    # The tool's length and the safe height before any sideways move: a control whose M06 leaves the spindle
+    # low would otherwise cross the block with the new, perhaps longer, tool.
+    out.append(f"G00 G43 H{t.number} Z{num(spec.safe_z_mm)}" if c.length_offsets else f"G00 Z{num(spec.safe_z_mm)}")
     out.append(f"G00 X{num(p[0, 0])} Y{num(p[0, 1])}")
-    out.append(f"G43 H{t.number} Z{num(spec.safe_z_mm)}" if c.length_offsets else f"G00 Z{num(spec.safe_z_mm)}")
     if isinstance(op.path, RoughMacro):
-        out += rough_macro_blocks(op.path, s)
+        out += rough_macro_blocks(op.path, s, variables=spec.variables)
     else:
         out += _moves(op, s, (p[0, 0], p[0, 1], spec.safe_z_mm))
     out.append(f"G00 Z{num(spec.safe_z_mm)}")

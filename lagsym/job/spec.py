@@ -31,7 +31,7 @@ from pathlib import Path
 
 from ..errors import InputError, LagsymError
 from ..io.files import read_bytes
-from ..controls import control, names
+from ..controls import VARIABLE_PROFILES, control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
 from ..values import in_range
@@ -46,7 +46,7 @@ JOB_DIALECTS = names(point_lists=True)
 
 _TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": list, "work_offset": str,
         "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
-        "operations": list}
+        "operations": list, "variables": str}
 _STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
 _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float, "flute_length": float,
          "reach": float}
@@ -99,6 +99,7 @@ class JobSpec:
     stock: dict
     tools: dict
     operations: tuple
+    variables: str = "full"
 
 
 def read_job(path) -> JobSpec:
@@ -192,6 +193,10 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         if op.options.get("macro") and control(dialect).macro is None:
             raise InputError(f"{source}: operations[{i}].macro: a roughing macro is written for "
                              f"{' or '.join(MACRO_DIALECTS)}, not {dialect!r}")
+    variables = _choice(data.get("variables", "full"), VARIABLE_PROFILES, "variables", source)
+    if "variables" in data and not any(op.options.get("macro") for op in ops):
+        raise InputError(f"{source}: variables = {variables!r} applies to a roughing macro only "
+                         "(an operation with macro = true)")
     program_number = data.get("program_number", 1000)
     low, high = control(dialect).program_numbers
     if not low <= program_number <= high:
@@ -208,7 +213,7 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         safe_z_mm=_length(data.get("safe_z", 50.0), "safe_z", source),
         rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
         title=data.get("title", Path(data["points"]).stem),
-        stock=_stock(data["stock"], source), tools=tools, operations=ops)
+        stock=_stock(data["stock"], source), tools=tools, operations=ops, variables=variables)
 
 
 def _stock(table: dict, source: str) -> dict:

@@ -34,7 +34,7 @@ from .raster import MacroRaster, sample_positions
 from .rounding import tip_lift, tips_on_grid
 
 __all__ = ["is_ball", "refuse_flat_end", "ball_offsets", "contact_form", "offset_points", "offset_statements", "TIP_OUTPUTS",
-           "check_gouge", "check_gouge_over", "checked_tip_lift", "ball_tips", "tip_points", "derivatives"]
+           "check_gouge", "check_gouge_over", "tightest_concave", "concave_message", "checked_tip_lift", "ball_tips", "tip_points", "derivatives"]
 
 TIP_OUTPUTS = ("pt", "rt", "zt")  # the variables the tool tip (P', R', Z') is computed into
 
@@ -105,42 +105,115 @@ def offset_statements(radius: float, offset: float) -> tuple:
     )
 
 
-def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", unit: float = 1.0):
-    """Refuse a normal offset where the surface is concave tighter than the ball (radius in program units).
-
-    The larger principal curvature of the graph ``Z(P, R)`` (positive where the
-    surface is concave, seen from the tool) is checked at every point (p, r).
-    Returns it, and ``Zp**2 + Zr**2`` there.
-    """
+def _curvature(form: RowForm, p, r):
+    """The larger principal curvature of ``Z(P, R)`` (positive where concave seen from the tool), and ``|grad|**2``."""
     f = derivatives(form, p, r)
     fx, fy, fxx, fxy, fyy = f["zp"], f["zr"], f["zpp"], f["zpr"], f["zrr"]
     g = 1.0 + fx**2 + fy**2
     mean = ((1 + fx**2) * fyy - 2 * fx * fy * fxy + (1 + fy**2) * fxx) / (2 * g**1.5)
     gauss = (fxx * fyy - fxy**2) / g**2
-    kmax = mean + np.sqrt(np.maximum(mean**2 - gauss, 0.0))
-    k = int(np.argmax(kmax))
-    if kmax[k] * radius > 1.0:
-        rc = 1.0 / kmax[k] / unit
-        pp, rr = (float(np.asarray(p).ravel()[k]) / unit, float(np.asarray(r).ravel()[k]) / unit)
-        raise ToolpathError(
-            f"{source}: the surface is concave with a radius of curvature of {rc:.3g} mm near "
-            f"({pp:.3f}, {rr:.3f}) mm, below the offset radius {radius / unit:g} mm (ball radius plus stock): "
-            f"an offset along the normal would gouge there; use a ball of diameter at most {2 * rc:.3g} mm, "
-            f"or the point-list toolpath (lagsym toolpath, drop-cutter)")
-    return kmax, g - 1.0
+    return mean + np.sqrt(np.maximum(mean**2 - gauss, 0.0)), g - 1.0
 
 
-def check_gouge_over(form: RowForm, raster: MacroRaster, offset: float, source: str, unit: float):
-    """:func:`check_gouge` over the raster: every position, or 1001 x 1001 of them evenly spread."""
+_CANDIDATES = 16  # the highest samples refined: the tightest hollow may lie between samples near any of them
+_ROUNDS = 16  # each round a 9 x 9 lattice a third the size of the last: the maximum to 1e-7 of a sample spacing
+
+
+def tightest_concave(form: RowForm, p, r) -> tuple[float, float, float]:
+    """The largest principal curvature over the box the positions (p, r) span, and where: ``(k, p, r)``.
+
+    The samples are a lattice; the tightest hollow usually lies between
+    them, so the largest curvature is refined around the highest samples by
+    zooming lattices (clamped to the box) until it is known to about 1e-7 of
+    a sample spacing.  The result is at least the samples' largest, so a
+    ball it allows is never larger than the surface allows at the samples.
+    """
+    p, r = np.asarray(p, float).ravel(), np.asarray(r, float).ravel()
+    k, _ = _curvature(form, p, r)
+    lo, hi = (float(p.min()), float(r.min())), (float(p.max()), float(r.max()))
+    side = max(int(np.sqrt(p.size)) - 1, 1)
+    step = 2.0 * max(hi[0] - lo[0], hi[1] - lo[1]) / side
+    best = (float(k.max()), float(p[k.argmax()]), float(r[k.argmax()]))
+    for i in np.argsort(k)[::-1][:_CANDIDATES]:
+        cp, cr, h = float(p[i]), float(r[i]), step
+        for _ in range(_ROUNDS):
+            g = np.linspace(-h, h, 9)
+            gp, gr = np.meshgrid(np.clip(cp + g, lo[0], hi[0]), np.clip(cr + g, lo[1], hi[1]))
+            kk, _ = _curvature(form, gp.ravel(), gr.ravel())
+            j = int(np.argmax(kk))
+            cp, cr, h = float(gp.ravel()[j]), float(gr.ravel()[j]), h / 3.0
+            if kk[j] > best[0]:
+                best = (float(kk[j]), cp, cr)
+    return best
+
+
+def _down(v: float, decimals: int) -> float:
+    """``v`` rounded down to ``decimals``: a limit stated from the safe side."""
+    return float(np.floor(v * 10.0**decimals + 1e-9) / 10.0**decimals)
+
+
+def concave_message(rc: float, offset: float, stock: float, at: tuple[float, float], source: str) -> str:
+    """The refusal of a ball whose offset ``offset`` (mm, radius plus ``stock``) exceeds the radius ``rc`` (mm).
+
+    Every figure is rounded down (the radius of curvature, the largest ball
+    allowed, ``2 (rc - stock)``), with as many decimals as it takes for none
+    to read as the refused value: never "2.6 below 2.6".
+
+    Examples
+    --------
+    >>> concave_message(2.5971099, 2.6, 0.0, (100.0, 20.19), "ex4.json")  # doctest: +NORMALIZE_WHITESPACE
+    'ex4.json: the surface is concave with a radius of curvature of 2.5971 mm near (100.000, 20.190) mm, below the
+    offset radius 2.6 mm (ball radius plus stock): an offset along the normal would gouge there; use a ball of
+    diameter at most 5.194 mm, or the point-list toolpath (lagsym toolpath, drop-cutter)'
+    >>> m = concave_message(2.599999, 2.6, 0.0, (0.0, 0.0), "s")  # not "2.6 mm, below the offset radius 2.6 mm"
+    >>> "curvature of 2.5999 mm" in m and "at most 5.199 mm" in m
+    True
+    """
+    refused = 2.0 * (offset - stock)
+    for d in range(4, 10):
+        shown, ball = _down(rc, d), _down(2.0 * (rc - stock), d - 1)
+        if shown < round(offset, d) and ball < round(refused, d):
+            break
+    ball_text = (f"use a ball of diameter at most {ball:.{d - 1}f} mm, or" if rc > stock
+                 else f"no ball fits with stock {stock:g} mm; use")
+    return (f"{source}: the surface is concave with a radius of curvature of {shown:.{d}f} mm near "
+            f"({at[0]:.3f}, {at[1]:.3f}) mm, below the offset radius {offset:g} mm (ball radius plus stock): "
+            f"an offset along the normal would gouge there; {ball_text} the point-list toolpath "
+            "(lagsym toolpath, drop-cutter)")
+
+
+def check_gouge(form: RowForm, p, r, radius: float, source: str = "<surface>", unit: float = 1.0, *,
+                stock: float = 0.0):
+    """Refuse a normal offset where the surface is concave tighter than the ball (radius in program units).
+
+    The larger principal curvature of the graph ``Z(P, R)`` (positive where the
+    surface is concave, seen from the tool) is checked at every point (p, r)
+    and, between them, at its largest over the box they span
+    (:func:`tightest_concave`).  ``radius`` is the offset, the ball's radius
+    plus ``stock`` (both in program units); the refusal states the largest
+    ball that fits, ``2 (rc - stock)``, rounded down (:func:`concave_message`).
+    Returns the curvature at the points, and ``Zp**2 + Zr**2`` there.
+    """
+    kmax, slopes_sq = _curvature(form, np.asarray(p, float), np.asarray(r, float))
+    k, pp, rr = tightest_concave(form, p, r)
+    if k * radius > 1.0:
+        raise ToolpathError(concave_message(1.0 / k / unit, radius / unit, stock / unit, (pp / unit, rr / unit),
+                                            source))
+    return kmax, slopes_sq
+
+
+def check_gouge_over(form: RowForm, raster: MacroRaster, offset: float, source: str, unit: float, *,
+                     stock: float = 0.0):
+    """:func:`check_gouge` over the raster: every position, or 1001 x 1001 of them evenly spread, and between."""
     xs, ys = sample_positions(raster, 1001)
     p, r = (xs, ys) if raster.direction == "x" else (ys, xs)
-    return check_gouge(form, p, r, offset, source, unit)
+    return check_gouge(form, p, r, offset, source, unit, stock=stock)
 
 
 def checked_tip_lift(form: RowForm, raster: MacroRaster, offset: float, resolution: Fraction, source: str = "<surface>",
-                     unit: float = 1.0) -> Fraction:
+                     unit: float = 1.0, *, stock: float = 0.0) -> Fraction:
     """:func:`check_gouge_over`, then the lift of the rounded tips (:func:`lagsym.macro.rounding.tip_lift`)."""
-    kmax, slopes_sq = check_gouge_over(form, raster, offset, source, unit)
+    kmax, slopes_sq = check_gouge_over(form, raster, offset, source, unit, stock=stock)
     return tip_lift(kmax, slopes_sq, offset, resolution) if resolution else Fraction(0)
 
 

@@ -172,7 +172,7 @@ def _ball_loops(surface: LagrangeSurface, settings: MachineSettings, counted: Ma
     rf = contact_form(surface, settings, counted.direction, form)
     radius, offset = ball_offsets(settings, tool)
     unit = resolution(settings)
-    lift = checked_tip_lift(rf, counted, offset, unit, surface.grid.source, settings.unit_factor)
+    lift = checked_tip_lift(rf, counted, offset, unit, surface.grid.source, settings.unit_factor, stock=offset - radius)
     row_code = tuple(row_statements(rf, var("r"), slopes=True))
     point_code = tuple(point_statements(rf, var("p"), var("z"), slopes=True)) + offset_statements(radius, offset)
     raise_z = Fraction(0) if unit else slope_lift(surface, settings)

@@ -62,7 +62,7 @@ def planned_points(surface: LagrangeSurface, settings: MachineSettings, raster: 
         return pts
     radius, offset = ball_offsets(settings, tool)
     form = contact_form(surface, settings, counted.direction)
-    lift = checked_tip_lift(form, counted, offset, unit)
+    lift = checked_tip_lift(form, counted, offset, unit, stock=offset - radius)
     p, r = (x, y) if counted.direction == "x" else (y, x)
     pt, rt, zt = ball_tips(form, radius, offset, p, r, resolution=unit, lift=lift)
     zt = zt + float(0 if unit else slope_lift(surface, settings))

@@ -50,6 +50,7 @@ from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .loops import MacroLoops
 from .model import Assign, Choose, Clamp, Item, Loop, Move, SetItem, Var, add, const, decimal_context, mul, run, sqrt, sub, var
 from .raster import Axis, MacroRaster
+from .roughvars import check_rough_variables
 
 __all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]
 
@@ -382,16 +383,20 @@ def _path(rows, pts, b, levels, direction: str) -> np.ndarray:
     return np.vstack(out)
 
 
-def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None) -> list[str]:
+def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
+                       variables: str = "full") -> list[str]:
     """The blocks from over the first point at safe Z: down to it, then the loops (Fanuc or LinuxCNC).
 
     For a program that writes its own header, tool change and end (a job's);
     :func:`rough_macro_program` writes a whole one, in any macro dialect.
+    The variables must fit the control's ``variables`` profile
+    (:func:`check_rough_variables`).
     """
     from . import fanuc, linuxcnc
     from ..gcode.numbers import fixed
 
     c = control(settings.dialect, "dialect of a roughing macro in a job", JOB_MACROS)
+    check_rough_variables(rm, c.name, variables, variable_base)
     uf, dp = settings.unit_factor, settings.digits
     z0 = float(rm.loops.start[2])
     out = []
@@ -401,7 +406,7 @@ def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base:
     out.append(f"F{fixed(settings.feed_mm_min * uf, 1, trim=True)}")
     if c.macro.name == "linuxcnc":
         return out + linuxcnc.body_lines(rm.loops, rm.precision)
-    return out + fanuc.body_lines(rm.loops, rm.precision, variable_base, control=c)
+    return out + fanuc.body_lines(rm.loops, rm.precision, variable_base, variables, control=c)
 
 
 def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
@@ -410,5 +415,6 @@ def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base
     from .program import RENDERERS
 
     c = control(settings.dialect, "macro dialect", names(macros=True))
+    check_rough_variables(rm, c.name, variables, variable_base)
     return RENDERERS[c.macro.name](rm.loops, settings, precision=rm.precision, variable_base=variable_base,
                               variables=variables)

@@ -19,7 +19,7 @@ _ROUNDED = {"add", "sub", "mul", "div", "neg", "num", "var", "named", "cmp", "lo
 _OPS = {"add": "+", "sub": "-", "mul": "*"}
 _CMP = {"EQ": "==", "NE": "!=", "GT": ">", "GE": ">=", "LT": "<", "LE": "<="}
 _LOGIC = {"AND": "&", "OR": "|", "XOR": "^"}
-STOPS = (2, 30, 99)  # M02, M30, M99 end the program
+STOPS = (2, 30)  # M02, M30 end the program (M99 and the calls are refused: lagsym.gcode.program.unrun_code)
 
 
 class Segment:
@@ -213,12 +213,15 @@ class Segment:
         for letter, t, node in temps:
             if letter == "G":
                 g = self.gen.constant(node)
-                if g is None:
-                    self.emit(f"GMODAL(m, {t})")
+                if g is None or g not in (0, 1, 2, 3, 90, 91):
+                    self.emit(f"GMODAL(m, {t})")  # the modes, and the alarm of a code the simulator does not run
                 elif g in (0, 1, 2, 3):
                     self.emit(f"m.motion = 'G{int(g)}'")
                 elif g in (90, 91):
                     self.emit(f"m.absolute = {g == 90}")
+        ms = [t for letter, t, _ in temps if letter == "M"]
+        for t in ms:
+            self.emit(f"MCHECK({t})")  # before the move: a block that calls does not move on its own
         if "F" in last:
             self.emit(f"m.feed = {last['F']}")
         axes = [(k, last[a]) for k, a in enumerate("XYZ") if a in last]
@@ -228,7 +231,6 @@ class Segment:
             self.emit("else: " + "; ".join(f"POS[{k}] = POS[{k}] + {t}" for k, t in axes))
             self.emit(f"A_LINE({b.line}); A_RAPID(m.motion == 'G0'); A_X(float(POS[0])); A_Y(float(POS[1])); "
                       "A_Z(float(POS[2])); A_F(float(m.feed))")
-        ms = [t for letter, t, _ in temps if letter == "M"]
         if ms:
             self.write_back()
             self.emit(f"return None if ({' or '.join(f'{t} in STOPS' for t in ms)}) else {i + 1}")

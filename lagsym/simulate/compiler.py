@@ -27,6 +27,7 @@ from __future__ import annotations
 import re
 from decimal import ROUND_HALF_UP, Decimal
 
+from ..gcode.program import unrun_code
 from .alarms import BlockAlarm, alarm_at
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile,
                      OIf, OWhile, Stop, While, Words)
@@ -61,12 +62,28 @@ def _leaders(blocks, labels) -> list[int]:
 
 
 def _modal_g(m, g) -> None:
+    why = unrun_code("G", g)
+    if why is not None:
+        raise BlockAlarm("not-run", f"G{_code(g)} {why}, which the simulator does not run")
     if g in (0, 1, 2, 3):
         m.motion = f"G{int(g)}"
     elif g == 90:
         m.absolute = True
     elif g == 91:
         m.absolute = False
+
+
+def _m_check(value) -> None:
+    """Refuse an ``M`` code that may call, return or move (:func:`lagsym.gcode.program.unrun_code`)."""
+    why = unrun_code("M", value)
+    if why is not None:
+        raise BlockAlarm("not-run", f"M{_code(value)} {why}, which the simulator does not run")
+
+
+def _code(value) -> str:
+    """A G or M number as a control shows it: ``98``, ``66.1``."""
+    v = round(float(value), 1)
+    return f"{v:g}" if v != int(v) else f"{int(v)}"
 
 
 def _constant_words(m, run) -> None:
@@ -81,7 +98,9 @@ def _constant_words(m, run) -> None:
             for letter, v in pairs:
                 if letter == "G":
                     _modal_g(m, v)
-                elif letter != "M":
+                elif letter == "M":
+                    _m_check(v)
+                else:
                     values[letter] = v
             if "F" in values:
                 m.feed = values["F"]
@@ -112,7 +131,7 @@ def _environment(m, labels) -> dict:
     return {"m": m, "V": m.vars, "NM": m.names, "POS": m.pos, "Z": Decimal(0), "ONE": Decimal(1),
             "ZERO": Decimal(0), "P": ctx.plus, "POW": ctx.power, "DIV": m.divide, "MOD": mod, "FUNC": m.func,
             "ATAN2": m.atan2, "GET": m.get, "GETN": m.named, "CHECK": m.check, "CONST": m.const, "JUMP": jump,
-            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "ARC": _arc, "WORDS": _constant_words, "STOPS": STOPS,
+            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc, "WORDS": _constant_words, "STOPS": STOPS,
             "A_LINE": line, "A_RAPID": rapid, "A_X": x, "A_Y": y, "A_Z": z, "A_F": feed}
 
 

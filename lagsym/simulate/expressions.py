@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from decimal import Decimal
 
+from ..gcode.program import unrun_code
 from ..gcode.words import FUNCTIONS, WordError, words
 from .alarms import BlockAlarm
 
@@ -276,6 +277,10 @@ def reference(text: str):
 
 
 _AXIS_DECIMAL = set("XYZABCIJKRUVW")
+# The addresses the simulator reads or that move nothing (S T H D, the P of G64, the O of a program number);
+# I J K R belong to arcs, which raise their own alarm.  Any other (A B C U V W: more axes; Q L E: a cycle's
+# or a call's parameters) would be skipped, and the path the simulator reports would not be the machine's.
+_RUN_LETTERS = frozenset("GMXYZFSTHDPNOIJKR")
 _PLAIN_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)")
 
 
@@ -287,6 +292,9 @@ def _word_value(letter: str, text: str, increments: bool):
     rather than guess.
     """
     t = text.strip()
+    if letter not in _RUN_LETTERS:
+        raise BlockAlarm("not-run", f"address {letter} ({letter}{t}) moves an axis or sets a parameter "
+                                    "the simulator does not run")
     if not t:
         raise BlockAlarm("114", f"address {letter} without a value")
     if _PLAIN_NUMBER.fullmatch(t):
@@ -307,4 +315,10 @@ def word_values(text: str, increments: bool) -> tuple[tuple[str, object], ...]:
         split = words(text)
     except WordError as e:
         raise BlockAlarm("114", str(e)) from None
+    for letter, value in split:  # a call's own words (G65 P9010 A1.) are named by the call, not by its A
+        if letter in "GM" and _PLAIN_NUMBER.fullmatch(value.strip()):
+            why = unrun_code(letter, value)
+            if why is not None:
+                code = round(float(value), 1)
+                raise BlockAlarm("not-run", f"{letter}{code:g} {why}, which the simulator does not run")
     return tuple((letter, _word_value(letter, value, increments)) for letter, value in split)

@@ -2,14 +2,20 @@
 
 What lagsym's Heidenhain macros use, and the common core around it: ``FN 0``
 to ``FN 5`` assignments, ``FN 9`` to ``FN 12`` conditional jumps to a
-label, straight ``L`` moves with ``F`` or ``FMAX``, ``M`` functions.  Set-up
-blocks (``BLK FORM``, ``TOOL CALL``, ``CYCL``) do nothing here; ``;`` starts
-a comment.
+label, straight ``L`` moves with ``X Y Z`` (absolute), ``R0``, ``F`` or ``FMAX``
+and ``M`` functions.  Set-up blocks (``BLK FORM``, ``TOOL CALL``, ``TOOL DEF``)
+do nothing here; ``;`` starts a comment.  What would move the tool another
+way is refused with its block, never skipped: cycles (``CYCL DEF`` may shift,
+rotate or scale the datum; ``CYCL CALL``, ``M99`` and ``M89`` run a cycle),
+incremental ``IX``, radius compensation ``RL``/``RR``, other axes, and ``M``
+functions outside :data:`lagsym.gcode.program.PLAIN_M` (``M91``/``M92``
+machine positions among them).
 """
 
 from __future__ import annotations
 
 import re
+from ..gcode.program import unrun_code
 from .alarms import BlockAlarm
 from .blocks import Assign, Block, IfGotoLabel, Label, Nop, Stop, Words
 from .expressions import expr_of
@@ -20,7 +26,11 @@ _OPERAND = r"([+-]?\s*(?:Q\d+|\d+\.?\d*|\.\d+))"
 _ASSIGN = re.compile(r"FN\s*(\d+)\s*:\s*Q(\d+)\s*=\s*" + _OPERAND + r"(?:\s*([-+*/])\s*" + _OPERAND + r")?", re.I)
 _JUMP = re.compile(r"FN\s*(9|10|11|12)\s*:\s*IF\s+" + _OPERAND + r"\s+(EQU|NE|GT|LT)\s+" + _OPERAND
                    + r"\s+GOTO\s+LBL\s+(\d+)", re.I)
-_SET_UP = ("BEGIN PGM", "BLK FORM", "TOOL CALL", "TOOL DEF", "CYCL")
+_SET_UP = ("BEGIN PGM", "BLK FORM", "TOOL CALL", "TOOL DEF")
+_AXIS = re.compile(r"(?<![A-Z])([XYZ])\s*" + _OPERAND, re.I)
+_FEED = re.compile(r"(?<![A-Z])F\s*(\d+\.?\d*|MAX)(?![A-Z0-9.])", re.I)
+_M = re.compile(r"(?<![A-Z])M\s*(\d+)(?![0-9.])", re.I)
+_R0 = re.compile(r"(?<![A-Z])R0(?![0-9.])", re.I)
 _OPERATORS = {1: "+", 2: "-", 3: "*", 4: "/"}
 _RELATIONS = {9: "EQU", 10: "NE", 11: "GT", 12: "LT"}
 _TESTS = {"EQU": "EQ", "NE": "NE", "GT": "GT", "LT": "LT"}  # the relation as the expression trees name it
@@ -34,6 +44,8 @@ def parse_block(line: int, raw: str, text: str) -> Block:
     u = t.upper()
     if not t or u.startswith(_SET_UP):
         return Nop(line, raw)
+    if u.startswith("CYCL"):
+        raise BlockAlarm("not-run", "cycles (CYCL DEF, CYCL CALL) are outside what the simulator runs")
     if u.startswith("END PGM"):
         return Stop(line, raw)
     m = re.fullmatch(r"LBL\s+(\d+)", t, re.I)
@@ -51,8 +63,16 @@ def parse_block(line: int, raw: str, text: str) -> Block:
         return Words(line, raw, _straight(m.group(1)))
     m = re.fullmatch(r"M\s*(\d+)", t, re.I)
     if m:
+        _check_m(m.group(1))
         return Words(line, raw, (("M", expr_of(("dec", m.group(1)))),))
     raise BlockAlarm("114", f"cannot read {t[:30]!r}")
+
+
+def _check_m(code: str) -> None:
+    """Refuse an ``M`` function that may run a cycle, call, or move (:func:`lagsym.gcode.program.unrun_code`)."""
+    why = unrun_code("M", int(code))
+    if why is not None:
+        raise BlockAlarm("not-run", f"M{int(code)} {why}, which the simulator does not run")
 
 
 def _operand(text: str):
@@ -89,8 +109,14 @@ def _comparison(fn: str, a: str, relation: str, b: str):
 
 def _straight(rest: str):
     """The words of ``L X.. Y.. Z.. F..``: ``FMAX`` is a rapid (``G0``), any other feed a ``G1``."""
-    axes = [(w[0].upper(), expr_of(_operand(w[1]))) for w in re.findall(r"([XYZ])\s*" + _OPERAND, rest, re.I)]
-    feed = re.search(r"\bF\s*(\d+\.?\d*|MAX)\b", rest, re.I)
+    axes = [(w[0].upper(), expr_of(_operand(w[1]))) for w in _AXIS.findall(rest)]
+    for code in _M.findall(rest):
+        _check_m(code)
+    left = _R0.sub(" ", _M.sub(" ", _FEED.sub(" ", _AXIS.sub(" ", rest)))).strip()
+    if left:
+        raise BlockAlarm("not-run", f"{left[:20]!r} in a straight move is outside what the simulator runs "
+                                    "(it reads X Y Z absolute, R0, F or FMAX, M)")
+    feed = _FEED.search(rest)
     rapid = feed is not None and feed.group(1).upper() == "MAX"
     out = [("G", expr_of(("dec", "0" if rapid else "1")))]
     if feed and not rapid:

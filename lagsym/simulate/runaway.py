@@ -8,8 +8,8 @@ jumps, and four things stop a run there:
   loop or ``IF``/``FN 9`` jump back on a condition that nothing in the loop
   can change (a constant, as ``WHILE [1 EQ 1]``, or variables no block of the
   loop sets), with no block between the target and the jump that can leave
-  (no ``M02``/``M30``/``M99``, ``END PGM``, no jump or loop exit outside it):
-  stopped the second time its jump runs;
+  (no ``M02``/``M30`` or ``END PGM``, no ``M99`` or call, whose alarm ends the run, no jump or loop exit
+  outside it): stopped the second time its jump runs;
 * the program comes back to the same block with every variable, the
   position and the modes as they were before: it is deterministic, so it
   would loop forever (found with Brent's doubling, so a cycle of any length
@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from decimal import Decimal
 
+from ..gcode.program import END_M, unrun_code
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
                      OWhile, Stop, While, Words)
@@ -196,7 +197,8 @@ def _may_leave(probe, blocks, labels, k: int, lo: int, hi: int) -> bool:
         return True
     if isinstance(c, Words):
         ms = [_constant(probe, f) for letter, f in c.words if letter == "M"]
-        return any(v is None or v in (2, 30, 99) for v in ms)
+        # an end, or a code the simulator refuses (a call, M99): its alarm ends the run too
+        return any(v is None or v in END_M or unrun_code("M", v) is not None for v in ms)
     if isinstance(c, (While, OWhile)):  # its exit, unless it is the head of the loop that jumps back from hi
         return c.end + 1 not in inside and not (k == lo and getattr(blocks[hi], "start", None) == lo)
     if isinstance(c, (End, OEndWhile)):

@@ -289,7 +289,7 @@ class _Row:
 
 
 def _rows(stock: Stock, box, radius: float, spec: RoughSpec) -> list[_Row]:
-    """The rows over the block, each sampled at the forward step plus the corners of the nearest-point rule."""
+    """The rows over the block, each sampled at the forward step plus the box edges and where the tool meets them."""
     along_x = spec.direction == "x"
     c0, c1 = (stock.y0, stock.y1) if along_x else (stock.x0, stock.x1)
     a0, a1 = (stock.x0, stock.x1) if along_x else (stock.y0, stock.y1)
@@ -334,8 +334,10 @@ def floor_at(drop: _Drop, xs, ys, progress: Progress | None = None, **search) ->
     """``CL + stock`` (mm) at tool positions ``xs, ys`` (lists of mm arrays) anywhere on the machine.
 
     A position outside the box but within the tool radius of it takes the
-    height at the nearest point of the box; farther out the tool touches
-    nothing (``-inf``).  ``search`` goes to
+    exact drop-cutter height there, the tool resting on what lies under it
+    inside the box (the height at the nearest point of the box is never
+    lower, but leaves material where the surface rises from an edge);
+    farther out the tool touches nothing (``-inf``).  ``search`` goes to
     :func:`~lagsym.toolpath.dropcutter.drop_cutter` (``lattice``, ``starts``); ``progress`` is
     told the positions dropped (stage ``dropping the tool``).
     """
@@ -345,7 +347,7 @@ def floor_at(drop: _Drop, xs, ys, progress: Progress | None = None, **search) ->
     touch = np.hypot(x - px, y - py) <= tool.radius_mm * (1 + 1e-12)
     out = np.full(x.size, -np.inf)
     if touch.any():
-        u, v = place.to_surface(px[touch], py[touch])
+        u, v = place.to_surface(x[touch], y[touch])
         radius, corner = tool.radius_mm / place.mm_per_unit, tool.corner_mm / place.mm_per_unit
         z = Tally(progress, "dropping the tool", len(u)).whole(
             lambda pu, pv: drop_cutter(surface, pu, pv, radius, corner=corner, evaluator=ev, **search), (u, v), _PIECE)

@@ -41,8 +41,8 @@ PATTERNS = ("raster", "offset")
 
 def along_samples(lo: float, hi: float, cross: float, box_along, box_cross, *, radius: float,
                   step: float) -> np.ndarray:
-    """Positions from ``lo`` to ``hi`` on a line at ``cross``: the forward step plus the corners of the
-    nearest-point rule (the box edges, and where the disc under the tool starts to meet an edge or corner)."""
+    """Positions from ``lo`` to ``hi`` on a line at ``cross``: the forward step plus where the drop-cutter
+    height has a corner (the box edges, and where the disc under the tool starts to meet an edge or corner)."""
     b_a0, b_a1 = box_along
     b_c0, b_c1 = box_cross
     extra = [b_a0, b_a1, b_a0 + radius, b_a1 - radius]
