@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
-from ._common import (dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (add_conditioning_argument, conditioning_notes, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -35,6 +37,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help=f"the control: {dialect_help(MACRO_DIALECTS)}")
     p.add_argument("--precision", type=int, choices=PRECISIONS,
                    help="significant digits of the control's arithmetic "
@@ -81,7 +84,9 @@ def settings_from(args, grid) -> tuple[MachineSettings, RasterSpec, Tool]:
 
 def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.file))
+    notes = conditioning_notes(surface.grid, args, err)
     settings, raster, tool = settings_from(args, surface.grid)
+    settings = replace(settings, notes=notes)
     program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,
                             variable_base=args.variable_base, form=args.form, variables=args.variables)
     emit(program.text, args.output, out)

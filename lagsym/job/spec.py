@@ -99,6 +99,7 @@ class JobSpec:
     stock: dict
     tools: dict
     operations: tuple
+    notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
 
 
 def read_job(path) -> JobSpec:
