@@ -177,6 +177,7 @@ class Amplification:
     lebesgue_y: float
     at: tuple[float, float]
     limit: float = AMPLIFICATION_LIMIT
+    fitted: bool = False  # the value is a least-squares fit's, from the points it was fitted to
 
     @property
     def exceeds(self) -> bool:
@@ -185,6 +186,9 @@ class Amplification:
 
     def text(self) -> str:
         """The figure in words."""
+        if self.fitted:
+            return (f"errors in the measured points can be amplified up to {self.value:.4g} times by this "
+                    f"least-squares fit (its Lebesgue function sampled over the box)")
         return (f"errors in the points can be amplified up to {self.value:.4g} times (Lebesgue constants "
                 f"{self.lebesgue_x:.4g} in x times {self.lebesgue_y:.4g} in y), worst near (x, y) = "
                 f"({self.at[0]:.4g}, {self.at[1]:.4g})")
@@ -207,6 +211,8 @@ def amplification(surface, limit: float = AMPLIFICATION_LIMIT) -> Amplification:
     g = surface if isinstance(surface, ControlGrid) else surface.grid
     lx, ax = lebesgue_maximum(g.x)
     ly, ay = lebesgue_maximum(g.y)
+    if g.amplification is not None:  # the heights were computed from measured points: theirs is the figure
+        return Amplification(g.amplification, lx, ly, (ax, ay), limit, fitted=True)
     return Amplification(lx * ly, lx, ly, (ax, ay), limit)
 
 
@@ -228,10 +234,11 @@ def require_conditioning(surface, *, accept: bool = False, limit: float = AMPLIF
     a = amplification(surface, limit)
     if a.exceeds and not accept:
         g = surface if isinstance(surface, ControlGrid) else surface.grid
+        way = ("fit them at lower degrees (lagsym fit POINTS --degree auto)" if a.fitted else
+               f"fit the points instead (lagsym fit {g.source} -o surface.json), use fewer or Chebyshev-spaced nodes")
         raise ConditioningError(
             f"{g.source}: {a.text()}, above lagsym's limit of {limit:g}: 0.01 of measurement noise could move "
-            f"the surface by {0.01 * a.value:.3g}; fit the points instead (lagsym fit {g.source} -o surface.json), "
-            f"use fewer or Chebyshev-spaced nodes, or give --accept-conditioning to use it as it is")
+            f"the surface by {0.01 * a.value:.3g}; {way}, or give --accept-conditioning to use it as it is")
     return a
 
 
@@ -287,8 +294,10 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
         )
     findings.append(
         Finding("amplification", amp.value, AMPLIFICATION_LIMIT, amp.exceeds,
-                f"surface amplification of data errors: {amp.value:.4g} (the product of the two, worst near "
-                f"(x, y) = ({amp.at[0]:.4g}, {amp.at[1]:.4g}))"
+                (f"surface amplification of errors in the measured points it was fitted to: {amp.value:.4g} "
+                 f"(the fit's Lebesgue function, sampled)" if amp.fitted else
+                 f"surface amplification of data errors: {amp.value:.4g} (the product of the two, worst near "
+                 f"(x, y) = ({amp.at[0]:.4g}, {amp.at[1]:.4g}))")
                 + (f": above {AMPLIFICATION_LIMIT:g}, so toolpath, rough, job, macro, export and sample refuse it "
                    f"without --accept-conditioning; for measured points use 'lagsym fit'"
                    if amp.exceeds else f" (limit {AMPLIFICATION_LIMIT:g})"))

@@ -57,6 +57,7 @@ __all__ = ["SurfaceFit", "fit_surface", "fit_coefficients", "representation_node
 CRITERIA = ("gcv", "loo")
 MAX_DEGREE = 12  # one polynomial beyond this is a piecewise surface's job
 NODE_DIGITS = 6  # representation nodes: the Chebyshev extrema rounded to 1e-6 of the box
+AMPLIFICATION_SAMPLES = 65  # per axis: the fit's Lebesgue function sampled on 65 x 65 points of the box
 
 
 @dataclass(frozen=True)
@@ -89,6 +90,12 @@ class SurfaceFit:
         Every candidate's score, lowest first (empty when the degrees were given).
     hull : tuple of (Fraction, Fraction)
         The convex hull of the points' ``(x, y)``, counter-clockwise.
+    amplification : float
+        How much the fit can amplify errors in the points: the largest value
+        over the box of its Lebesgue function ``sum_k |h_k(x, y)|`` (``h_k``
+        the weight of point ``k`` in the fitted value at ``(x, y)``), sampled
+        on a grid of :data:`AMPLIFICATION_SAMPLES` squared points of the box;
+        also the surface grid's ``amplification``, which the guard rail reads.
     """
 
     surface: LagrangeSurface
@@ -102,6 +109,7 @@ class SurfaceFit:
     score: float | None = None
     scores: tuple[tuple[tuple[int, int], float], ...] = ()
     hull: tuple[tuple[Fraction, Fraction], ...] = ()
+    amplification: float = 1.0
 
     @property
     def terms(self) -> int:
@@ -184,6 +192,8 @@ class SurfaceFit:
         lines.append(f"{n} points, {self.terms} coefficients, {weighted}least squares in exact rationals")
         lines.append(f"residuals: max {self.max_residual:.6g}, RMS {self.rms:.6g}, "
                      f"noise estimate sqrt(RSS/(N-k)) {self.sigma:.6g}")
+        lines.append(f"amplification of errors in the points: {self.amplification:.4g} (the fit's Lebesgue "
+                     f"function, sampled on {AMPLIFICATION_SAMPLES} x {AMPLIFICATION_SAMPLES} points of the box)")
         if threshold is None:
             t, said = Fraction(3) * as_exact(self.sigma, "sigma"), "3 x the noise estimate"
         else:
@@ -523,15 +533,44 @@ def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, ma
     numerators, denominator = _residuals(scaled, coeffs)
     x0, x1 = min(p[0] for p in pts), max(p[0] for p in pts)
     y0, y1 = min(p[1] for p in pts), max(p[1] for p in pts)
-    fit = SurfaceFit(surface=_surface(coeffs, (x0, x1, y0, y1), source, units), coefficients=coeffs,
+    amp = _amplification(pts, w, chosen)
+    fit = SurfaceFit(surface=_surface(coeffs, (x0, x1, y0, y1), source, units, amp), coefficients=coeffs,
                      degree=chosen, points=pts, weights=w, residual_numerators=numerators,
-                     residual_denominator=denominator, hull=_hull(scaled))
+                     residual_denominator=denominator, hull=_hull(scaled), amplification=amp)
     if not scores:
         return fit
     return replace(fit, criterion=criterion, score=_exact_score(fit, criterion), scores=tuple(scores))
 
 
-def _surface(coeffs, box, source: str, units: str | None) -> LagrangeSurface:
+def _amplification(points, weights, degree: tuple[int, int]) -> float:
+    """The largest value of the fit's Lebesgue function over a grid of the box, in floating point.
+
+    With ``sqrt(W) A = Q R`` (``A`` the Chebyshev basis at the points), the
+    fitted value at ``(x, y)`` is ``b(x, y) R^-1 Q^T sqrt(W) z``; the sum of
+    the absolute values of that row's entries is the Lebesgue function.
+    """
+    import numpy as np
+
+    xs = np.array([float(p[0]) for p in points])
+    ys = np.array([float(p[1]) for p in points])
+    sw = np.sqrt(np.array([float(v) for v in weights])) if weights is not None else np.ones(len(xs))
+    (p, q), n = degree, len(xs)
+    lo_x, hi_x, lo_y, hi_y = xs.min(), xs.max(), ys.min(), ys.max()
+    a = (_chebyshev(xs, lo_x, hi_x, p)[:, :, None] * _chebyshev(ys, lo_y, hi_y, q)[:, None, :]).reshape(n, -1)
+    qm, rm = np.linalg.qr(a * sw[:, None])
+    k = AMPLIFICATION_SAMPLES
+    gx = _chebyshev(np.linspace(lo_x, hi_x, k), lo_x, hi_x, p)
+    gy = _chebyshev(np.linspace(lo_y, hi_y, k), lo_y, hi_y, q)
+    b = (gx[:, None, :, None] * gy[None, :, None, :]).reshape(k * k, -1)
+    coef = np.linalg.solve(rm.T, b.T).T  # b R^-1, one row an evaluation point
+    best, rows = 0.0, max(1, 4_000_000 // n)
+    for start in range(0, len(coef), rows):
+        h = (coef[start:start + rows] @ qm.T) * sw
+        best = max(best, float(np.abs(h).sum(axis=1).max()))
+    return best
+
+
+def _surface(coeffs, box, source: str, units: str | None, amp: float | None = None) -> LagrangeSurface:
     """The fitted polynomial as the Lagrange surface through its values at the representation nodes.
 
     The values are found with one exact matrix product; the surface's
@@ -551,7 +590,7 @@ def _surface(coeffs, box, source: str, units: str | None) -> LagrangeSurface:
     cm = flint.fmpq_mat(n, m, [_fmpq(c) for row in padded for c in row])
     zm = vx * cm * vy.transpose()
     z = [[Fraction(int(zm[i, k].p), int(zm[i, k].q)) for k in range(m)] for i in range(n)]
-    grid = grid_from_table(nodes_x, nodes_y, z, source=source, units=units)
+    grid = replace(grid_from_table(nodes_x, nodes_y, z, source=source, units=units), amplification=amp)
     return LagrangeSurface(grid=grid, coefficients=tuple(tuple(r) for r in padded))
 
 

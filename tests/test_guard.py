@@ -120,3 +120,15 @@ def test_the_fit_of_the_same_points_passes_the_guard_and_machines(run_cli, tmp_p
     status, _, err = run_cli("toolpath", surf, "-o", tmp_path / "p.nc", "--stepover", "10", "--step", "5")
     assert status == 0 and "CONDITIONING" not in (tmp_path / "p.nc").read_text()
     assert json.loads(surf.read_text())["degree"][0] < 11
+
+
+def test_a_fit_that_interpolates_is_refused_as_the_interpolant_is(run_cli, tmp_path, noisy):
+    surf = tmp_path / "full.json"
+    status, out, err = run_cli("fit", noisy, "--degree", "11", "-o", surf)
+    assert status == 0 and "this fit amplifies errors in the points up to" in err
+    amp = json.loads(surf.read_text())["amplification"]
+    assert 0.9 * 2623 < amp <= 2623 * (1 + 1e-9)  # sampled, so at most the exact interpolant's figure
+    status, _, err = run_cli("toolpath", surf, "-o", tmp_path / "p.nc")
+    assert status == 2 and "by this least-squares fit" in err and "--degree auto" in err
+    status, out, _ = run_cli("check", surf)
+    assert "WARNING surface amplification of errors in the measured points it was fitted to" in out

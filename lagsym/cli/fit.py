@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 
+from ..conditioning import AMPLIFICATION_LIMIT
 from ..errors import InputError
 from ..export.surfacejson import write_surface_json
 from ..fit import CRITERIA, MAX_DEGREE, fit_surface
@@ -29,9 +30,9 @@ standard error) is read by every command that reads a points file:
 equation, check, sample, export, toolpath, rough, job, macro, plot.
 
 examples:
-  lagsym fit probe.csv -o surface.json
-  lagsym fit probe.csv --degree 4x3 --threshold 0.05 -o surface.json
-  lagsym fit scan.xyz --criterion loo --weights scan-weights.txt -o surface.json
+  lagsym fit examples/probe-12x12.csv -o surface.json
+  lagsym fit examples/probe-12x12.csv --degree 4x3 --threshold 0.05 -o surface-4x3.json
+  lagsym fit examples/probe-scattered.csv --criterion loo -o scattered.json
   lagsym toolpath surface.json -o part.nc"""
 
 
@@ -82,6 +83,10 @@ def run(args, out, err) -> int:
     emit(buf.getvalue(), args.output, out)
     report = out if args.output and args.output != "-" else err
     report.write(fit.report(args.threshold) + "\n")
+    if fit.amplification > AMPLIFICATION_LIMIT:
+        err.write(f"lagsym: warning: this fit amplifies errors in the points up to {fit.amplification:.4g} times, "
+                  f"above the limit of {AMPLIFICATION_LIMIT:g}: toolpath, rough, job, macro, export and sample "
+                  f"will refuse it without --accept-conditioning; lower degrees (--degree auto) amplify less\n")
     if args.output and args.output != "-":
         report.write(f"wrote {args.output}: the exact surface, read by every command that reads points\n")
     return 0

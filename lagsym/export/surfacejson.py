@@ -14,7 +14,10 @@ are the polynomial's values on a grid of nodes (more nodes than its degree in
 each direction), so the Lagrange surface through them is the polynomial
 itself: every command that reads a points file reads this file as that
 surface (:func:`lagsym.io.read_points` checks that every ``z`` is the
-polynomial's value, exactly, and refuses a file where one is not).  ``fit``
+polynomial's value, exactly, and refuses a file where one is not).
+``amplification`` is how much the surface can amplify errors in the points
+it was fitted to (the fit's Lebesgue function, sampled); the commands that
+machine or export a surface refuse it above their limit.  ``fit``
 is the report of the fit that made it (:func:`lagsym.fit.fit_surface`), for
 reading only; its figures are decimals.
 """
@@ -51,6 +54,8 @@ def surface_document(surface, coefficients=None, fit=None) -> dict:
     doc["x"] = [_text(v) for v in g.x]
     doc["y"] = [_text(v) for v in g.y]
     doc["z"] = [[_text(v) for v in row] for row in g.z]
+    if g.amplification is not None:
+        doc["amplification"] = g.amplification
     if fit is not None:
         doc["fit"] = {
             "source": g.source, "points": len(fit.points), "weighted": fit.weights is not None,

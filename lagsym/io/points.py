@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -130,6 +130,11 @@ def surface_file(name: str, data: dict) -> ControlGrid:
         raise InputError(f"{name}: {len(xs)} x {len(ys)} nodes cannot hold a polynomial of degree {p}x{q}; "
                          f"it needs at least {p + 1} x {q + 1}")
     grid = grid_from_table(xs, ys, z, source=name, units=_units(name, data))
+    amp = data.get("amplification")
+    if amp is not None:
+        if isinstance(amp, bool) or not isinstance(amp, (int, Fraction)) or not 1 <= amp < 10 ** 300:
+            raise InputError(f"{name}: \"amplification\": {_short(amp)} should be a number of at least 1")
+        grid = replace(grid, amplification=float(amp))
     # One exact matrix product gives every node's value: V_x C V_y^T.
     import flint
 
