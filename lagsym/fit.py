@@ -57,7 +57,8 @@ __all__ = ["SurfaceFit", "fit_surface", "fit_coefficients", "representation_node
 CRITERIA = ("gcv", "loo")
 MAX_DEGREE = 12  # one polynomial beyond this is a piecewise surface's job
 NODE_DIGITS = 6  # representation nodes: the Chebyshev extrema rounded to 1e-6 of the box
-AMPLIFICATION_SAMPLES = 65  # per axis: the fit's Lebesgue function sampled on 65 x 65 points of the box
+AMPLIFICATION_SAMPLES = 65  # per axis at most: the fit's Lebesgue function sampled on up to 65 x 65 points
+AMPLIFICATION_WORK = 4_000_000  # sample points times data points: fewer samples for many points, at least 17 x 17
 
 
 @dataclass(frozen=True)
@@ -94,8 +95,11 @@ class SurfaceFit:
         How much the fit can amplify errors in the points: the largest value
         over the box of its Lebesgue function ``sum_k |h_k(x, y)|`` (``h_k``
         the weight of point ``k`` in the fitted value at ``(x, y)``), sampled
-        on a grid of :data:`AMPLIFICATION_SAMPLES` squared points of the box;
-        also the surface grid's ``amplification``, which the guard rail reads.
+        on a grid of :attr:`samples` squared points of the box; also the
+        surface grid's ``amplification``, which the guard rail reads.
+    samples : int
+        The points per axis of that grid: 65, fewer for many points (at
+        least 17), so that sampling costs no more than the fit.
     """
 
     surface: LagrangeSurface
@@ -110,6 +114,7 @@ class SurfaceFit:
     scores: tuple[tuple[tuple[int, int], float], ...] = ()
     hull: tuple[tuple[Fraction, Fraction], ...] = ()
     amplification: float = 1.0
+    samples: int = AMPLIFICATION_SAMPLES
 
     @property
     def terms(self) -> int:
@@ -193,7 +198,7 @@ class SurfaceFit:
         lines.append(f"residuals: max {self.max_residual:.6g}, RMS {self.rms:.6g}, "
                      f"noise estimate sqrt(RSS/(N-k)) {self.sigma:.6g}")
         lines.append(f"amplification of errors in the points: {self.amplification:.4g} (the fit's Lebesgue "
-                     f"function, sampled on {AMPLIFICATION_SAMPLES} x {AMPLIFICATION_SAMPLES} points of the box)")
+                     f"function, sampled on {self.samples} x {self.samples} points of the box)")
         if threshold is None:
             t, said = Fraction(3) * as_exact(self.sigma, "sigma"), "3 x the noise estimate"
         else:
@@ -349,22 +354,19 @@ def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
 
     With ``x = X / dx`` and ``C`` the coefficients times their common
     denominator ``den``: ``den dx**P dy**Q p(x, y) = sum_ab C[a][b] X**a
-    dx**(P-a) Y**b dy**(Q-b)``, one integer matrix product and a row-wise sum.
+    dx**(P-a) Y**b dy**(Q-b)``, one integer matrix-vector product whose
+    matrix holds only the data's small integers.
     """
     den = _common_denominator([c for row in coefficients for c in row])
     P, Q = len(coefficients) - 1, len(coefficients[0]) - 1
     n = len(s.X)
-    cm = flint.fmpz_mat(P + 1, Q + 1, [int(c * den) for row in coefficients for c in row])
-    ax = flint.fmpz_mat(n, P + 1, [x ** a * s.dx ** (P - a) for x in s.X for a in range(P + 1)])
-    t = ax * cm
+    col = flint.fmpz_mat((P + 1) * (Q + 1), 1, [int(c * den) for row in coefficients for c in row])
+    xs = [[x ** a * s.dx ** (P - a) for a in range(P + 1)] for x in s.X]
+    ys = [[y ** b * s.dy ** (Q - b) for b in range(Q + 1)] for y in s.Y]
+    basis = flint.fmpz_mat(n, (P + 1) * (Q + 1), [u * v for rx, ry in zip(xs, ys) for u in rx for v in ry])
+    values = basis * col
     scale = den * s.dx ** P * s.dy ** Q
-    out = []
-    for k, (y, z) in enumerate(zip(s.Y, s.Z)):
-        val = 0
-        for b in range(Q, -1, -1):
-            val = val * y + int(t[k, b]) * s.dy ** (Q - b)
-        out.append(z * scale - val * s.dz)
-    return tuple(out), scale * s.dz
+    return tuple(z * scale - int(values[k, 0]) * s.dz for k, z in enumerate(s.Z)), scale * s.dz
 
 
 def _check_points(points, source: str) -> tuple[tuple[Fraction, Fraction, Fraction], ...]:
@@ -533,16 +535,22 @@ def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, ma
     numerators, denominator = _residuals(scaled, coeffs)
     x0, x1 = min(p[0] for p in pts), max(p[0] for p in pts)
     y0, y1 = min(p[1] for p in pts), max(p[1] for p in pts)
-    amp = _amplification(pts, w, chosen)
+    samples = _samples(len(pts))
+    amp = _amplification(pts, w, chosen, samples)
     fit = SurfaceFit(surface=_surface(coeffs, (x0, x1, y0, y1), source, units, amp), coefficients=coeffs,
                      degree=chosen, points=pts, weights=w, residual_numerators=numerators,
-                     residual_denominator=denominator, hull=_hull(scaled), amplification=amp)
+                     residual_denominator=denominator, hull=_hull(scaled), amplification=amp,
+                     samples=samples)
     if not scores:
         return fit
     return replace(fit, criterion=criterion, score=_exact_score(fit, criterion), scores=tuple(scores))
 
 
-def _amplification(points, weights, degree: tuple[int, int]) -> float:
+def _samples(n: int) -> int:
+    return max(17, min(AMPLIFICATION_SAMPLES, math.isqrt(AMPLIFICATION_WORK // n)))
+
+
+def _amplification(points, weights, degree: tuple[int, int], samples: int) -> float:
     """The largest value of the fit's Lebesgue function over a grid of the box, in floating point.
 
     With ``sqrt(W) A = Q R`` (``A`` the Chebyshev basis at the points), the
@@ -558,7 +566,7 @@ def _amplification(points, weights, degree: tuple[int, int]) -> float:
     lo_x, hi_x, lo_y, hi_y = xs.min(), xs.max(), ys.min(), ys.max()
     a = (_chebyshev(xs, lo_x, hi_x, p)[:, :, None] * _chebyshev(ys, lo_y, hi_y, q)[:, None, :]).reshape(n, -1)
     qm, rm = np.linalg.qr(a * sw[:, None])
-    k = AMPLIFICATION_SAMPLES
+    k = samples
     gx = _chebyshev(np.linspace(lo_x, hi_x, k), lo_x, hi_x, p)
     gy = _chebyshev(np.linspace(lo_y, hi_y, k), lo_y, hi_y, q)
     b = (gx[:, None, :, None] * gy[None, :, None, :]).reshape(k * k, -1)
