@@ -39,6 +39,7 @@ every command and function that takes a surface.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from fractions import Fraction
@@ -386,11 +387,9 @@ def _degree(degree) -> tuple[int, int] | None:
     if degree is None or degree == "auto":
         return None
     if isinstance(degree, str):
-        parts = degree.lower().split("x")
-        try:
-            vals = [int(v) for v in parts]
-        except ValueError:
-            raise InputError(f"degree {degree!r} should be a whole number (4), two (4x3) or 'auto'") from None
+        if not re.fullmatch(r"[0-9]{1,6}(x[0-9]{1,6})?", degree.strip().lower()):
+            raise InputError(f"degree {degree!r} should be a whole number (4), two (4x3) or 'auto'")
+        vals = [int(v) for v in degree.strip().lower().split("x")]
     elif isinstance(degree, int) and not isinstance(degree, bool):
         vals = [degree]
     else:
