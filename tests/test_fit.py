@@ -219,3 +219,44 @@ def test_cli_fit_weights_and_bad_weights(run_cli, tmp_path):
     wts.write_text("2\n" * 39 + "x\n")
     status, _, err = run_cli("fit", src, "--degree", "2", "--weights", wts)
     assert status == 2 and "line 40" in err and err.count("\n") == 1
+
+
+def _disc_top(coefficients, cx, cy, radius, n=61):
+    """The highest ball-tip height over the disc under a ball at (cx, cy): a brute-force drop-cutter."""
+    t = np.linspace(-radius, radius, n)
+    gx, gy = np.meshgrid(t, t)
+    inside = gx ** 2 + gy ** 2 <= radius ** 2
+    px, py = cx + gx[inside], cy + gy[inside]
+    ok = (px >= 0) & (px <= 100) & (py >= 0) & (py <= 80)
+    px, py = px[ok], py[ok]
+    return float((polyval(coefficients, px, py) + np.sqrt(np.maximum(radius ** 2 - (px - cx) ** 2 - (py - cy) ** 2, 0))
+                  - radius).max())
+
+
+def test_the_fitted_surface_machines_without_gouge_and_its_macro_runs_in_rs274(run_cli, tmp_path, rs274):
+    from gcheck import interpret
+
+    src, surf = tmp_path / "probe.csv", tmp_path / "surface.json"
+    points = noisy_grid()
+    src.write_text("x,y,z\n" + "".join(f"{_dec(x)},{_dec(y)},{_dec(z)}\n" for x, y, z in points))
+    assert run_cli("fit", src, "-o", surf)[0] == 0
+    coefficients = fit_surface(points).coefficients
+    prog = tmp_path / "part.ngc"
+    status, _, err = run_cli("toolpath", surf, "--dialect", "linuxcnc", "--tool-diameter", "6", "--stepover", "4",
+                             "--step", "1", "-o", prog)
+    assert status == 0, err
+    feeds, _ = interpret(rs274, prog.read_text())
+    rng = np.random.default_rng(1)
+    for x, y, z in feeds[rng.choice(len(feeds), 300, replace=False)]:
+        top = _disc_top(coefficients, x, y, 3.0)
+        assert z >= top - 1e-3  # no gouge (the program's resolution and the lattice's step)
+        assert z <= top + 0.02  # and on the part, not in the air
+    macro = tmp_path / "part-macro.ngc"
+    status, _, err = run_cli("macro", surf, "--dialect", "linuxcnc", "--tool-diameter", "6", "--stepover", "4",
+                             "--step", "2", "-o", macro)
+    assert status == 0, err
+    mfeeds, _ = interpret(rs274, macro.read_text())
+    assert len(mfeeds) > 500
+    for x, y, z in mfeeds[rng.choice(len(mfeeds), 200, replace=False)]:
+        if 0 <= x <= 100 and 0 <= y <= 80:
+            assert z >= _disc_top(coefficients, x, y, 3.0) - 1e-3
