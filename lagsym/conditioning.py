@@ -36,7 +36,7 @@ LEBESGUE_LIMIT = 10.0  # data errors amplified more than tenfold
 # A surface amplifies errors in its points by up to the product of its axes' Lebesgue constants.  Above
 # 100, 0.01 mm of probe noise can become a millimetre.  The paper's examples stay below 5 (5x5 even
 # nodes: 4.87); even nodes pass up to 8x8 (48), 9x9 is refused (120); Chebyshev-like nodes pass at any
-# degree lagsym fits (12x12 of them: 6.4).
+# degree lagsym fits (12x12 of them: 6.2).
 AMPLIFICATION_LIMIT = 100.0
 OVERSHOOT_LIMIT = 0.10  # the surface leaves the data range by more than 10 % of it
 FLOAT_ERROR_LIMIT = 1e-12  # numeric samples trusted to this fraction of the data range
