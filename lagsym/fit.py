@@ -463,7 +463,7 @@ def _exact_score(fit: SurfaceFit, criterion: str) -> float:
     return float(np.mean((r / (1 - h)) ** 2))
 
 
-def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, max_degree=None,
+def fit_surface(points, degree=None, *, criterion: str | None = None, weights=None, max_degree=None,
                 source: str | None = None, units: str | None = None) -> SurfaceFit:
     """The exact least-squares tensor-product polynomial through measured points.
 
@@ -475,8 +475,10 @@ def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, ma
     degree : int, (int, int), str or None
         ``4`` (4 in x and y), ``(4, 3)`` or ``"4x3"``; None or ``"auto"``
         chooses them by ``criterion``.
-    criterion : {"gcv", "loo"}
-        Generalized cross-validation (default) or leave-one-out, for ``degree=None``.
+    criterion : {"gcv", "loo"}, optional
+        How ``degree=None`` chooses: generalized cross-validation (the
+        default) or leave-one-out; refused with given degrees, which it
+        would not change.
     weights : sequence of numbers, optional
         One positive weight per point (for example ``1 / sigma_k**2``).
     max_degree : int or (int, int), optional
@@ -506,7 +508,12 @@ def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, ma
         units = units if units is not None else points.units
     source = source or "<points>"
     pts = _check_points(points, source)
-    criterion = choice(criterion, CRITERIA, "criterion")
+    chosen = _degree(degree)
+    if chosen is not None and (criterion is not None or max_degree is not None):
+        given = "criterion" if criterion is not None else "max_degree"
+        raise InputError(f"{given} chooses degrees; the degrees are given ({chosen[0]}x{chosen[1]}): "
+                         f"leave out one or the other")
+    criterion = choice(criterion or "gcv", CRITERIA, "criterion")
     w = None
     if weights is not None:
         w = tuple(as_exact(v, f"{source}: weight {i + 1}") for i, v in enumerate(weights))
@@ -519,7 +526,6 @@ def fit_surface(points, degree=None, *, criterion: str = "gcv", weights=None, ma
     if nx < 2 or ny < 2:
         raise GridError(f"{source}: the points have {nx} distinct x and {ny} distinct y values; "
                         f"a surface needs at least 2 of each")
-    chosen = _degree(degree)
     scores: list = []
     if chosen is None:
         top = _degree(max_degree) if max_degree is not None else (min(nx - 1, 8), min(ny - 1, 8))

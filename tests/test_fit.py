@@ -145,6 +145,10 @@ def test_too_few_points_for_the_degree_are_refused():
         fit_surface([(0, 0, 1), (1, 0, 2), (0, 1, 3), (1, 1, 4), (2, 2, 5)], 3)
     with pytest.raises(InputError, match="degree '4y'"):
         fit_surface(noisy_grid(), "4y")
+    with pytest.raises(InputError, match="criterion chooses degrees; the degrees are given"):
+        fit_surface(noisy_grid(), 4, criterion="loo")
+    with pytest.raises(InputError, match="max_degree chooses degrees"):
+        fit_surface(noisy_grid(), "4x3", max_degree=6)
     with pytest.raises(InputError, match="weight 1 = 0 is not positive"):
         fit_surface([(0, 0, 1), (1, 0, 2), (0, 1, 3), (1, 1, 4)], 1, weights=[0, 1, 1, 1])
 
@@ -196,6 +200,15 @@ def test_cli_fit_auto_prints_the_choice_and_score(run_cli, tmp_path):
     assert status == 0
     assert json.loads(out)["format"] == "lagsym-surface"
     assert "chosen by generalized cross-validation: score" in err
+
+
+def test_cli_fit_refuses_a_criterion_with_given_degrees(run_cli, tmp_path):
+    src = tmp_path / "probe.json"
+    src.write_text(json.dumps([[_dec(x), _dec(y), _dec(z)] for x, y, z in noisy_grid()]))
+    status, _, err = run_cli("fit", src, "--degree", "4", "--criterion", "loo")
+    assert status == 2 and "--criterion chooses the degrees" in err and err.count("\n") == 1
+    status, _, err = run_cli("fit", src, "--degree", "4", "--max-degree", "5")
+    assert status == 2 and "--max-degree chooses the degrees" in err
 
 
 def test_a_surface_file_changed_by_hand_is_refused(run_cli, tmp_path):

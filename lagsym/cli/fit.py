@@ -42,7 +42,7 @@ def add_arguments(p) -> None:
     p.add_argument("--degree", default="auto", metavar="P[xQ]",
                    help=f"degree in x and y (4), or in each (4x3), 0 to {MAX_DEGREE}; "
                         f"auto (default) chooses them by --criterion")
-    p.add_argument("--criterion", choices=CRITERIA, default="gcv",
+    p.add_argument("--criterion", choices=CRITERIA,
                    help="how --degree auto chooses: gcv (default; generalized cross-validation) or loo "
                         "(leave-one-out)")
     p.add_argument("--max-degree", metavar="P[xQ]",
@@ -76,8 +76,11 @@ def run(args, out, err) -> int:
     if not data.plain:
         err.write(f"{data.source}: read as {data.layout}\n")
     weights = read_weights(args.weights) if args.weights else None
-    fit = fit_surface(data.points, args.degree, criterion=args.criterion, weights=weights,
-                      max_degree=args.max_degree, source=data.source, units=data.units)
+    if args.degree != "auto" and (args.criterion or args.max_degree):
+        raise InputError(f"--{'criterion' if args.criterion else 'max-degree'} chooses the degrees, and --degree "
+                         f"{args.degree} gives them: leave out one or the other")
+    fit = fit_surface(data.points, None if args.degree == "auto" else args.degree, criterion=args.criterion,
+                      weights=weights, max_degree=args.max_degree, source=data.source, units=data.units)
     buf = io.StringIO()
     write_surface_json(buf, fit.surface, fit.coefficients, fit)
     emit(buf.getvalue(), args.output, out)
