@@ -132,3 +132,11 @@ def test_a_fit_that_interpolates_is_refused_as_the_interpolant_is(run_cli, tmp_p
     assert status == 2 and "by this least-squares fit" in err and "--degree auto" in err
     status, out, _ = run_cli("check", surf)
     assert "WARNING surface amplification of errors in the measured points it was fitted to" in out
+
+
+def test_the_override_is_recorded_in_the_macro_header(run_cli, tmp_path, noisy):
+    prog = tmp_path / "m.ngc"
+    status, _, err = run_cli("macro", noisy, "--dialect", "linuxcnc", "--tool-diameter", "0", "--safe-z", "100",
+                             "--stepover", "10", "--step", "10", "-o", prog, "--accept-conditioning")
+    assert status == 0, err
+    assert "(CONDITIONING 2623X ABOVE 100 ACCEPTED --ACCEPT-CONDITIONING)" in prog.read_text().splitlines()[:8]
