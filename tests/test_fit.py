@@ -273,3 +273,25 @@ def test_the_fitted_surface_machines_without_gouge_and_its_macro_runs_in_rs274(r
     for x, y, z in mfeeds[rng.choice(len(mfeeds), 200, replace=False)]:
         if 0 <= x <= 100 and 0 <= y <= 80:
             assert z >= _disc_top(coefficients, x, y, 3.0) - 1e-3
+
+
+def test_coefficients_longer_than_python_prints_are_written_read_and_printed(run_cli, tmp_path):
+    # An exact fit of many points to a high degree has numerators and denominators of thousands of digits,
+    # past the 4,300 that Python converts to text by itself.
+    import io
+
+    from lagsym.export.surfacejson import write_surface_json
+
+    c = Fraction(3 * 10 ** 5000 + 1, 10 ** 5000 - 7)
+    points = [(Fraction(x), Fraction(y), c * x + y) for x in range(3) for y in range(3)]
+    fit = fit_surface(points, (1, 1))
+    assert fit.coefficients == ((0, 1), (c, 0))
+    buf = io.StringIO()
+    write_surface_json(buf, fit.surface, fit.coefficients, fit)
+    surf = tmp_path / "long.json"
+    surf.write_text(buf.getvalue())
+    assert lagrange_surface(read_points(surf)).coefficients == fit.surface.coefficients
+    status, out, err = run_cli("equation", surf)
+    assert status == 0, err
+    assert out.startswith("z = 3000") and "/9999" in out and len(out) > 10_000
+    assert run_cli("check", surf)[0] == 0

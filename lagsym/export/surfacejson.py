@@ -34,7 +34,13 @@ FORMAT = "lagsym-surface"
 
 
 def _text(v: Fraction) -> str:
-    return str(Fraction(v))
+    # Through python-flint: Python's own int-to-text conversion stops at 4,300 digits, and an exact fit of
+    # many points to a high degree has coefficients longer than that.
+    import flint
+
+    v = Fraction(v)
+    num = str(flint.fmpz(v.numerator))
+    return num if v.denominator == 1 else f"{num}/{flint.fmpz(v.denominator)}"
 
 
 def surface_document(surface, coefficients=None, fit=None) -> dict:

@@ -88,10 +88,13 @@ def _big(v: Any, where: str) -> Fraction:
     if isinstance(v, str) and _INTEGER_RATIO.match(v):
         if len(v) > _SURFACE_DIGITS:
             raise InputError(f"{where}: a number of {len(v)} characters is too long")
+        import flint  # Python's own text-to-int conversion stops at 4,300 digits; flint's does not
+
         num, _, den = v.partition("/")
-        if den and int(den) == 0:
+        d = int(flint.fmpz(den or "1"))
+        if d == 0:
             raise InputError(f"{where}: {v[:20]!r} divides by zero")
-        return Fraction(int(num), int(den or 1))
+        return Fraction(int(flint.fmpz(num.lstrip("+"))), d)
     return _value(v, where)
 
 
