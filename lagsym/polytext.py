@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["supported", "plain_text", "latex_text", "nested_text", "latex_decimal_text"]
+__all__ = ["supported", "plain_text", "latex_text", "nested_text", "latex_decimal_text", "fraction_text"]
 
 Monomial = tuple[int, ...]
 
@@ -62,6 +62,17 @@ def _digits(n: int) -> str:
     import flint
 
     return str(flint.fmpz(n))
+
+
+def fraction_text(c: Fraction) -> str:
+    """``str(c)`` for a fraction of any length.
+
+    Examples
+    --------
+    >>> fraction_text(Fraction(-3, 4)), fraction_text(Fraction(5))
+    ('-3/4', '5')
+    """
+    return _digits(c.numerator) if c.denominator == 1 else f"{_digits(c.numerator)}/{_digits(c.denominator)}"
 
 
 def _plain_term(key: Monomial, c: Fraction, names: tuple[str, ...]) -> str:

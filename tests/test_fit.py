@@ -294,4 +294,6 @@ def test_coefficients_longer_than_python_prints_are_written_read_and_printed(run
     status, out, err = run_cli("equation", surf)
     assert status == 0, err
     assert out.startswith("z = 3000") and "/9999" in out and len(out) > 10_000
+    status, out, err = run_cli("equation", surf, "--format", "json")
+    assert status == 0 and Fraction(json.loads(out)["coefficients"]["1,0"]) == c
     assert run_cli("check", surf)[0] == 0
