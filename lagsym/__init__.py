@@ -24,11 +24,13 @@ from typing import TYPE_CHECKING
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "errors": ("ExitStatus", "LagsymError", "InputError", "GridError", "FormulaError", "ToolpathError",
+    "errors": ("ExitStatus", "LagsymError", "InputError", "GridError", "ConditioningError", "FormulaError", "ToolpathError",
                "ProgramError", "RenderError", "TransferError"),
     "io": ("read_points", "read_curve_points", "read_any_points"),
     "grid": ("ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points"),
     "lagrange": ("LagrangeCurve", "LagrangeSurface", "lagrange_curve", "lagrange_surface", "lagrange_basis"),
+    "fit": ("SurfaceFit", "fit_surface"),
+    "conditioning": ("require_conditioning", "amplification"),
     "evaluate": ("SurfaceEvaluator", "surface_evaluator", "evaluate_points", "evaluate_grid", "evaluate_curve",
                  "lambdify_surface"),
     "sampling": ("Sample", "SampleGrid", "sample", "sample_grid"),
@@ -107,7 +109,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .compare import Comparison, DeviationMeasures, compare_surfaces, deviation_measures, render_table
     from .dnc import (PROFILES, LineFault, LineSettings, Program, TransferProgress, TransferResult, parse_program,
                       profile, receive_program, resume_setup, send_program, transfer_segments)
-    from .errors import (ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
+    from .errors import (ConditioningError, ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
     from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
     from .evaluate import (SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
@@ -121,6 +123,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .grid import ControlGrid, CurvePoints, curve_from_points, grid_from_points, grid_from_table
     from .io import read_any_points, read_curve_points, read_points
     from .lagrange import LagrangeCurve, LagrangeSurface, lagrange_basis, lagrange_curve, lagrange_surface
+    from .fit import SurfaceFit, fit_surface
+    from .conditioning import amplification, require_conditioning
     from .macro import (MacroProgram, RoughMacro, macro_program, planned_points, predicted_error, program_stats,
                         rough_macro, rough_macro_program)
     from .post.program import PointProgram, point_program, write_program

@@ -19,17 +19,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import ConditioningError
 from .evaluate import evaluate_grid, surface_evaluator
+from .grid import ControlGrid
 from .lagrange import LagrangeSurface
 
 __all__ = [
     "Finding", "CheckReport", "check_surface", "check_curve", "float_error_bound", "lebesgue_constant",
     "DEGREE_LIMIT", "SPACING_LIMIT", "LEBESGUE_LIMIT", "OVERSHOOT_LIMIT", "FLOAT_ERROR_LIMIT",
+    "AMPLIFICATION_LIMIT", "Amplification", "amplification", "require_conditioning", "lebesgue_maximum",
 ]
 
 DEGREE_LIMIT = 6  # the paper's danger line (section 4, item 4)
 SPACING_LIMIT = 5.0  # lagsym's, not the paper's; outside 1/5..5 the ratio is pointed out, never a warning
 LEBESGUE_LIMIT = 10.0  # data errors amplified more than tenfold
+# A surface amplifies errors in its points by up to the product of its axes' Lebesgue constants.  Above
+# 100, 0.01 mm of probe noise can become a millimetre.  The paper's examples stay below 5 (5x5 even
+# nodes: 4.87); even nodes pass up to 8x8 (48), 9x9 is refused (120); Chebyshev-like nodes pass at any
+# degree lagsym fits (12x12 of them: 6.2).
+AMPLIFICATION_LIMIT = 100.0
 OVERSHOOT_LIMIT = 0.10  # the surface leaves the data range by more than 10 % of it
 FLOAT_ERROR_LIMIT = 1e-12  # numeric samples trusted to this fraction of the data range
 EPS = float(np.finfo(float).eps)
@@ -102,25 +110,136 @@ def lebesgue_constant(nodes, samples: int = 17, rounds: int = 12) -> float:
     >>> round(lebesgue_constant([0, 1]), 12), round(lebesgue_constant(range(20)))
     (1.0, 5890)
     """
-    s = np.sort(np.asarray([float(v) for v in nodes]))
-    if len(s) < 2:
-        return 1.0
-    s = (s - s[0]) / (s[-1] - s[0])
+    return lebesgue_maximum(nodes, samples, rounds)[0]
+
+
+def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float, float]:
+    """The Lebesgue constant of ``nodes`` and where the Lebesgue function reaches it (a coordinate in their span).
+
+    The search of :func:`lebesgue_constant`, which this is.
+
+    Examples
+    --------
+    >>> value, at = lebesgue_maximum(range(12))
+    >>> round(value, 1), 0 < at < 1 or 10 < at < 11
+    (51.2, True)
+    """
+    raw = np.sort(np.asarray([float(v) for v in nodes]))
+    if len(raw) < 2:
+        return 1.0, float(raw[0]) if len(raw) else 0.0
+    s = (raw - raw[0]) / (raw[-1] - raw[0])
     diff = np.abs(s[:, None] - s[None, :])
     np.fill_diagonal(diff, 1.0)
     logw = -np.log(diff).sum(axis=1)
     lo, hi = s[:-1].copy(), s[1:].copy()
     u = np.linspace(0.0, 1.0, samples + 2)[1:-1]
     best = np.full(len(lo), -np.inf)
+    where = np.zeros(len(lo))
     for _ in range(rounds):
         t = lo[:, None] + (hi - lo)[:, None] * u
         vals = _log_lebesgue(s, logw, t)
         k = vals.argmax(axis=1)
-        best = np.maximum(best, vals[np.arange(len(lo)), k])
-        step = (hi - lo) / (samples + 1)
+        top = vals[np.arange(len(lo)), k]
         centre = t[np.arange(len(lo)), k]
+        where = np.where(top > best, centre, where)
+        best = np.maximum(best, top)
+        step = (hi - lo) / (samples + 1)
         lo, hi = np.maximum(centre - step, lo), np.minimum(centre + step, hi)
-    return float(np.exp(best.max()))
+    i = int(best.argmax())
+    return float(np.exp(best[i])), float(raw[0] + where[i] * (raw[-1] - raw[0]))
+
+
+@dataclass(frozen=True)
+class Amplification:
+    """How much a grid's Lagrange surface can amplify errors in its heights.
+
+    The surface is ``sum_ik L_i(x) L_k(y) z_ik``; an error ``e_ik`` in the
+    heights moves it by ``sum_ik L_i(x) L_k(y) e_ik``, at most
+    ``max|e| * (sum_i |L_i(x)|) (sum_k |L_k(y)|)``, whose largest value over
+    the box is the product of the two axes' Lebesgue constants (the tensor
+    Lebesgue function is the product of the 1-D ones, so the bound is
+    reached).
+
+    Attributes
+    ----------
+    value : float
+        ``lebesgue_x * lebesgue_y``.
+    lebesgue_x, lebesgue_y : float
+        Each axis's Lebesgue constant.
+    at : tuple of float
+        ``(x, y)`` where the amplification is largest.
+    limit : float
+        The limit it was judged against.
+    """
+
+    value: float
+    lebesgue_x: float
+    lebesgue_y: float
+    at: tuple[float, float]
+    limit: float = AMPLIFICATION_LIMIT
+    fitted: bool = False  # the value is a least-squares fit's, from the points it was fitted to
+
+    @property
+    def exceeds(self) -> bool:
+        """Whether the amplification is above :attr:`limit`."""
+        return self.value > self.limit
+
+    def text(self) -> str:
+        """The figure in words."""
+        if self.fitted:
+            return (f"errors in the measured points can be amplified up to {self.value:.4g} times by this "
+                    f"least-squares fit (its Lebesgue function sampled over the box)")
+        return (f"errors in the points can be amplified up to {self.value:.4g} times (Lebesgue constants "
+                f"{self.lebesgue_x:.4g} in x times {self.lebesgue_y:.4g} in y), worst near (x, y) = "
+                f"({self.at[0]:.4g}, {self.at[1]:.4g})")
+
+    def header_note(self) -> str:
+        """The program header's note when the surface was accepted above the limit."""
+        return f"conditioning {self.value:.4g}x above {self.limit:g} accepted (--accept-conditioning)"
+
+
+def amplification(surface, limit: float = AMPLIFICATION_LIMIT) -> Amplification:
+    """The :class:`Amplification` of a grid or of a :class:`~lagsym.lagrange.LagrangeSurface`.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_table
+    >>> a = amplification(grid_from_table(range(12), range(12), [[0] * 12] * 12))
+    >>> round(a.value), a.exceeds
+    (2623, True)
+    """
+    g = surface if isinstance(surface, ControlGrid) else surface.grid
+    lx, ax = lebesgue_maximum(g.x)
+    ly, ay = lebesgue_maximum(g.y)
+    if g.amplification is not None:  # the heights were computed from measured points: theirs is the figure
+        return Amplification(g.amplification, lx, ly, (ax, ay), limit, fitted=True)
+    return Amplification(lx * ly, lx, ly, (ax, ay), limit)
+
+
+def require_conditioning(surface, *, accept: bool = False, limit: float = AMPLIFICATION_LIMIT) -> Amplification:
+    """The surface's :class:`Amplification`, refused above ``limit`` unless ``accept``.
+
+    Every command that turns a surface into something physical (a toolpath, a
+    program, a macro, an exported or sampled file) asks this first: an
+    interpolant of measured points whose nodes amplify their errors a hundred
+    times machines the noise, not the part.
+
+    Raises
+    ------
+    ConditioningError
+        Naming the figure, where it is largest and the ways out: a
+        least-squares fit (``lagsym fit``), fewer or Chebyshev-spaced nodes,
+        or ``--accept-conditioning``.
+    """
+    a = amplification(surface, limit)
+    if a.exceeds and not accept:
+        g = surface if isinstance(surface, ControlGrid) else surface.grid
+        way = ("fit them at lower degrees (lagsym fit POINTS --degree auto)" if a.fitted else
+               f"fit the points instead (lagsym fit {g.source} -o surface.json), use fewer or Chebyshev-spaced nodes")
+        raise ConditioningError(
+            f"{g.source}: {a.text()}, above lagsym's limit of {limit:g}: 0.01 of measurement noise could move "
+            f"the surface by {0.01 * a.value:.3g}; {way}, or give --accept-conditioning to use it as it is")
+    return a
 
 
 def float_error_bound(surface: LagrangeSurface, box: tuple[float, float, float, float] | None = None) -> float:
@@ -144,13 +263,19 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
     g = surface.grid
     dx, dy = g.degree
     findings = []
-    for axis, d in (("x", dx), ("y", dy)):
-        findings.append(
-            Finding(
-                f"degree_{axis}", d, DEGREE_LIMIT, d > DEGREE_LIMIT,
-                f"degree in {axis}: {d}" + (f" (above {DEGREE_LIMIT}, the paper's danger line)" if d > DEGREE_LIMIT else f" (limit {DEGREE_LIMIT})"),
-            )
-        )
+    amp = amplification(g)
+    for axis, d, lam in (("x", dx, amp.lebesgue_x), ("y", dy, amp.lebesgue_y)):
+        # The paper's line at 6 was drawn for even spacing; what makes a degree dangerous is the amplification
+        # its nodes give (Chebyshev-like nodes at degree 11: 2.49), so the degree is judged by that.
+        bad = d > DEGREE_LIMIT and lam > LEBESGUE_LIMIT
+        if d <= DEGREE_LIMIT:
+            note = f" (the paper's line: {DEGREE_LIMIT})"
+        elif bad:
+            note = f" (above {DEGREE_LIMIT}, the paper's danger line, on nodes with Lebesgue constant {lam:.3g})"
+        else:
+            note = (f" (above the paper's {DEGREE_LIMIT}, but on well-spaced nodes: Lebesgue constant {lam:.3g}, "
+                    f"so not a danger)")
+        findings.append(Finding(f"degree_{axis}", d, DEGREE_LIMIT, bad, f"degree in {axis}: {d}{note}"))
     ratio = _spacing(g.x_array) / _spacing(g.y_array)
     far = ratio > SPACING_LIMIT or ratio < 1 / SPACING_LIMIT
     # Not a warning: x -> a x maps the interpolant onto itself, so nothing measured above or below changes.
@@ -160,13 +285,23 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
                 f"but rescaling an axis changes no measure of the surface"
                 + (f"; outside lagsym's 1/{SPACING_LIMIT:g}..{SPACING_LIMIT:g}" if far else "") + ")")
     )
-    for axis, nodes in (("x", g.x_array), ("y", g.y_array)):
-        lam = lebesgue_constant(nodes)
+    for axis, lam in (("x", amp.lebesgue_x), ("y", amp.lebesgue_y)):
         findings.append(
             Finding(f"lebesgue_{axis}", lam, LEBESGUE_LIMIT, lam > LEBESGUE_LIMIT,
                     f"Lebesgue constant of the {axis} nodes: {lam:.4g}"
-                    + (f" (data errors can be amplified {lam:.3g} times)" if lam > LEBESGUE_LIMIT else ""))
+                    + (f" (along {axis} alone, data errors can be amplified {lam:.3g} times)"
+                       if lam > LEBESGUE_LIMIT else ""))
         )
+    findings.append(
+        Finding("amplification", amp.value, AMPLIFICATION_LIMIT, amp.exceeds,
+                (f"surface amplification of errors in the measured points it was fitted to: {amp.value:.4g} "
+                 f"(the fit's Lebesgue function, sampled)" if amp.fitted else
+                 f"surface amplification of data errors: {amp.value:.4g} (the product of the two, worst near "
+                 f"(x, y) = ({amp.at[0]:.4g}, {amp.at[1]:.4g}))")
+                + (f": above {AMPLIFICATION_LIMIT:g}, so toolpath, rough, job, macro, export and sample refuse it "
+                   f"without --accept-conditioning; for measured points use 'lagsym fit'"
+                   if amp.exceeds else f" (limit {AMPLIFICATION_LIMIT:g})"))
+    )
     xs = np.linspace(g.x_array[0], g.x_array[-1], dx * samples_per_interval + 1)
     ys = np.linspace(g.y_array[0], g.y_array[-1], dy * samples_per_interval + 1)
     zs = evaluate_grid(surface, xs, ys)

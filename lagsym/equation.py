@@ -172,7 +172,7 @@ def _json(obj) -> str:
             "equation": f"z = {_expr_text(obj)}",
             "variables": [str(v) for v in obj.variables],
             "degree": {"x": obj.degree[0], "y": obj.degree[1]},
-            "coefficients": {f"{a},{b}": str(c) for (a, b), c in sorted(coeffs.items())},
+            "coefficients": {f"{a},{b}": polytext.fraction_text(c) for (a, b), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in g.x], "y": [str(v) for v in g.y]},
         }
     else:
@@ -180,7 +180,7 @@ def _json(obj) -> str:
             "equation": f"y = {_expr_text(obj)}",
             "variables": [str(obj.variable)],
             "degree": {"x": obj.degree},
-            "coefficients": {str(a): str(c) for (a,), c in sorted(coeffs.items())},
+            "coefficients": {str(a): polytext.fraction_text(c) for (a,), c in sorted(coeffs.items())},
             "nodes": {"x": [str(v) for v in obj.points.x]},
         }
     return json.dumps(doc, indent=2)

@@ -45,6 +45,10 @@ class GridError(InputError):
     """Control points that do not form the rectangular grid the method needs."""
 
 
+class ConditioningError(InputError):
+    """A surface that amplifies errors in its points beyond the limit, asked to become something physical."""
+
+
 class FormulaError(InputError):
     """A reference formula that does not parse under the strict grammar."""
 

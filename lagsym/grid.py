@@ -64,6 +64,11 @@ class ControlGrid:
     units : str or None
         The units of the coordinates where the file says them (``"mm"`` or
         ``"inch"``: a JSON ``"units"`` key or a header such as ``X (mm)``).
+    amplification : float or None
+        For heights computed from other, measured points (a least-squares
+        fit's values at its nodes): how much the surface can amplify errors
+        in those points.  None for measured heights, whose amplification is
+        the nodes' own (:func:`lagsym.conditioning.amplification`).
     """
 
     x: tuple[Fraction, ...]
@@ -71,6 +76,7 @@ class ControlGrid:
     z: tuple[tuple[Fraction, ...], ...]
     source: str = field(default="<points>", compare=False)
     units: str | None = field(default=None, compare=False)
+    amplification: float | None = field(default=None, compare=False)
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -316,6 +316,7 @@ class MachineSettings:
     feed_height_mm: float = 2.0
     coolant: str = "off"
     surface_units: str = "mm"
+    notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
     program: ProgramFormat = field(init=False, repr=False, compare=False)
     cutting: CuttingData = field(init=False, repr=False, compare=False)
     slot: ToolSlot = field(init=False, repr=False, compare=False)

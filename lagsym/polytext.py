@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["supported", "plain_text", "latex_text", "nested_text", "latex_decimal_text"]
+__all__ = ["supported", "plain_text", "latex_text", "nested_text", "latex_decimal_text", "fraction_text"]
 
 Monomial = tuple[int, ...]
 
@@ -54,13 +54,34 @@ def _factors(key: Monomial, names: tuple[str, ...]) -> list[tuple[str, int]]:
     return sorted(((names[v], p) for v, p in enumerate(key) if p), key=lambda t: t[0])
 
 
+def _digits(n: int) -> str:
+    """``str(n)`` for an integer of any length: Python's own conversion stops at 4,300 digits (an exact fit of
+    many points has longer coefficients); python-flint's does not."""
+    if n.bit_length() < 14_000:
+        return str(n)
+    import flint
+
+    return str(flint.fmpz(n))
+
+
+def fraction_text(c: Fraction) -> str:
+    """``str(c)`` for a fraction of any length.
+
+    Examples
+    --------
+    >>> fraction_text(Fraction(-3, 4)), fraction_text(Fraction(5))
+    ('-3/4', '5')
+    """
+    return _digits(c.numerator) if c.denominator == 1 else f"{_digits(c.numerator)}/{_digits(c.denominator)}"
+
+
 def _plain_term(key: Monomial, c: Fraction, names: tuple[str, ...]) -> str:
     """One term without its sign, as ``str`` writes it."""
     c = abs(c)
-    num = [str(c.numerator)] if c.numerator != 1 or not any(key) else []
+    num = [_digits(c.numerator)] if c.numerator != 1 or not any(key) else []
     num += [n if p == 1 else f"{n}**{p}" for n, p in _factors(key, names)]
     text = "*".join(num)
-    return text if c.denominator == 1 else f"{text}/{c.denominator}"
+    return text if c.denominator == 1 else f"{text}/{_digits(c.denominator)}"
 
 
 def _join(parts: list[tuple[bool, str]], sep_minus: str = " - ", first_minus: str = "-") -> str:
@@ -88,8 +109,8 @@ def plain_text(coeffs: dict[Monomial, Fraction], names: tuple[str, ...]) -> str:
 def _latex_term(key: Monomial, c: Fraction, names: tuple[str, ...]) -> str:
     c = abs(c)
     mono = " ".join(n if p == 1 else f"{n}^{{{p}}}" for n, p in _factors(key, names))
-    num = " ".join(t for t in (str(c.numerator) if c.numerator != 1 or not mono else "", mono) if t)
-    return num if c.denominator == 1 else f"\\frac{{{num}}}{{{c.denominator}}}"
+    num = " ".join(t for t in (_digits(c.numerator) if c.numerator != 1 or not mono else "", mono) if t)
+    return num if c.denominator == 1 else f"\\frac{{{num}}}{{{_digits(c.denominator)}}}"
 
 
 def latex_text(coeffs: dict[Monomial, Fraction], names: tuple[str, ...]) -> str:
@@ -175,12 +196,12 @@ def _str_sum(form: tuple[_Term, ...], names: tuple[str, ...]) -> str:
 
 def _str_term(t: _Term, names: tuple[str, ...]) -> str:
     c = abs(t.coeff)
-    num = [str(c.numerator)] if c.numerator != 1 or not (t.powers or t.sum) else []
+    num = [_digits(c.numerator)] if c.numerator != 1 or not (t.powers or t.sum) else []
     num += [n if p == 1 else f"{n}**{p}" for n, p in t.powers]
     if t.sum is not None:
         num.append(f"({_str_sum(t.sum, names)})")
     text = "*".join(num)
-    return text if c.denominator == 1 else f"{text}/{c.denominator}"
+    return text if c.denominator == 1 else f"{text}/{_digits(c.denominator)}"
 
 
 def nested_text(coefficients, names: tuple[str, ...]) -> str:

@@ -161,7 +161,8 @@ def test_sample_refuses_heights_whose_rounding_exceeds_the_data(run_cli, tmp_pat
     p = tmp_path / "g.json"
     p.write_text(json.dumps({"points": [[i, k, (i * 7 + k * 3) % 7] for i in range(n) for k in range(n)]}))
     one_line_error(*run_cli("sample", p, "--nx", "5"), "--accept-rounding")
-    assert run_cli("sample", p, "--nx", "5", "--accept-rounding")[0] == 0
+    one_line_error(*run_cli("sample", p, "--nx", "5", "--accept-rounding"), "--accept-conditioning")
+    assert run_cli("sample", p, "--nx", "5", "--accept-rounding", "--accept-conditioning")[0] == 0
 
 
 # 8. No quiet wrong output.

@@ -245,7 +245,8 @@ def test_cli_warns_when_rounding_cannot_be_trusted(run_cli, tmp_path):
     pts = [[k, j, int(v) / 100] for k in range(n) for j, v in zip(range(n), rng.integers(100, 340, n))]
     src = tmp_path / "rough.json"
     src.write_text(json.dumps(pts))
-    status, _, err = run_cli("sample", src, "--nx", "5", "-o", tmp_path / "o.csv")
+    # 20 x 20 even nodes amplify errors in the points beyond any use: accepted here to see the rounding warning.
+    status, _, err = run_cli("sample", src, "--nx", "5", "-o", tmp_path / "o.csv", "--accept-conditioning")
     assert status == 0
     assert "rounding error of the samples may reach" in err and "lagsym check" in err
     status, out, _ = run_cli("check", src, "--format", "json")

@@ -27,6 +27,7 @@ COMMANDS = {
     "equation": ["--digits", "--max-terms"],
     "curve": ["--digits"],
     "check": [],
+    "fit": ["--degree", "--max-degree", "--threshold"],
     "sample": ["--nx", "--ny", "--step", "--x0", "--max-points"],
     "compare": ["--samples", "--degree", "--tolerance"],
     "toolpath": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--spindle", "--safe-z",

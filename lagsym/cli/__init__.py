@@ -57,7 +57,8 @@ class _ParserExit(Exception):
 COMMANDS = {
     "equation": "print the exact Lagrange surface z = F(x, y) through a grid of control points",
     "curve": "print the exact Lagrange curve y = F(x) through a set of points",
-    "check": "measure degree, spacing ratio, Lebesgue constants and overshoot of a surface or curve",
+    "fit": "fit an exact least-squares polynomial surface to measured points (a grid or scattered) and write it",
+    "check": "measure degree, spacing ratio, Lebesgue constants, amplification of data errors and overshoot",
     "sample": "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)",
     "export": "write the exact surface as a CAD file: STEP or IGES B-spline surface or solid, exact JSON",
     "compare": "compare the Lagrange surface with Hermite, Bezier and B-spline surfaces (the paper's Table 1)",

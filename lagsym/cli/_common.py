@@ -61,6 +61,31 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
     return f.points
 
 
+ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points more than lagsym's limit "
+                            "(see 'lagsym check'); the program header records it")
+
+
+def add_conditioning_argument(p) -> None:
+    """``--accept-conditioning``, for the commands that turn a surface into something physical."""
+    p.add_argument("--accept-conditioning", action="store_true", help=ACCEPT_CONDITIONING_HELP)
+
+
+def conditioning_notes(grid, args, err: IO[str]) -> tuple[str, ...]:
+    """Refuse ``grid`` if it amplifies data errors beyond the limit, unless ``--accept-conditioning``.
+
+    Returns the program header's note when accepted above the limit (and says
+    so on ``err``), else nothing.
+    """
+    from ..conditioning import require_conditioning
+
+    a = require_conditioning(grid, accept=getattr(args, "accept_conditioning", False))
+    if not a.exceeds:
+        return ()
+    err.write(f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
+              f"accepted with --accept-conditioning\n")
+    return (a.header_note(),)
+
+
 # Every numeric option is checked here, once, as argparse reads it: finite and within a range that
 # the message states, so no command sees NaN, an infinity or a figure no machine or file can hold.
 def number(low: float, high: float, unit: str = "", *, above: bool = False):

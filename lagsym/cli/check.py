@@ -11,10 +11,14 @@ from ..lagrange import lagrange_curve, lagrange_surface
 from ._common import add_points_arguments, load_points
 
 DESCRIPTION = """Measure what the paper's section 4 warns about for the points in FILE:
-degree in each direction (above 6 is the paper's danger line), the spacing
-ratio between the directions, the Lebesgue constant of each node set and the
-overshoot of the interpolant between the nodes.  Warnings go to standard
-output; the exit status is 0, or 1 with --strict when there is a warning.
+degree in each direction (above the paper's line of 6 a warning only on
+nodes that amplify errors more than tenfold: Chebyshev-like nodes are well
+conditioned at any degree), the spacing ratio between the directions, the
+Lebesgue constant of each node set, the surface's amplification of errors in
+its points (their product; a fitted surface file's own figure), which the
+commands that machine or export a surface refuse above 100, and the overshoot
+of the interpolant between the nodes.  Warnings go to standard output; the
+exit status is 0, or 1 with --strict when there is a warning.
 
 examples:
   lagsym check examples/paper-example-4.json

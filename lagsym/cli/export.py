@@ -9,7 +9,7 @@ from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ._common import count
+from ._common import add_conditioning_argument, conditioning_notes, count
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
@@ -37,6 +37,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", required=True,
                    help=f"output file, format by extension: {', '.join(CAD_FORMATS)}")
     p.add_argument("--method", choices=METHODS, default="lagrange",
@@ -61,6 +62,8 @@ def run(args, out, err) -> int:
     units = grid.units or args.units or "mm"
     if args.units and units != args.units:
         raise InputError(f"{args.file}: the file states \"units\": \"{units}\", not --units {args.units}")
+    if args.method == "lagrange":  # the other methods do not interpolate, so do not amplify the points' errors
+        conditioning_notes(grid, args, err)
     patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree or 3)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
     lo, hi = grid.z_range()

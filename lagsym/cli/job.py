@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..io import write_text
-from ._common import cusp_note
+from ._common import add_conditioning_argument, conditioning_notes, cusp_note
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
@@ -20,6 +20,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("job", help="job file (TOML)")
+    add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     add_max_points(p)
 
@@ -42,7 +43,7 @@ def run(args, out, err) -> int:
     from ..job import job_program, plan_job, read_job
     from ._progress import progress_bar
 
-    spec = read_job(args.job)
+    spec = guard_job(read_job(args.job), args, err)
     with progress_bar(err) as progress:
         planned = plan_job(spec, args.max_points, args.max_samples, progress=progress)
     prog = job_program(planned)
@@ -52,6 +53,15 @@ def run(args, out, err) -> int:
         out.write(prog.text)
     report(planned, prog, err)
     return 0
+
+
+def guard_job(spec, args, err):
+    """The job, refused if its surface amplifies data errors beyond the limit (unless accepted, then noted)."""
+    from dataclasses import replace
+
+    from ..io import read_points
+
+    return replace(spec, notes=conditioning_notes(read_points(spec.points), args, err))
 
 
 def report(planned, prog, err) -> None:

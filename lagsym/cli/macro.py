@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
@@ -9,7 +11,7 @@ from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_p
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
 from ..macro.program import MAX_MACRO_POINTS
-from ._common import (dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (add_conditioning_argument, conditioning_notes, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -36,6 +38,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help=f"the control: {dialect_help(MACRO_DIALECTS)}")
     p.add_argument("--precision", type=int, choices=PRECISIONS,
                    help="significant digits of the control's arithmetic "
@@ -88,7 +91,9 @@ def settings_from(args, grid) -> tuple[MachineSettings, RasterSpec, Tool]:
 
 def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.file))
+    notes = conditioning_notes(surface.grid, args, err)
     settings, raster, tool = settings_from(args, surface.grid)
+    settings = replace(settings, notes=notes)
     program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,
                             variable_base=args.variable_base, form=args.form, variables=args.variables,
                             max_points=args.max_points)

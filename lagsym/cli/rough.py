@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import (dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
+from ._common import (add_conditioning_argument, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
                       number, origin)
 from .job import add_max_points
 
@@ -38,6 +38,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=names(point_lists=True), default="fanuc",
                    help=f"the control: {dialect_help(names(point_lists=True))}")
@@ -168,11 +169,11 @@ def run(args, out, err) -> int:
     from ..job.spec import parse_job
     from ..toolpath.rough import MAX_ROUGH_SAMPLES
     from ._progress import progress_bar
-    from .job import report
+    from .job import guard_job, report
 
     _refuse(args)
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
-    spec = parse_job(job_data(args), "lagsym rough")
+    spec = guard_job(parse_job(job_data(args), "lagsym rough"), args, err)
     with progress_bar(err) as progress:
         planned = plan_job(spec, args.max_points, samples, progress=progress)
     prog = job_program(planned)

@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..sampling import MAX_AXIS_POINTS, MAX_POINTS, Box, iter_blocks, sample_grid
-from ._common import count, exact
+from ._common import add_conditioning_argument, conditioning_notes, count, exact
 
 DESCRIPTION = f"""Sample the exact Lagrange surface through the control points in FILE on a
 regular grid and write the interior data, numerically stable at any density.
@@ -37,6 +37,7 @@ PROGRESS_POINTS = 250_000  # smaller jobs finish before a bar is worth drawing
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     d = p.add_argument_group("density (counts or spacing)")
     d.add_argument("--nx", type=count(2, MAX_AXIS_POINTS), metavar="N", help="grid lines in x, edges included (default 101; alone, also ny)")
     d.add_argument("--ny", type=count(2, MAX_AXIS_POINTS), metavar="N", help="grid lines in y, edges included (default: as --nx)")
@@ -95,6 +96,7 @@ def run(args, out, err) -> int:
         raise InputError(f"{args.file}: rounding error of the samples may reach {rel:.1e} times the data range, so the "
                          f"heights could be anything; use fewer or Chebyshev-spaced nodes, exact values from "
                          f"'lagsym equation', or --accept-rounding to write them anyway")
+    conditioning_notes(surface.grid, args, err)
     if rel > FLOAT_ERROR_LIMIT:
         err.write(f"lagsym: warning: rounding error of the samples may reach {rel:.1e} of the data range "
                   f"(trusted limit {FLOAT_ERROR_LIMIT:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "

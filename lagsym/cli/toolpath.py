@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ..controls import names
 from ..io import read_points, write_text
 from ..lagrange import lagrange_surface
@@ -10,7 +12,7 @@ from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import (dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+from ._common import (add_conditioning_argument, conditioning_notes, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._progress import progress_bar
 
@@ -33,6 +35,7 @@ POINT_DIALECTS = names(point_lists=True)
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=POINT_DIALECTS, default="fanuc",
                    help=f"the control: {dialect_help(POINT_DIALECTS)}")
@@ -90,7 +93,8 @@ def run(args, out, err) -> int:
     from ..toolpath import plan_toolpath
 
     grid = read_points(args.file)
-    settings = settings_from(args, args.dialect, grid)
+    notes = conditioning_notes(grid, args, err)
+    settings = replace(settings_from(args, args.dialect, grid), notes=notes)
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)

@@ -14,18 +14,26 @@ from ..values import exact_number
 from .files import MAX_BYTES, STDIN_SILENCE_S, EventLog, event_log, read_bytes, read_program, read_text
 from .points import (
     TABLE_SUFFIXES,
+    SURFACE_FORMAT,
     PointsFile,
+    ScatteredPoints,
     parse_curve_points,
     parse_points,
     read_any_points,
     read_curve_points,
     read_point_file,
     read_points,
+    read_scattered_points,
+    surface_file,
 )
 from .write import atomic_path, atomic_write, check_output, write_text
 
 __all__ = [
     "read_points",
+    "read_scattered_points",
+    "ScatteredPoints",
+    "surface_file",
+    "SURFACE_FORMAT",
     "read_point_file",
     "PointsFile",
     "read_curve_points",

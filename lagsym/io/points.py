@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,8 @@ from ..values import MAX_EXPONENT, NotANumber, choice, exact_number
 from .files import read_text
 from .table import UNIT_NAMES, parse_columns, read_table
 
-__all__ = ["PointsFile", "read_point_file", "read_points", "read_curve_points", "read_any_points", "parse_points",
+__all__ = ["PointsFile", "read_point_file", "surface_file", "SURFACE_FORMAT", "ScatteredPoints",
+           "read_scattered_points", "read_points", "read_curve_points", "read_any_points", "parse_points",
            "parse_curve_points", "TABLE_SUFFIXES"]
 
 def _json_float(text: str) -> Fraction:
@@ -76,6 +78,83 @@ def _short(v: Any) -> str:
 
 
 TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".xyz", ".dat", ".asc")
+SURFACE_FORMAT = "lagsym-surface"
+_INTEGER_RATIO = re.compile(r"^[+-]?\d+(/\d+)?$")
+_SURFACE_DIGITS = 1_000_000  # an exact fit's coefficients run to thousands of digits; a million is no coefficient
+
+
+def _big(v: Any, where: str) -> Fraction:
+    """An exact number of a surface file, where a rational may have far more digits than a measured value."""
+    if isinstance(v, str) and _INTEGER_RATIO.match(v):
+        if len(v) > _SURFACE_DIGITS:
+            raise InputError(f"{where}: a number of {len(v)} characters is too long")
+        import flint  # Python's own text-to-int conversion stops at 4,300 digits; flint's does not
+
+        num, _, den = v.partition("/")
+        d = int(flint.fmpz(den or "1"))
+        if d == 0:
+            raise InputError(f"{where}: {v[:20]!r} divides by zero")
+        return Fraction(int(flint.fmpz(num.lstrip("+"))), d)
+    return _value(v, where)
+
+
+def _table_of(name: str, data: dict, key: str, depth: int) -> list:
+    value = data.get(key)
+    if not isinstance(value, list) or not value or (depth == 2 and not all(isinstance(r, list) and r for r in value)):
+        shape = "a list of rows of numbers" if depth == 2 else "a list of numbers"
+        raise InputError(f"{name}: \"{key}\" should be {shape}, found {_short(value)}")
+    if depth == 1:
+        return [_big(v, f"{name}: {key}[{i}]") for i, v in enumerate(value)]
+    return [[_big(v, f"{name}: {key}[{i}][{k}]") for k, v in enumerate(row)] for i, row in enumerate(value)]
+
+
+def surface_file(name: str, data: dict) -> ControlGrid:
+    """The grid of a ``lagsym-surface`` document (:mod:`lagsym.export.surfacejson`), checked exactly.
+
+    Every height must be the value of the file's polynomial at its node, so
+    the Lagrange surface through the grid is that polynomial; a file whose
+    heights and coefficients disagree (edited by hand) is refused, naming the
+    first node that differs.
+    """
+    if data.get("format") != SURFACE_FORMAT:
+        raise InputError(f"{name}: \"format\": {_short(data.get('format'))} is not one lagsym reads as points "
+                         f"(a {SURFACE_FORMAT!r} file, or a list of points)")
+    if data.get("version") != 1:
+        raise InputError(f"{name}: {SURFACE_FORMAT} version {_short(data.get('version'))} is not 1")
+    coeffs = _table_of(name, data, "coefficients", 2)
+    if len({len(r) for r in coeffs}) != 1:
+        raise InputError(f"{name}: the rows of \"coefficients\" differ in length")
+    xs, ys, z = (_table_of(name, data, k, d) for k, d in (("x", 1), ("y", 1), ("z", 2)))
+    p, q = len(coeffs) - 1, len(coeffs[0]) - 1
+    if data.get("degree") != [p, q]:
+        raise InputError(f"{name}: \"degree\": {_short(data.get('degree'))} does not match the coefficients "
+                         f"(degree {p}x{q})")
+    if len(xs) <= p or len(ys) <= q:
+        raise InputError(f"{name}: {len(xs)} x {len(ys)} nodes cannot hold a polynomial of degree {p}x{q}; "
+                         f"it needs at least {p + 1} x {q + 1}")
+    grid = grid_from_table(xs, ys, z, source=name, units=_units(name, data))
+    amp = data.get("amplification")
+    if amp is not None:
+        if isinstance(amp, bool) or not isinstance(amp, (int, Fraction)) or not 1 <= amp < 10 ** 300:
+            raise InputError(f"{name}: \"amplification\": {_short(amp)} should be a number of at least 1")
+        grid = replace(grid, amplification=float(amp))
+    # One exact matrix product gives every node's value: V_x C V_y^T.
+    import flint
+
+    def fq(v: Fraction):
+        return flint.fmpq(v.numerator, v.denominator)
+
+    vx = flint.fmpq_mat(len(grid.x), p + 1, [fq(v ** a) for v in grid.x for a in range(p + 1)])
+    vy = flint.fmpq_mat(len(grid.y), q + 1, [fq(v ** b) for v in grid.y for b in range(q + 1)])
+    values = vx * flint.fmpq_mat(p + 1, q + 1, [fq(c) for row in coeffs for c in row]) * vy.transpose()
+    for i, xi in enumerate(grid.x):
+        for k, yk in enumerate(grid.y):
+            v = values[i, k]
+            if Fraction(int(v.p), int(v.q)) != grid.z[i][k]:
+                raise InputError(f"{name}: the height at (x, y) = ({float(xi):.6g}, {float(yk):.6g}) is not the "
+                                 f"polynomial's value there (the file was changed after it was written); "
+                                 f"write it again with 'lagsym fit'")
+    return grid
 
 
 def _kind(name: str, text: str) -> str:
@@ -157,6 +236,10 @@ def _json_points(name: str, text: str, arity: int | None):
     data = _load_json(name, text)
     units = _units(name, data)
     if isinstance(data, dict):
+        if "format" in data:
+            if arity == 2:
+                raise InputError(f"{name}: a {data['format']!r} file holds a surface, not curve points")
+            return surface_file(name, data), 3, f"{SURFACE_FORMAT} file", units
         if "points" in data:
             data = data["points"]
         elif {"x", "y", "z"} <= data.keys() and arity != 2:
@@ -226,6 +309,60 @@ def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None
         points, report = snap_points(points, snap, axes=arity - 1, source=name)
     build = grid_from_points if arity == 3 else curve_from_points
     return PointsFile(build(points, source=name, units=units), layout, plain, report)
+
+
+@dataclass(frozen=True)
+class ScatteredPoints:
+    """Points ``(x, y, z)`` as a file lists them, in no grid (for :func:`lagsym.fit.fit_surface`).
+
+    Attributes
+    ----------
+    points : tuple of (Fraction, Fraction, Fraction)
+        The points in the file's order (a grid file's x-major).
+    source : str
+        The file name.
+    units : str or None
+        The units where the file says them.
+    layout : str
+        How the file was read, in words.
+    plain : bool
+        True for the layouts that need no saying.
+    """
+
+    points: tuple[tuple[Fraction, Fraction, Fraction], ...]
+    source: str
+    units: str | None
+    layout: str
+    plain: bool = True
+
+
+def read_scattered_points(path: str | os.PathLike, columns=None) -> ScatteredPoints:
+    """Read surface points that need not form a grid: scattered, or a grid with points missing.
+
+    The layouts are those of :func:`read_points`; a repeated ``(x, y)`` is
+    refused (two heights for one place are two measurements to average
+    first, or a mistake).
+    """
+    name, text = read_text(path)
+    cols = parse_columns(columns, 3) if columns else None
+    if _kind(name, text) == "json":
+        if cols:
+            raise InputError(f"{name}: --columns is for tables (CSV, TSV, .xyz); a JSON file names its values")
+        points, _, layout, units = _json_points(name, text, 3)
+        plain = True
+    else:
+        points, table = read_table(name, text, 3, cols)
+        layout, units, plain = table.describe(), table.units, table.plain
+    if isinstance(points, ControlGrid):
+        units = units or points.units
+        points = points.points()
+    seen: dict[tuple[Fraction, Fraction], int] = {}
+    for idx, pt in enumerate(points):
+        if (pt[0], pt[1]) in seen:
+            raise InputError(f"{name}: points {seen[(pt[0], pt[1])] + 1} and {idx + 1} are both at (x, y) = "
+                             f"({float(pt[0]):g}, {float(pt[1]):g}); average them or drop one")
+        seen[(pt[0], pt[1])] = idx
+    return ScatteredPoints(tuple(tuple(pt) for pt in points), name, units, layout, plain)
 
 
 def parse_points(text: str, source: str = "<points>", kind: str = "json") -> ControlGrid:

@@ -84,6 +84,7 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
     elif title:
         out.append(f.comment(title))
     st = job.stock
+    out += [f.comment(iso_comment(n)) for n in spec.notes]
     out.append(f.comment(iso_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM")))
     for i, (op, m) in enumerate(zip(job.operations, minutes), 1):
         t = op.tool

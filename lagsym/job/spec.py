@@ -100,6 +100,7 @@ class JobSpec:
     tools: dict
     operations: tuple
     variables: str = "full"
+    notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
 
 
 def read_job(path) -> JobSpec:

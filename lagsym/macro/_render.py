@@ -18,7 +18,8 @@ def header_comments(loops, settings: MachineSettings, precision: int) -> list[st
     """What the program is, in ISO comment text: the form, the raster, the surface's units."""
     f, r = loops.form, loops.raster
     return [iso_comment(f"surface {f.shape[0]}x{f.shape[1]} normalized {f.kind} {precision} digit arithmetic"),
-            iso_comment(f"{r.size} points rows along {r.direction}"), surface_comment(settings)]
+            iso_comment(f"{r.size} points rows along {r.direction}"), surface_comment(settings),
+            *(iso_comment(n) for n in settings.notes)]
 
 
 def _z(settings: MachineSettings, value_mm: float) -> str:

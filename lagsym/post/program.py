@@ -42,6 +42,7 @@ def blocks(program: PointProgram) -> list[str]:
     else:
         out += [f.comment(t) for t in (title, tool) if t]
     out.append(f.comment(surface_comment(s)))
+    out += [f.comment(iso_comment(n)) for n in s.notes]
     out.append(f"{units_word(s)} {f.safe_start}")
     if f.tool_change:
         out.append(f"T{s.tool_number} {f.tool_change}")

@@ -1,0 +1,145 @@
+"""The exact least-squares solve: the data in integers, integer moments, one exact solve, exact residuals.
+
+Every coordinate is scaled to an integer (``x * Dx``, ``Dx`` the common
+denominator of the x values: for decimals a power of ten) and shifted by an
+integer near the middle of its range, so the moments ``sum_k w_k u_k**s
+v_k**t`` and the right-hand side are integer matrix products
+(python-flint's ``fmpz_mat``); the normal equations are solved exactly
+(``fmpz_mat.solve``) and the solution carried back to powers of ``x`` and
+``y`` by the exact binomial change of variables.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+
+import flint
+
+from ..errors import GridError
+
+__all__ = ["fit_coefficients"]
+
+
+def _common_denominator(values: Sequence[Fraction]) -> int:
+    d = 1
+    for v in values:
+        d = math.lcm(d, v.denominator)
+    return d
+
+
+def _powers(values: Sequence[int], top: int) -> list[list[int]]:
+    rows = []
+    for v in values:
+        row, acc = [1], 1
+        for _ in range(top):
+            acc *= v
+            row.append(acc)
+        rows.append(row)
+    return rows
+
+
+def _shift_matrix(scale: int, shift: int, degree: int) -> list[list[int]]:
+    """``T[a][e]``: the coefficient of ``x**e`` in ``(scale * x - shift)**a``."""
+    return [[math.comb(a, e) * scale ** e * (-shift) ** (a - e) if e <= a else 0 for e in range(degree + 1)]
+            for a in range(degree + 1)]
+
+
+@dataclass(frozen=True)
+class _Scaled:
+    """The data in integers: ``x = X / dx``, ``y = Y / dy``, ``z = Z / dz``, ``w = W / dw``."""
+
+    X: list[int]
+    Y: list[int]
+    Z: list[int]
+    W: list[int]
+    dx: int
+    dy: int
+    dz: int
+    dw: int
+
+    @classmethod
+    def of(cls, points, weights) -> _Scaled:
+        xs, ys, zs = ([pt[i] for pt in points] for i in range(3))
+        dx, dy, dz = (_common_denominator(v) for v in (xs, ys, zs))
+        if weights is None:
+            W, dw = [1] * len(points), 1
+        else:
+            dw = _common_denominator(weights)
+            W = [int(w * dw) for w in weights]
+        return cls([int(v * dx) for v in xs], [int(v * dy) for v in ys], [int(v * dz) for v in zs], W,
+                   dx, dy, dz, dw)
+
+
+def fit_coefficients(points: Sequence[Sequence[Fraction]], degree: tuple[int, int],
+                     weights: Sequence[Fraction] | None = None,
+                     source: str = "<points>") -> tuple[tuple[Fraction, ...], ...]:
+    """The exact least-squares coefficients ``c[a][b]`` (of ``x**a y**b``) of degree ``degree`` through ``points``.
+
+    Raises
+    ------
+    GridError
+        When the points do not determine a polynomial of that degree (too few
+        distinct x or y values, or too few points).
+
+    Examples
+    --------
+    >>> pts = [(0, 0, 1), (1, 0, 3), (0, 1, 2), (1, 1, 4), (2, 2, 7)]
+    >>> fit_coefficients([(Fraction(x), Fraction(y), Fraction(z)) for x, y, z in pts], (1, 1))
+    ((Fraction(1, 1), Fraction(1, 1)), (Fraction(2, 1), Fraction(0, 1)))
+    """
+    pts = [tuple(Fraction(v) for v in pt) for pt in points]
+    ws = None if weights is None else [Fraction(w) for w in weights]
+    return _solve(_Scaled.of(pts, ws), degree, source)
+
+
+def _solve(s: _Scaled, degree: tuple[int, int], source: str) -> tuple[tuple[Fraction, ...], ...]:
+    p, q = degree
+    # Integer shifts near the middle keep the powers, and so the exact numbers, small.
+    cx, cy = (min(s.X) + max(s.X)) // 2, (min(s.Y) + max(s.Y)) // 2
+    pu = _powers([v - cx for v in s.X], 2 * p)
+    pv = _powers([v - cy for v in s.Y], 2 * q)
+    n = len(s.X)
+    wu = flint.fmpz_mat(2 * p + 1, n, [w * r[e] for e in range(2 * p + 1) for w, r in zip(s.W, pu)])
+    wzu = flint.fmpz_mat(p + 1, n, [w * z * r[e] for e in range(p + 1) for w, z, r in zip(s.W, s.Z, pu)])
+    moments = wu * flint.fmpz_mat(n, 2 * q + 1, [c for r in pv for c in r])  # sum w u**s v**t
+    rhs = wzu * flint.fmpz_mat(n, q + 1, [c for r in pv for c in r[:q + 1]])
+    k = (p + 1) * (q + 1)
+    idx = [(a, b) for a in range(p + 1) for b in range(q + 1)]
+    gram = flint.fmpz_mat(k, k, [moments[a + c, b + d] for a, b in idx for c, d in idx])
+    r = flint.fmpz_mat(k, 1, [rhs[a, b] for a, b in idx])
+    try:
+        sol = gram.solve(r)
+    except ZeroDivisionError:
+        nx, ny = len(set(s.X)), len(set(s.Y))
+        raise GridError(
+            f"{source}: the {n} points do not determine a degree {p}x{q} polynomial ({k} coefficients from "
+            f"{nx} distinct x and {ny} distinct y values); give lower degrees"
+        ) from None
+    cu = flint.fmpq_mat(p + 1, q + 1, [sol[i, 0] for i in range(k)])
+    tx = flint.fmpq_mat(p + 1, p + 1, [v for row in _shift_matrix(s.dx, cx, p) for v in row])
+    ty = flint.fmpq_mat(q + 1, q + 1, [v for row in _shift_matrix(s.dy, cy, q) for v in row])
+    c = tx.transpose() * cu * ty / s.dz
+    return tuple(tuple(Fraction(int(c[a, b].p), int(c[a, b].q)) for b in range(q + 1)) for a in range(p + 1))
+
+
+def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
+    """``z - p(x, y)`` for every point exactly, as integers over one denominator.
+
+    With ``x = X / dx`` and ``C`` the coefficients times their common
+    denominator ``den``: ``den dx**P dy**Q p(x, y) = sum_ab C[a][b] X**a
+    dx**(P-a) Y**b dy**(Q-b)``, one integer matrix-vector product whose
+    matrix holds only the data's small integers.
+    """
+    den = _common_denominator([c for row in coefficients for c in row])
+    P, Q = len(coefficients) - 1, len(coefficients[0]) - 1
+    n = len(s.X)
+    col = flint.fmpz_mat((P + 1) * (Q + 1), 1, [int(c * den) for row in coefficients for c in row])
+    xs = [[x ** a * s.dx ** (P - a) for a in range(P + 1)] for x in s.X]
+    ys = [[y ** b * s.dy ** (Q - b) for b in range(Q + 1)] for y in s.Y]
+    basis = flint.fmpz_mat(n, (P + 1) * (Q + 1), [u * v for rx, ry in zip(xs, ys) for u in rx for v in ry])
+    values = basis * col
+    scale = den * s.dx ** P * s.dy ** Q
+    return tuple(z * scale - int(values[k, 0]) * s.dz for k, z in enumerate(s.Z)), scale * s.dz
