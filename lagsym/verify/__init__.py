@@ -26,12 +26,16 @@ reached at a real position on a move.  For the ball and the flat end it is
 the lowest there is over the cell centre (``resolution_mm`` 0: floating-point
 rounding apart); for the bull nose, whose lowest point along a move has no
 closed form, the tool sweeps at most ``resolution_mm`` lower
-(:func:`lagsym.verify.swept.bull_resolution`, below 1e-4 mm).  So a gouge it reports is
+(:func:`lagsym.verify.swept.bull_resolution`, below 1e-4 mm).  The figures are
+not read off the cell centres alone (:mod:`lagsym.verify.bounds`, docs/verify.md):
+material left and the scallop are upper bounds over every triangle of
+centres (the swept tool is convex over each move), and the gouge and the
+rapid's depth are evaluated exactly at the critical points found from every
+centre, so neither is understated whatever the cell.  A gouge reported is
 real, and the depth from which a cut counts as a gouge needs no room for the
 simulation: by default it is what the program's rounding can cause,
 :func:`gouge_limit` (half a unit of the last decimal, and that much sideways
-on each axis times the steepest slope of the surface).  Material left is
-overstated by at most ``resolution_mm``.
+on each axis times the steepest slope of the surface).
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ from ..machine import MAX_LEFT_MM, Placement, Tool, mm_per_program_unit
 from ..progress import Progress
 from .bounds import curvature_limits, deepest_cut, left_bound
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
+from .swept import lowest_along
 
 __all__ = ["CutReport", "simulate_cut", "press_moves", "height_map_axes", "gouge_limit", "program_resolution_mm",
            "MAX_CELLS", "MAX_CONTACTS", "MAX_LEFT_MM"]
@@ -317,7 +322,8 @@ def _left(cut, surf, slope, winner, moves, grid, curvature, ev, placement) -> di
                 np.hypot(ev.fast_points(sx, sy, dx=1), ev.fast_points(sx, sy, dy=1)))
 
     norm, height, px, py, ti, tj = left_bound(cut, surf, winner, moves, grid, curvature=(slope, m_top, m_abs),
-                                              cosine=_cosine, skip_below=best["scallop_mm"], surface_at=surface_at)
+                                              cosine=_cosine, skip_below=best["scallop_mm"], surface_at=surface_at,
+                                              inner=inner)
     if len(norm):
         k = int(np.argmax(norm))
         if norm[k] > best["left_mm"]:
@@ -344,7 +350,7 @@ def _rapids(ev, placement, surf, path, use, lines, grid, curvature):
 
     All rapids are pressed into one map; the depth is searched between the
     cell centres as for the feed moves (:func:`lagsym.verify.bounds.deepest_cut`),
-    and the line is that of the rapid that reaches it.
+    and the line is that of the first rapid that reaches the deepest point.
     """
     xs, ys, r, corner = grid
     none = (0.0, (float(xs[0]), float(ys[0])), 0)
@@ -358,4 +364,7 @@ def _rapids(ev, placement, surf, path, use, lines, grid, curvature):
                                      curvature=curvature)
     if not depth > 0.0:
         return none, segments
-    return (float(depth), where, int(lines[k[move]])), segments
+    # The first rapid that reaches the deepest point (a retract from it reaches it too).
+    low = lowest_along(path[k], path[k + 1], where[0], where[1], r, corner)
+    first = int(np.flatnonzero(low <= np.nanmin(low) + 1e-9)[0]) if np.isfinite(low).any() else move
+    return (float(depth), where, int(lines[k[first]])), segments

@@ -46,7 +46,7 @@ NEWTON_STEPS = 4  # Newton steps from each cell centre towards the highest point
 CURVATURE_MARGIN = 1.25  # the largest sampled curvature of the surface, with a quarter added
 _BIG = 1.0e30  # stands for a move that does not cover a corner
 SPLIT = 8  # squares whose bound is above the figure reached are split SPLIT x SPLIT
-_SPLIT_BATCH = 512  # squares split at a time
+_SPLIT_BATCH = 256  # squares split at a time
 _CORNERS = ((0, 0), (1, 0), (0, 1), (1, 1))
 _TRIANGLES = ((0, 1, 3), (0, 2, 3))  # each square cut along its diagonal from its first corner
 
@@ -111,15 +111,16 @@ def _game(d):
     return best, where
 
 
-def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below, surface_at, split=SPLIT):
+def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below, surface_at, inner, split=SPLIT):
     """The most material left over the triangles of the grid, bounded from above; see the module.
 
     ``moves = (a, b)`` the moves the ``winner`` map indexes, ``grid = (xs, ys,
     r, corner)``, ``curvature = (slope, M, Mabs)``: the surface's slope at the
     centres and :func:`curvature_limits`; ``cosine(slope)`` the normal factor
     of a slope; ``surface_at(x_mm, y_mm)`` the surface's height and slope at
-    points; ``skip_below`` a normal figure already reached at a cell centre:
-    triangles whose bound is below it are not refined.  Triangles whose bound
+    points; ``inner`` the centres the scallop is measured over; ``skip_below``
+    a normal figure already reached at a cell centre inside: triangles whose
+    bound is below it are not refined.  Triangles whose bound
     is above it are split ``split`` x ``split`` and bounded again with the
     same moves.  Returns ``(normal, height, x, y, i, j)`` over the triangles
     solved (flat arrays), ``(i, j)`` the square's first corner.
@@ -142,12 +143,15 @@ def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below,
                 d[k, c, ok] = np.where(np.isfinite(e), e - surf[i[ok] + di, j[ok] + dj], _BIG)
     out = []
     extra = np.full((8, len(i)), -1, dtype=np.int64)
+    lost_in = {}
     for t, tri in enumerate(_TRIANGLES):
         dt = d[:, list(tri), :]
         lost = np.flatnonzero(~(dt < _BIG).all(axis=1).any(axis=0))
         if len(lost):
             # No move lowest at a corner covers the whole triangle: try those lowest at the 32 centres around.
             dt[:, :, lost], extra[4 * t:4 * t + 4, lost] = _wider(lost, tri, (i, j), (cut, surf, winner), moves, grid)
+        lost_in[t] = np.zeros(len(i), dtype=bool)
+        lost_in[t][lost] = True
         slope = np.min(np.stack([slope_at[i + _CORNERS[v][0], j + _CORNERS[v][1]] for v in tri]), axis=0)
         # The convex bound: the lowest over the moves of their highest corner.
         cheap = np.min(np.where((dt < _BIG).all(axis=1), dt.max(axis=1), _BIG), axis=0)
@@ -157,39 +161,58 @@ def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below,
             continue
         vx = np.stack([xs[i[k] + _CORNERS[v][0]] for v in tri])
         vy = np.stack([ys[j[k] + _CORNERS[v][1]] for v in tri])
-        normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], (hx, hy), (m_top, m_abs), cosine)
+        ids = np.where(lost_in[t][None, :], extra[4 * t:4 * t + 4], w)
+        normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], (hx, hy), (m_top, m_abs), cosine, ids[:, k])
         out.append([normal, height, px, py, i[k], j[k]])
     if not out:
         return tuple(np.zeros(0) for _ in range(6))
     normal, height, px, py, ti, tj = (np.concatenate(p) for p in zip(*out))
     sny = ny - 1
-    # Split the squares whose bound is above the figure already reached, and bound them again.
-    sq = np.unique(ti[normal > skip_below] * sny + tj[normal > skip_below])
-    wide = (extra[:, sq] >= 0).any(axis=0)
-    for group in (sq[~wide], sq[wide]):
-        for s0 in range(0, len(group), _SPLIT_BATCH):
-            part = group[s0:s0 + _SPLIT_BATCH]
-            si, sj = part // sny, part % sny
+    # Split the squares whose bound is above the figure reached, highest first; a square whose bound is
+    # below the highest bound already final cannot change the figure (nor, inside, the scallop's).
+    key = ti * sny + tj
+    sq_inner = inner[:-1, :-1] & inner[1:, :-1] & inner[:-1, 1:] & inner[1:, 1:]
+    top = np.full(sny * (nx - 1), -np.inf)
+    np.maximum.at(top, key, normal)
+    order = np.argsort(-top)
+    order = order[top[order] > skip_below]
+    final_all = final_in = skip_below
+    s0 = 0
+    while s0 < len(order):
+        part = order[s0:s0 + _SPLIT_BATCH]
+        s0 += _SPLIT_BATCH
+        need = top[part] > np.where(sq_inner.ravel()[part], final_in, final_all)
+        part = np.sort(part[need])
+        if not len(part):
+            continue
+        for group in (part[~(extra[:, part] >= 0).any(axis=0)], part[(extra[:, part] >= 0).any(axis=0)]):
+            if not len(group):
+                continue
+            si, sj = group // sny, group % sny
             cand = np.stack([winner[si + di, sj + dj] for di, dj in _CORNERS])
-            if (extra[:, part] >= 0).any():
-                cand = np.concatenate([cand, extra[:, part]])
+            if (extra[:, group] >= 0).any():
+                cand = np.concatenate([cand, extra[:, group]])
             fine = _split(si, sj, cand, moves, grid, surface_at=surface_at, split=split,
                           curvature=(m_top, m_abs), cosine=cosine)
             # A square none of whose small triangles a move tried covers keeps its coarse bound.
-            mine = np.isin(ti * sny + tj, part)
+            mine = np.isin(key, group)
             lost = ~np.isfinite(fine[1])
             if lost.any():
                 best_of = {}
                 for q in np.flatnonzero(mine):
-                    key = int(ti[q] * sny + tj[q])
-                    if key not in best_of or normal[q] > normal[best_of[key]]:
-                        best_of[key] = q
-                src = np.array([best_of[int(v)] for v in part[lost]])
+                    if int(key[q]) not in best_of or normal[q] > normal[best_of[int(key[q])]]:
+                        best_of[int(key[q])] = q
+                src = np.array([best_of[int(v)] for v in group[lost]])
                 for f, v in zip(fine[:4], (normal, height, px, py)):
                     f[lost] = v[src]
             # Each square's two coarse triangles give way to the highest of its small ones.
             normal, height, px, py, ti, tj = (np.concatenate([v[~mine], f]) for v, f in
                                               zip((normal, height, px, py, ti, tj), fine))
+            key = ti * sny + tj
+            final_all = max(final_all, float(fine[0].max()))
+            ins = sq_inner.ravel()[group]
+            if ins.any():
+                final_in = max(final_in, float(fine[0][ins].max()))
     return normal, height, px, py, ti, tj
 
 
@@ -202,9 +225,21 @@ def _raise(value, slope, cell, curvature, cosine):
     return height * cosine(np.maximum(slope - m_abs * 0.5 * np.hypot(hx, hy), 0.0)), height
 
 
-def _solve(d, vx, vy, slope, cell, curvature, cosine):
-    """The bound over triangles: ``d`` ``(K, 3, n)`` is ``E_k - S`` at their corners ``(vx, vy)`` ``(3, n)``."""
-    val, lam = _game(np.where((d < _BIG).all(axis=1)[:, None, :], d, _BIG))
+def _solve(d, vx, vy, slope, cell, curvature, cosine, ids):
+    """The bound over triangles: ``d`` ``(K, 3, n)`` is ``E_k - S`` at their corners ``(vx, vy)`` ``(3, n)``
+    for the moves ``ids`` ``(K, n)``; a move met twice, or not covering a corner, is left out."""
+    valid = (d < _BIG).all(axis=1) & (ids >= 0)
+    for k in range(1, len(ids)):
+        valid[k] &= ~(ids[:k] == ids[k]).any(axis=0)
+    # The games of one, two, ... moves are solved apart: most triangles see one or two.
+    order = np.argsort(~valid, axis=0, kind="stable")
+    d = np.take_along_axis(d, order[:, None, :], axis=0)
+    count = valid.sum(axis=0)
+    val, lam = np.full(d.shape[2], _BIG), np.zeros((3, d.shape[2]))
+    for kv in range(1, len(ids) + 1):
+        cols = np.flatnonzero(count == kv)
+        if len(cols):
+            val[cols], lam[:, cols] = _game(d[:kv, :, cols])
     normal, height = _raise(val, slope, cell, curvature, cosine)
     return normal, height, (lam * vx).sum(axis=0), (lam * vy).sum(axis=0)
 
@@ -243,7 +278,7 @@ def _split(si, sj, cand, moves, grid, *, surface_at, split, curvature, cosine):
     vx = px[corners].transpose(1, 0, 2).reshape(3, m * n)
     vy = py[corners].transpose(1, 0, 2).reshape(3, m * n)
     sl = slope[corners].min(axis=1).reshape(m * n)
-    normal, height, qx, qy = _solve(dt, vx, vy, sl, (hx, hy), curvature, cosine)
+    normal, height, qx, qy = _solve(dt, vx, vy, sl, (hx, hy), curvature, cosine, np.tile(w, (1, m)))
     normal, height = normal.reshape(m, n), height.reshape(m, n)
     qx, qy = qx.reshape(m, n), qy.reshape(m, n)
     top = np.argmax(normal, axis=0)
@@ -318,11 +353,11 @@ def deepest_cut(ev, placement, cut, surf, winner, moves, grid, *, curvature=None
         s_xy = ev.fast_points(sx, sy, dx=1, dy=1) / scale
         s_yy = ev.fast_points(sx, sy, dy=2) / scale
         e = {(i, j): lowest_in_frame(frame, px + i * step, py + j * step, r, corner)
-             for i in (-1, 0, 1) for j in (-1, 0, 1)}
+             for i, j in ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1))}
         e_x, e_y = (e[1, 0] - e[-1, 0]) / (2 * step), (e[0, 1] - e[0, -1]) / (2 * step)
         e_xx = (e[1, 0] - 2 * e[0, 0] + e[-1, 0]) / step**2
         e_yy = (e[0, 1] - 2 * e[0, 0] + e[0, -1]) / step**2
-        e_xy = (e[1, 1] - e[1, -1] - e[-1, 1] + e[-1, -1]) / (4 * step * step)
+        e_xy = (e[1, 1] - e[1, 0] - e[0, 1] + 2 * e[0, 0] - e[-1, 0] - e[0, -1] + e[-1, -1]) / (2 * step * step)
         # Newton on surface minus tool, its Hessian made negative definite; kept within the centre's cell.
         gx, gy = s_x - e_x, s_y - e_y
         hxx, hxy, hyy = s_xx - e_xx, s_xy - e_xy, s_yy - e_yy
