@@ -84,8 +84,12 @@ def window_check(surface, mm_per_unit, moves_a, moves_b, radius, centre, half, s
     X, Y = np.meshgrid(gx, gy, indexing="ij")
     s = polynomial_heights(surface, mm_per_unit, X, Y)
     h = 1e-4
-    sx = (polynomial_heights(surface, mm_per_unit, X + h, Y) - polynomial_heights(surface, mm_per_unit, X - h, Y)) / (2 * h)
-    sy = (polynomial_heights(surface, mm_per_unit, X, Y + h) - polynomial_heights(surface, mm_per_unit, X, Y - h)) / (2 * h)
+
+    def height(x, y):
+        return polynomial_heights(surface, mm_per_unit, x, y)
+
+    sx = (height(X + h, Y) - height(X - h, Y)) / (2 * h)
+    sy = (height(X, Y + h) - height(X, Y - h)) / (2 * h)
     above = cut - s
     normal = above / np.sqrt(1.0 + sx * sx + sy * sy)
     gi, li, ni = int(np.argmin(above)), int(np.argmax(above)), int(np.argmax(normal))

@@ -276,10 +276,10 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     ev = surface_evaluator(surface)
     curvature = curvature_limits(ev, sx, sy, placement.mm_per_unit)
     grid = (xs, ys, r, corner)
-    gouge, gouge_at, _ = deepest_cut(ev, placement, cut, surf, winner, (path[feed], path[feed + 1]), grid,
-                                     curvature=curvature)
-    crash, crash_segments = _rapids(ev, placement, surf, path, use & rapid, np.asarray(moves.line), grid, curvature)
-    left = _left(cut, surf, slope, winner, (path[feed], path[feed + 1]), grid, curvature, ev, placement)
+    gouge, gouge_at, _ = deepest_cut(ev, placement, cut, surf, winner, moves=(path[feed], path[feed + 1]), grid=grid)
+    crash, crash_segments = _rapids(ev, placement, surf, path, use & rapid, lines=np.asarray(moves.line), grid=grid)
+    left = _left(cut, surf, slope, winner, moves=(path[feed], path[feed + 1]), grid=grid, curvature=curvature,
+                 ev=ev, placement=placement)
     return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=max(gouge, 0.0), gouge_at=gouge_at,
                      **left, rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
                      unreached_mm2=float((~np.isfinite(cut)).sum() * hx * hy), resolution_mm=resolution,
@@ -293,7 +293,7 @@ def _cosine(slope):
     return 1.0 / np.sqrt(1.0 + slope * slope)
 
 
-def _left(cut, surf, slope, winner, moves, grid, curvature, ev, placement) -> dict:
+def _left(cut, surf, slope, winner, *, moves, grid, curvature, ev, placement) -> dict:
     """Material left (normal to the surface, and its height) and scallop, bounded from above, and where.
 
     At the cell centres the cut is compared with the surface; between them
@@ -345,7 +345,7 @@ def _slopes(surface, sx, sy) -> np.ndarray:
     return np.hypot(fx, fy).reshape(gx.shape)
 
 
-def _rapids(ev, placement, surf, path, use, lines, grid, curvature):
+def _rapids(ev, placement, surf, path, use, *, lines, grid):
     """The deepest a rapid goes below the surface, where and on which line; and the segments swept.
 
     All rapids are pressed into one map; the depth is searched between the
@@ -360,8 +360,7 @@ def _rapids(ev, placement, surf, path, use, lines, grid, curvature):
     cut = np.full(surf.shape, np.inf)
     winner = np.full(surf.shape, -1, dtype=np.int64)
     segments = sweep(cut, path[k], path[k + 1], xs, ys, r=r, corner=corner, winner=winner)
-    depth, where, move = deepest_cut(ev, placement, cut, surf, winner, (path[k], path[k + 1]), grid,
-                                     curvature=curvature)
+    depth, where, move = deepest_cut(ev, placement, cut, surf, winner, moves=(path[k], path[k + 1]), grid=grid)
     if not depth > 0.0:
         return none, segments
     # The first rapid that reaches the deepest point (a retract from it reaches it too).

@@ -162,14 +162,26 @@ def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below,
         vx = np.stack([xs[i[k] + _CORNERS[v][0]] for v in tri])
         vy = np.stack([ys[j[k] + _CORNERS[v][1]] for v in tri])
         ids = np.where(lost_in[t][None, :], extra[4 * t:4 * t + 4], w)
-        normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], (hx, hy), (m_top, m_abs), cosine, ids[:, k])
+        normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], cell=(hx, hy), curvature=(m_top, m_abs),
+                                        cosine=cosine, ids=ids[:, k])
         out.append([normal, height, px, py, i[k], j[k]])
     if not out:
         return tuple(np.zeros(0) for _ in range(6))
-    normal, height, px, py, ti, tj = (np.concatenate(p) for p in zip(*out))
+    found = tuple(np.concatenate(p) for p in zip(*out))
+    return _refine(found, extra, winner, moves, grid, surface_at=surface_at, split=split,
+                   curvature=(m_top, m_abs), cosine=cosine, skip_below=skip_below, inner=inner)
+
+
+def _refine(found, extra, winner, moves, grid, *, surface_at, split, curvature, cosine, skip_below, inner):
+    """Split the squares whose bound is above the figure reached, highest first, and bound them again.
+
+    A square whose bound is below the highest bound already final cannot
+    change the figure (nor, inside, the scallop's), so it is left whole.
+    """
+    normal, height, px, py, ti, tj = found
+    m_top, m_abs = curvature
+    nx, ny = winner.shape
     sny = ny - 1
-    # Split the squares whose bound is above the figure reached, highest first; a square whose bound is
-    # below the highest bound already final cannot change the figure (nor, inside, the scallop's).
     key = ti * sny + tj
     sq_inner = inner[:-1, :-1] & inner[1:, :-1] & inner[:-1, 1:] & inner[1:, 1:]
     top = np.full(sny * (nx - 1), -np.inf)
@@ -194,26 +206,31 @@ def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below,
                 cand = np.concatenate([cand, extra[:, group]])
             fine = _split(si, sj, cand, moves, grid, surface_at=surface_at, split=split,
                           curvature=(m_top, m_abs), cosine=cosine)
-            # A square none of whose small triangles a move tried covers keeps its coarse bound.
-            mine = np.isin(key, group)
-            lost = ~np.isfinite(fine[1])
-            if lost.any():
-                best_of = {}
-                for q in np.flatnonzero(mine):
-                    if int(key[q]) not in best_of or normal[q] > normal[best_of[int(key[q])]]:
-                        best_of[int(key[q])] = q
-                src = np.array([best_of[int(v)] for v in group[lost]])
-                for f, v in zip(fine[:4], (normal, height, px, py)):
-                    f[lost] = v[src]
-            # Each square's two coarse triangles give way to the highest of its small ones.
-            normal, height, px, py, ti, tj = (np.concatenate([v[~mine], f]) for v, f in
-                                              zip((normal, height, px, py, ti, tj), fine))
+            normal, height, px, py, ti, tj = _replace((normal, height, px, py, ti, tj), key, group, fine)
             key = ti * sny + tj
             final_all = max(final_all, float(fine[0].max()))
             ins = sq_inner.ravel()[group]
             if ins.any():
                 final_in = max(final_in, float(fine[0][ins].max()))
     return normal, height, px, py, ti, tj
+
+
+def _replace(found, key, group, fine):
+    """The bounds ``found`` (normal, height, x, y, i, j; ``key`` their squares) with the squares ``group`` split:
+    each square's coarse triangles give way to the highest of its small ones (``fine``), and a square none
+    of whose small triangles a move tried covers keeps its coarse bound."""
+    normal = found[0]
+    mine = np.isin(key, group)
+    lost = ~np.isfinite(fine[1])
+    if lost.any():
+        best_of = {}
+        for q in np.flatnonzero(mine):
+            if int(key[q]) not in best_of or normal[q] > normal[best_of[int(key[q])]]:
+                best_of[int(key[q])] = q
+        src = np.array([best_of[int(v)] for v in group[lost]])
+        for f, v in zip(fine[:4], found[:4]):
+            f[lost] = v[src]
+    return tuple(np.concatenate([v[~mine], f]) for v, f in zip(found, fine))
 
 
 def _raise(value, slope, cell, curvature, cosine):
@@ -225,7 +242,7 @@ def _raise(value, slope, cell, curvature, cosine):
     return height * cosine(np.maximum(slope - m_abs * 0.5 * np.hypot(hx, hy), 0.0)), height
 
 
-def _solve(d, vx, vy, slope, cell, curvature, cosine, ids):
+def _solve(d, vx, vy, slope, *, cell, curvature, cosine, ids):
     """The bound over triangles: ``d`` ``(K, 3, n)`` is ``E_k - S`` at their corners ``(vx, vy)`` ``(3, n)``
     for the moves ``ids`` ``(K, n)``; a move met twice, or not covering a corner, is left out."""
     valid = (d < _BIG).all(axis=1) & (ids >= 0)
@@ -278,7 +295,8 @@ def _split(si, sj, cand, moves, grid, *, surface_at, split, curvature, cosine):
     vx = px[corners].transpose(1, 0, 2).reshape(3, m * n)
     vy = py[corners].transpose(1, 0, 2).reshape(3, m * n)
     sl = slope[corners].min(axis=1).reshape(m * n)
-    normal, height, qx, qy = _solve(dt, vx, vy, sl, (hx, hy), curvature, cosine, np.tile(w, (1, m)))
+    normal, height, qx, qy = _solve(dt, vx, vy, sl, cell=(hx, hy), curvature=curvature, cosine=cosine,
+                                    ids=np.tile(w, (1, m)))
     normal, height = normal.reshape(m, n), height.reshape(m, n)
     qx, qy = qx.reshape(m, n), qy.reshape(m, n)
     top = np.argmax(normal, axis=0)
@@ -311,7 +329,7 @@ def _wider(lost, tri, ij, maps, moves, grid):
     return np.take_along_axis(d, order[:, None, :], axis=0), chosen
 
 
-def deepest_cut(ev, placement, cut, surf, winner, moves, grid, *, curvature=None):
+def deepest_cut(ev, placement, cut, surf, winner, *, moves, grid):
     """The deepest the moves go below the surface, at the critical points near the cell centres; see the module.
 
     Returns ``(depth, (x, y), move)``: the surface minus the swept tool at the

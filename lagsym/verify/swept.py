@@ -37,7 +37,8 @@ import math
 
 import numpy as np
 
-__all__ = ["lowest_ball", "lowest_flat", "lowest_bull", "bull_resolution", "lowest_along", "move_frames", "lowest_in_frame", "BISECTIONS"]
+__all__ = ["lowest_ball", "lowest_flat", "lowest_bull", "bull_resolution", "lowest_along", "move_frames",
+           "lowest_in_frame", "BISECTIONS"]
 
 BISECTIONS = 30
 
@@ -129,7 +130,7 @@ def move_frames(a, b):
 
 
 def lowest_in_frame(frame, px, py, r, corner):
-    """Lowest height of the tool's lower surface over ``(px, py)`` along moves given by :func:`move_frames`; NaN where none.
+    """Lowest height of the tool's lower surface over ``(px, py)`` along moves in :func:`move_frames`; NaN where none.
 
     ``r`` and ``corner`` are the tool's radius and corner radius (``r`` for a ball, 0 for a flat end).
     """
@@ -146,7 +147,7 @@ def lowest_in_frame(frame, px, py, r, corner):
 
 
 def lowest_along(a, b, px, py, r, corner):
-    """Lowest height of the tool's lower surface over the points ``(px, py)`` along the moves ``a -> b``; NaN where none.
+    """Lowest height of the tool's lower surface over ``(px, py)`` along the moves ``a -> b``; NaN where none.
 
     ``a`` and ``b`` are ``(..., 3)`` tip positions broadcast with ``px`` and
     ``py``; ``r`` and ``corner`` as :func:`lowest_in_frame` takes them.
