@@ -51,6 +51,8 @@ CURVATURE_MARGIN = 1.25  # the largest sampled curvature of the surface, with a 
 _BIG = 1.0e30  # stands for a move that does not cover a corner
 SPLIT = 8  # squares whose bound is above the figure reached are split SPLIT x SPLIT
 _SPLIT_BATCH = 256  # squares split at a time
+_NODES_AT_ONCE = 32768  # cell centres searched from at a time
+_SQUARES_AT_ONCE = 65536  # squares bounded at a time (memory: some hundred bytes each)
 _CORNERS = ((0, 0), (1, 0), (0, 1), (1, 1))
 _TRIANGLES = ((0, 1, 3), (0, 2, 3))  # each square cut along its diagonal from its first corner
 
@@ -134,44 +136,49 @@ def left_bound(cut, surf, winner, moves, grid, *, curvature, cosine, skip_below,
     slope_at, m_top, m_abs = curvature
     nx, ny = cut.shape
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
-    i, j = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    w = np.stack([winner[i + di, j + dj] for di, dj in _CORNERS])  # (4 candidates, squares)
-    # E_k - S at the four corners for the four candidate moves.
-    d = np.full((4, 4, len(i)), _BIG)
-    for c, (di, dj) in enumerate(_CORNERS):
-        for k in range(4):
-            ok = w[k] >= 0
-            if ok.any():
-                e = lowest_along(a_all[w[k][ok]], b_all[w[k][ok]], xs[i[ok] + di], ys[j[ok] + dj], r, corner)
-                d[k, c, ok] = np.where(np.isfinite(e), e - surf[i[ok] + di, j[ok] + dj], _BIG)
-    out = []
-    extra = np.full((8, len(i)), -1, dtype=np.int64)
-    lost_in = {}
-    for t, tri in enumerate(_TRIANGLES):
-        dt = d[:, list(tri), :]
-        lost = np.flatnonzero(~(dt < _BIG).all(axis=1).any(axis=0))
-        if len(lost):
-            # No move lowest at a corner covers the whole triangle: try those lowest at the 32 centres around.
-            dt[:, :, lost], extra[4 * t:4 * t + 4, lost] = _wider(lost, tri, (i, j), (cut, surf, winner), moves, grid)
-        lost_in[t] = np.zeros(len(i), dtype=bool)
-        lost_in[t][lost] = True
-        slope = np.min(np.stack([slope_at[i + _CORNERS[v][0], j + _CORNERS[v][1]] for v in tri]), axis=0)
-        # The convex bound: the lowest over the moves of their highest corner.
-        cheap = np.min(np.where((dt < _BIG).all(axis=1), dt.max(axis=1), _BIG), axis=0)
-        cheap = _raise(cheap, slope, (hx, hy), (m_top, m_abs), cosine)[0]
-        k = np.flatnonzero((cheap > skip_below) | (cheap >= _BIG))
-        if not len(k):
-            continue
-        vx = np.stack([xs[i[k] + _CORNERS[v][0]] for v in tri])
-        vy = np.stack([ys[j[k] + _CORNERS[v][1]] for v in tri])
-        ids = np.where(lost_in[t][None, :], extra[4 * t:4 * t + 4], w)
-        normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], cell=(hx, hy), curvature=(m_top, m_abs),
-                                        cosine=cosine, ids=ids[:, k])
-        out.append([normal, height, px, py, i[k], j[k]])
+    out, lost_keys, lost_moves = [], [], []
+    rows = max(1, _SQUARES_AT_ONCE // max(ny - 1, 1))
+    for i0 in range(0, nx - 1, rows):
+        i, j = np.meshgrid(np.arange(i0, min(i0 + rows, nx - 1)), np.arange(ny - 1), indexing="ij")
+        i, j = i.ravel(), j.ravel()
+        w = np.stack([winner[i + di, j + dj] for di, dj in _CORNERS])  # (4 candidates, squares)
+        # E_k - S at the four corners for the four candidate moves.
+        d = np.full((4, 4, len(i)), _BIG)
+        for c, (di, dj) in enumerate(_CORNERS):
+            for k in range(4):
+                ok = w[k] >= 0
+                if ok.any():
+                    e = lowest_along(a_all[w[k][ok]], b_all[w[k][ok]], xs[i[ok] + di], ys[j[ok] + dj], r, corner)
+                    d[k, c, ok] = np.where(np.isfinite(e), e - surf[i[ok] + di, j[ok] + dj], _BIG)
+        extra = np.full((8, len(i)), -1, dtype=np.int64)
+        for t, tri in enumerate(_TRIANGLES):
+            dt = d[:, list(tri), :]
+            ids = w.copy()
+            lost = np.flatnonzero(~(dt < _BIG).all(axis=1).any(axis=0))
+            if len(lost):
+                # No move lowest at a corner covers the whole triangle: try those lowest at the 32 centres around.
+                dt[:, :, lost], extra[4 * t:4 * t + 4, lost] = _wider(lost, tri, (i, j), (cut, surf, winner), moves,
+                                                                      grid)
+                ids[:, lost] = extra[4 * t:4 * t + 4, lost]
+            slope = np.min(np.stack([slope_at[i + _CORNERS[v][0], j + _CORNERS[v][1]] for v in tri]), axis=0)
+            # The convex bound: the lowest over the moves of their highest corner.
+            cheap = np.min(np.where((dt < _BIG).all(axis=1), dt.max(axis=1), _BIG), axis=0)
+            cheap = _raise(cheap, slope, (hx, hy), (m_top, m_abs), cosine)[0]
+            k = np.flatnonzero((cheap > skip_below) | (cheap >= _BIG))
+            if not len(k):
+                continue
+            vx = np.stack([xs[i[k] + _CORNERS[v][0]] for v in tri])
+            vy = np.stack([ys[j[k] + _CORNERS[v][1]] for v in tri])
+            normal, height, px, py = _solve(dt[:, :, k], vx, vy, slope[k], cell=(hx, hy), curvature=(m_top, m_abs),
+                                            cosine=cosine, ids=ids[:, k])
+            out.append([normal, height, px, py, i[k], j[k]])
+        wide = (extra >= 0).any(axis=0)
+        lost_keys.append(i[wide] * (ny - 1) + j[wide])
+        lost_moves.append(extra[:, wide])
     if not out:
         return tuple(np.zeros(0) for _ in range(6))
     found = tuple(np.concatenate(p) for p in zip(*out))
+    extra = (np.concatenate(lost_keys), np.concatenate(lost_moves, axis=1))
     return _refine(found, extra, winner, moves, grid, surface_at=surface_at, split=split,
                    curvature=(m_top, m_abs), cosine=cosine, skip_below=skip_below, inner=inner)
 
@@ -198,16 +205,19 @@ def _refine(found, extra, winner, moves, grid, *, surface_at, split, curvature, 
         part = order[s0:s0 + _SPLIT_BATCH]
         s0 += _SPLIT_BATCH
         need = top[part] > np.where(sq_inner.ravel()[part], final_in, final_all)
+        # A square with a corner the tool never reached is left whole: all of it is left there.
+        need &= np.all([winner[part // sny + di, part % sny + dj] >= 0 for di, dj in _CORNERS], axis=0)
         part = np.sort(part[need])
         if not len(part):
             continue
-        for group in (part[~(extra[:, part] >= 0).any(axis=0)], part[(extra[:, part] >= 0).any(axis=0)]):
+        more = _extra_at(extra, part)
+        for group in (part[~(more >= 0).any(axis=0)], part[(more >= 0).any(axis=0)]):
             if not len(group):
                 continue
             si, sj = group // sny, group % sny
             cand = np.stack([winner[si + di, sj + dj] for di, dj in _CORNERS])
-            if (extra[:, group] >= 0).any():
-                cand = np.concatenate([cand, extra[:, group]])
+            if (_extra_at(extra, group) >= 0).any():
+                cand = np.concatenate([cand, _extra_at(extra, group)])
             fine = _split(si, sj, cand, moves, grid, surface_at=surface_at, split=split,
                           curvature=(m_top, m_abs), cosine=cosine)
             normal, height, px, py, ti, tj = _replace((normal, height, px, py, ti, tj), key, group, fine)
@@ -217,6 +227,15 @@ def _refine(found, extra, winner, moves, grid, *, surface_at, split, curvature, 
             if ins.any():
                 final_in = max(final_in, float(fine[0][ins].max()))
     return normal, height, px, py, ti, tj
+
+
+def _extra_at(extra, keys):
+    """The moves tried beyond the corners' for the squares ``keys`` (``(8, n)``, -1 where none): ``extra``
+    holds them as ``(squares, moves)`` for the few squares that needed them."""
+    held, moves = extra
+    at = np.clip(np.searchsorted(held, keys), 0, max(len(held) - 1, 0))
+    found = (at < len(held)) & (held[at] == keys) if len(held) else np.zeros(len(keys), dtype=bool)
+    return np.where(found[None, :], moves[:, at] if len(held) else -1, -1)
 
 
 def _replace(found, key, group, fine):
@@ -340,17 +359,30 @@ def deepest_cut(ev, placement, cut, surf, winner, *, moves, grid):
     highest point found (negative where the tool stays above everywhere), and
     the index of the move that reaches it.
     """
-    xs, ys, r, corner = grid
-    a_all, b_all = moves
-    nx, ny = cut.shape
-    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
+    xs, ys = grid[0], grid[1]
+    ny = cut.shape[1]
     reached = np.isfinite(cut)
     if not reached.any():
         return -np.inf, (float(xs[0]), float(ys[0])), -1
     g = np.where(reached, surf - cut, -np.inf)
     k0 = int(np.argmax(g))
     best = (float(g.flat[k0]), (float(xs[k0 // ny]), float(ys[k0 % ny])), int(winner.flat[k0]))
-    ii, jj = np.nonzero(reached)
+    all_i, all_j = np.nonzero(reached)
+    for s0 in range(0, len(all_i), _NODES_AT_ONCE):
+        found = _climb(ev, placement, all_i[s0:s0 + _NODES_AT_ONCE], all_j[s0:s0 + _NODES_AT_ONCE], winner,
+                       moves=moves, grid=grid)
+        if found[0] > best[0]:
+            best = found
+    return best
+
+
+def _climb(ev, placement, ii, jj, winner, *, moves, grid):
+    """Newton from the centres ``(ii, jj)`` for the moves lowest there and at their four neighbours: the
+    highest surface minus tool found, where, and the move (see the module)."""
+    xs, ys, r, corner = grid
+    a_all, b_all = moves
+    nx, ny = winner.shape
+    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     # The moves lowest at each centre and at its four neighbours, each once.
     cand = [winner[ii, jj]]
     for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
@@ -395,7 +427,7 @@ def deepest_cut(ev, placement, cut, surf, winner, *, moves, grid):
     sx, sy = placement.to_surface(px, py)
     depth = placement.height_mm(ev.fast_points(sx, sy)) - lowest_in_frame(frame, px, py, r, corner)
     depth = np.where(np.isfinite(depth), depth, -np.inf)
-    k = int(np.argmax(depth)) if len(depth) else 0
-    if len(depth) and depth[k] > best[0]:
-        return float(depth[k]), (float(px[k]), float(py[k])), int(move[k])
-    return best
+    if not len(depth):
+        return -np.inf, (0.0, 0.0), -1
+    k = int(np.argmax(depth))
+    return float(depth[k]), (float(px[k]), float(py[k])), int(move[k])
