@@ -26,12 +26,16 @@ reached at a real position on a move.  For the ball and the flat end it is
 the lowest there is over the cell centre (``resolution_mm`` 0: floating-point
 rounding apart); for the bull nose, whose lowest point along a move has no
 closed form, the tool sweeps at most ``resolution_mm`` lower
-(:func:`lagsym.verify.swept.bull_resolution`, below 1e-4 mm).  So a gouge it reports is
+(:func:`lagsym.verify.swept.bull_resolution`, below 1e-4 mm).  The figures are
+not read off the cell centres alone (:mod:`lagsym.verify.bounds`, docs/verify.md):
+material left and the scallop are upper bounds over every triangle of
+centres (the swept tool is convex over each move), and the gouge and the
+rapid's depth are evaluated exactly at the critical points found from every
+centre, so neither is understated whatever the cell.  A gouge reported is
 real, and the depth from which a cut counts as a gouge needs no room for the
 simulation: by default it is what the program's rounding can cause,
 :func:`gouge_limit` (half a unit of the last decimal, and that much sideways
-on each axis times the steepest slope of the surface).  Material left is
-overstated by at most ``resolution_mm``.
+on each axis times the steepest slope of the surface).
 """
 
 from __future__ import annotations
@@ -48,7 +52,9 @@ from ..gcode import Moves, numeric_words, program_blocks, program_units
 from ..gcode.words import plain_move
 from ..machine import MAX_LEFT_MM, Placement, Tool, mm_per_program_unit
 from ..progress import Progress
+from .bounds import curvature_limits, deepest_cut, left_bound
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
+from .swept import lowest_along
 
 __all__ = ["CutReport", "simulate_cut", "press_moves", "height_map_axes", "gouge_limit", "program_resolution_mm",
            "MAX_CELLS", "MAX_CONTACTS", "MAX_LEFT_MM"]
@@ -263,37 +269,72 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     check_work(path[:-1][use], path[1:][use], piece, r, hx, hy, max_contacts=max_contacts)
     rapid = np.asarray(moves.rapid, dtype=bool)
     cut = np.full((len(xs), len(ys)), np.inf)
-    segments, _ = press_moves(cut, xs, ys, path[:-1][use & ~rapid], path[1:][use & ~rapid], tool, max_contacts=None,
-                               progress=progress)
-    crash, crash_segments = _rapids(surf, path, use & rapid, np.asarray(moves.line), (xs, ys, r, corner))
-    return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, **_compare(cut, surf, slope, xs, ys, r),
-                     rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
+    feed = np.flatnonzero(use & ~rapid)
+    winner = np.full(cut.shape, -1, dtype=np.int64)
+    segments, _ = press_moves(cut, xs, ys, path[feed], path[feed + 1], tool, max_contacts=None, progress=progress,
+                              winner=winner)
+    ev = surface_evaluator(surface)
+    curvature = curvature_limits(ev, sx, sy, placement.mm_per_unit)
+    grid = (xs, ys, r, corner)
+    gouge, gouge_at, _ = deepest_cut(ev, placement, cut, surf, winner, moves=(path[feed], path[feed + 1]), grid=grid)
+    crash, crash_segments = _rapids(ev, placement, surf, path, use & rapid, lines=np.asarray(moves.line), grid=grid)
+    left = _left(cut, surf, slope, winner, moves=(path[feed], path[feed + 1]), grid=grid, curvature=curvature,
+                 ev=ev, placement=placement)
+    return CutReport(xs_mm=xs, ys_mm=ys, cut_mm=cut, surface_mm=surf, gouge_mm=max(gouge, 0.0), gouge_at=gouge_at,
+                     **left, rapid_mm=crash[0], rapid_at=crash[1], rapid_line=crash[2],
                      unreached_mm2=float((~np.isfinite(cut)).sum() * hx * hy), resolution_mm=resolution,
                      gouge_limit_mm=limit, max_left_mm=float(max_left_mm),
                      max_scallop_mm=math.inf if max_scallop_mm is None else float(max_scallop_mm),
                      segments=segments + crash_segments)
 
 
-def _compare(cut, surf, slope, xs, ys, r) -> dict:
-    """Gouge, material left (normal to the surface, and its height) and scallop of a cut map, and where."""
+def _cosine(slope):
+    """The cosine of the slope angle of a slope: the share of a height that lies normal to the surface."""
+    return 1.0 / np.sqrt(1.0 + slope * slope)
+
+
+def _left(cut, surf, slope, winner, *, moves, grid, curvature, ev, placement) -> dict:
+    """Material left (normal to the surface, and its height) and scallop, bounded from above, and where.
+
+    At the cell centres the cut is compared with the surface; between them
+    every triangle of centres gets the bound of :func:`lagsym.verify.bounds.left_bound`.
+    """
+    xs, ys, r, _ = grid
     reached = np.isfinite(cut)
-    diff = np.where(reached, cut - surf, np.nan)
-    gi = int(np.nanargmin(diff)) if reached.any() else 0
-    gouge = max(0.0, -float(diff.flat[gi])) if reached.any() else 0.0
     above = np.where(reached, np.maximum(cut - surf, 0.0), np.inf)
-    left = above / np.sqrt(1.0 + slope**2)
-    li = int(np.argmax(left))
+    left = above * _cosine(slope)
     x0, x1, y0, y1 = xs[0], xs[-1], ys[0], ys[-1]
     inner = (xs[:, None] >= x0 + r) & (xs[:, None] <= x1 - r) & (ys[None, :] >= y0 + r) & (ys[None, :] <= y1 - r)
     normal = np.where(inner & reached, left, 0.0)
-    si = int(np.argmax(normal))
+    li, si = int(np.argmax(left)), int(np.argmax(normal))
 
     def at(k):
         i, j = np.unravel_index(k, cut.shape)
         return float(xs[i]), float(ys[j])
 
-    return dict(gouge_mm=gouge, gouge_at=at(gi), left_mm=float(left.flat[li]), left_at=at(li),
-                left_height_mm=float(above.flat[li]), scallop_mm=float(normal.flat[si]), scallop_at=at(si))
+    best = dict(left_mm=float(left.flat[li]), left_at=at(li), left_height_mm=float(above.flat[li]),
+                scallop_mm=float(normal.flat[si]), scallop_at=at(si))
+    m_top, m_abs = curvature
+
+    def surface_at(x_mm, y_mm):
+        sx, sy = placement.to_surface(x_mm, y_mm)
+        return (placement.height_mm(ev.fast_points(sx, sy)),
+                np.hypot(ev.fast_points(sx, sy, dx=1), ev.fast_points(sx, sy, dy=1)))
+
+    norm, height, px, py, ti, tj = left_bound(cut, surf, winner, moves, grid, curvature=(slope, m_top, m_abs),
+                                              cosine=_cosine, skip_below=best["scallop_mm"], surface_at=surface_at,
+                                              inner=inner)
+    if len(norm):
+        k = int(np.argmax(norm))
+        if norm[k] > best["left_mm"]:
+            best.update(left_mm=float(norm[k]), left_at=(float(px[k]), float(py[k])),
+                        left_height_mm=float(height[k]))
+        square_inner = inner[ti, tj] & inner[ti + 1, tj] & inner[ti, tj + 1] & inner[ti + 1, tj + 1]
+        if square_inner.any():
+            k = int(np.argmax(np.where(square_inner, norm, -np.inf)))
+            if norm[k] > best["scallop_mm"]:
+                best.update(scallop_mm=float(norm[k]), scallop_at=(float(px[k]), float(py[k])))
+    return best
 
 
 def _slopes(surface, sx, sy) -> np.ndarray:
@@ -304,11 +345,12 @@ def _slopes(surface, sx, sy) -> np.ndarray:
     return np.hypot(fx, fy).reshape(gx.shape)
 
 
-def _rapids(surf, path, use, lines, grid):
+def _rapids(ev, placement, surf, path, use, *, lines, grid):
     """The deepest a rapid goes below the surface, where and on which line; and the segments swept.
 
-    All rapids are pressed into one map; only those that pass over the worst
-    cell are simulated again, one by one, to name the line.
+    All rapids are pressed into one map; the depth is searched between the
+    cell centres as for the feed moves (:func:`lagsym.verify.bounds.deepest_cut`),
+    and the line is that of the first rapid that reaches the deepest point.
     """
     xs, ys, r, corner = grid
     none = (0.0, (float(xs[0]), float(ys[0])), 0)
@@ -316,22 +358,12 @@ def _rapids(surf, path, use, lines, grid):
     if not k.size:
         return none, 0
     cut = np.full(surf.shape, np.inf)
-    segments = sweep(cut, path[k], path[k + 1], xs, ys, r=r, corner=corner)
-    depth = np.where(np.isfinite(cut), surf - cut, -np.inf)
-    i = int(np.argmax(depth))
-    if not depth.flat[i] > 0.0:
+    winner = np.full(surf.shape, -1, dtype=np.int64)
+    segments = sweep(cut, path[k], path[k + 1], xs, ys, r=r, corner=corner, winner=winner)
+    depth, where, move = deepest_cut(ev, placement, cut, surf, winner, moves=(path[k], path[k + 1]), grid=grid)
+    if not depth > 0.0:
         return none, segments
-    a, b = np.unravel_index(i, depth.shape)
-    px, py = xs[a], ys[b]
-    line = 0
-    for m in k:
-        lo, hi = np.minimum(path[m], path[m + 1]), np.maximum(path[m], path[m + 1])
-        if lo[0] - r <= px <= hi[0] + r and lo[1] - r <= py <= hi[1] + r:
-            one = np.full(surf.shape, np.inf)
-            sweep(one, path[m:m + 1], path[m + 1:m + 2], xs, ys, r=r, corner=corner)
-            if one[a, b] <= cut[a, b]:
-                line = int(lines[m])
-                break
-    return (float(depth.flat[i]), (float(px), float(py)), line), segments
-
-
+    # The first rapid that reaches the deepest point (a retract from it reaches it too).
+    low = lowest_along(path[k], path[k + 1], where[0], where[1], r, corner)
+    first = int(np.flatnonzero(low <= np.nanmin(low) + 1e-9)[0]) if np.isfinite(low).any() else move
+    return (float(depth), where, int(lines[k[first]])), segments

@@ -37,7 +37,8 @@ MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB
 MAX_CONTACTS = 20_000_000_000  # segments (all, before those far from the box are dropped) times cells under the tool
 
 
-def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, progress: Progress | None = None) -> int:
+def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, progress: Progress | None = None,
+          winner: np.ndarray | None = None) -> int:
     """Lower ``cut`` to the tool's lowest surface along every move (in place); the number of segments swept.
 
     Moves are split into segments no longer sideways than ``_PIECE_CELLS``
@@ -48,7 +49,9 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
     footprint wide: the even ones are swept at the same time, then the odd
     ones, so no two threads ever write the same cell.  ``progress`` is told
     the segments swept (stage ``sweeping moves``), those far from the map
-    counted as they are dropped.
+    counted as they are dropped.  ``winner``, an integer array the shape of
+    ``cut``, if given, is set at every cell a move lowers to the index of that
+    move in ``a_all`` (a move whose tool reaches the cell's lowest height).
     """
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     piece = _PIECE_CELLS * max(hx, hy)
@@ -59,12 +62,13 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
     swept = Tally(progress, "sweeping moves", segments(a_all, b_all, piece) if progress is not None else None)
     swept.start()
     for s in range(0, len(a_all), _MOVES_PER_PASS):
-        a, b = _pieces(np.asarray(a_all[s:s + _MOVES_PER_PASS], dtype=float),
-                       np.asarray(b_all[s:s + _MOVES_PER_PASS], dtype=float), piece)
+        a, b, move = _pieces(np.asarray(a_all[s:s + _MOVES_PER_PASS], dtype=float),
+                             np.asarray(b_all[s:s + _MOVES_PER_PASS], dtype=float), piece)
+        move += s
         near = ((np.maximum(a[:, 0], b[:, 0]) >= xs[0] - r - hx) & (np.minimum(a[:, 0], b[:, 0]) <= xs[-1] + r + hx)
                 & (np.maximum(a[:, 1], b[:, 1]) >= ys[0] - r - hy) & (np.minimum(a[:, 1], b[:, 1]) <= ys[-1] + r + hy))
         swept.add(len(a) - int(near.sum()))
-        a, b = a[near], b[near]
+        a, b, move = a[near], b[near], move[near]
         count += len(a)
         if not len(a):
             continue
@@ -79,12 +83,16 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
         cols = slice(max(j0, 0), min(j0 + pad.shape[1], len(ys)))
         inner = (slice(rows.start - i0, rows.stop - i0), slice(cols.start - j0, cols.stop - j0))
         pad[inner] = cut[rows, cols]
+        wpad = None
+        if winner is not None:
+            wpad = np.full(pad.shape, -1, dtype=np.int64)
+            wpad[inner] = winner[rows, cols]
         stripes = 2 * workers if workers > 1 and pad.shape[0] >= 2 * workers * (2 * kx + 1) else 1
         work = [[] for _ in range(stripes)]
         for stripe, chunk in _chunks(a, b, (ix - i0, iy - j0), (i0, j0), (xs, ys, r), shape=pad.shape,
-                                      stripes=stripes):
+                                      stripes=stripes, move=move):
             work[stripe].append(chunk)
-        geometry = (hx, hy, r, kx, ky, pad.shape[1], pad.reshape(-1))
+        geometry = (hx, hy, r, kx, ky, pad.shape[1], pad.reshape(-1), None if wpad is None else wpad.reshape(-1))
 
         def run(chunks):
             with np.errstate(invalid="ignore"):
@@ -98,6 +106,8 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
             with ThreadPoolExecutor(workers) as pool:
                 for phase in (0, 1):
                     list(pool.map(run, work[phase::2]))
+        if winner is not None:
+            winner[rows, cols] = wpad[inner]
         np.minimum(cut[rows, cols], pad[inner], out=cut[rows, cols])
     swept.finish()
     return count
@@ -119,20 +129,23 @@ def _kernel(r, corner):
 
 
 def _pieces(a, b, piece):
-    """The moves turned to rise (``b_z >= a_z``) and split into segments at most ``piece`` long sideways."""
+    """The moves turned to rise (``b_z >= a_z``) and split into segments at most ``piece`` long sideways.
+
+    Returns the segments' ends and the index of the move each comes from.
+    """
     up = b[:, 2] >= a[:, 2]
     a, b = np.where(up[:, None], a, b), np.where(up[:, None], b, a)
     d = b - a
     n = np.maximum(np.ceil(np.hypot(d[:, 0], d[:, 1]) / piece), 1).astype(np.int64)
     if not len(n) or int(n.max()) == 1:
-        return a, b
+        return a, b, np.arange(len(a))
     k = np.repeat(np.arange(len(a)), n)
     i = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
     t0, t1 = i / n[k], (i + 1) / n[k]
-    return a[k] + t0[:, None] * d[k], a[k] + t1[:, None] * d[k]
+    return a[k] + t0[:, None] * d[k], a[k] + t1[:, None] * d[k], k
 
 
-def _chunks(a, b, anchor, origin, grid, *, shape, stripes):
+def _chunks(a, b, anchor, origin, grid, *, shape, stripes, move):
     """Segments in groups whose nearest cells (to their middles) differ, so one offset reaches distinct cells.
 
     ``anchor`` holds each segment's nearest cell in the window ``shape``, whose first cell is ``origin`` in the map.
@@ -141,7 +154,7 @@ def _chunks(a, b, anchor, origin, grid, *, shape, stripes):
     the flat index of its nearest cell in the window, that cell's offset from
     the segment's start, the unit direction ``(ux, uy)`` and the group's
     longest segment (the groups are sorted by length, so short segments are
-    swept over a small footprint).
+    swept over a small footprint), and the moves they come from.
     """
     xs, ys, r = grid
     ix, iy = anchor
@@ -166,13 +179,13 @@ def _chunks(a, b, anchor, origin, grid, *, shape, stripes):
     for run in np.split(order, np.flatnonzero(np.diff(group)) + 1):
         for g in np.array_split(run, -(-len(run) // _CHUNK)):
             yield int(stripe[g[0]]), ((a[g, 2], a[g, 2] + r, length[g], m[g], k[g]), key[g], bx[g], by[g],
-                                      (ux[g], uy[g]), float(length[g].max()))
+                                      (ux[g], uy[g]), float(length[g].max()), move[g])
 
 
 def _sweep_chunk(chunk, geometry, lowest):
     """Lower the padded map over every cell the segments of one group can reach (rows ``di``, columns ``dj``)."""
-    seg, base, bx, by, (ux, uy), longest = chunk
-    hx, hy, r, kx, ky, stride, flat = geometry
+    seg, base, bx, by, (ux, uy), longest, move = chunk
+    hx, hy, r, kx, ky, stride, flat, wflat = geometry
     # The segment lies within longest / 2 of its middle, the middle within half a cell of its nearest cell.
     reach = r + longest / 2 + 1e-9
     lo = kx * stride + ky  # offsets are taken from a view this far back, so the index arrays stay as they are
@@ -190,7 +203,13 @@ def _sweep_chunk(chunk, geometry, lowest):
         for j in range(-span, span + 1):
             view = flat[lo + di * stride + j:]
             cur = view[base]
-            np.fmin(cur, lowest(ax + ay[j + ky], ex + ey[j + ky], seg), out=cur)
+            v = lowest(ax + ay[j + ky], ex + ey[j + ky], seg)
+            if wflat is not None:
+                won = v < cur
+                if won.any():
+                    wview = wflat[lo + di * stride + j:]
+                    wview[base[won]] = move[won]
+            np.fmin(cur, v, out=cur)
             view[base] = cur
 
 
@@ -201,8 +220,8 @@ def _sweep_few(chunk, geometry, lowest):
     thousands; here each NumPy operation covers every cell of the square
     footprint of up to 64 segments, and ``np.fmin.at`` lowers the map.
     """
-    (az, azr, length, m, k), base, bx, by, (ux, uy), _ = chunk
-    hx, hy, _, kx, ky, stride, flat = geometry
+    (az, azr, length, m, k), base, bx, by, (ux, uy), _, move = chunk
+    hx, hy, _, kx, ky, stride, flat, wflat = geometry
     di, dj = np.arange(-kx, kx + 1), np.arange(-ky, ky + 1)
     offsets = (di * stride)[:, None] + dj[None, :]
     for s in range(0, len(base), 64):
@@ -212,7 +231,12 @@ def _sweep_few(chunk, geometry, lowest):
         ce = (-wx * uy[g, None])[:, :, None] + (wy * ux[g, None])[:, None, :]
         v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)))
         under = ~np.isnan(v)
-        np.fmin.at(flat, (base[g, None, None] + offsets)[under], v[under])
+        cells = (base[g, None, None] + offsets)[under]
+        np.fmin.at(flat, cells, v[under])
+        if wflat is not None:
+            # Any move whose value is the cell's new lowest reaches it there.
+            won = flat[cells] == v[under]
+            wflat[cells[won]] = np.broadcast_to(move[g, None, None], v.shape)[under][won]
 
 
 def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tuple[np.ndarray, np.ndarray]:
@@ -248,18 +272,20 @@ def check_work(a, b, piece: float, r: float, hx: float, hy: float, *, max_contac
 
 
 def press_moves(cut: np.ndarray, xs: np.ndarray, ys: np.ndarray, a: np.ndarray, b: np.ndarray, tool: Tool, *,
-                max_contacts: int | None = MAX_CONTACTS, progress: Progress | None = None) -> tuple[int, float]:
+                max_contacts: int | None = MAX_CONTACTS, progress: Progress | None = None,
+                winner: np.ndarray | None = None) -> tuple[int, float]:
     """Lower the height map ``cut`` (in place) to the tool's lower surface along the moves ``a[k] -> b[k]`` (mm).
 
     ``cut[i, j]`` is the height over ``(xs[i], ys[j])``, evenly spaced cell
     centres.  Returns the number of segments swept and the simulation's
-    vertical resolution (as :func:`simulate_cut` states it); ``progress`` as :func:`sweep` tells it.
+    vertical resolution (as :func:`simulate_cut` states it); ``progress`` as
+    :func:`sweep` tells it, ``winner`` as :func:`sweep` sets it.
     """
     r, corner, piece, resolution = tool_grid(tool, xs, ys)
     if not len(a):
         return 0, resolution
     check_work(a, b, piece, r, xs[1] - xs[0], ys[1] - ys[0], max_contacts=max_contacts)
-    return sweep(cut, a, b, xs, ys, r=r, corner=corner, progress=progress), resolution
+    return sweep(cut, a, b, xs, ys, r=r, corner=corner, progress=progress, winner=winner), resolution
 
 
 def tool_grid(tool: Tool, xs: np.ndarray, ys: np.ndarray) -> tuple[float, float, float, float]:

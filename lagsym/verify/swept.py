@@ -37,7 +37,8 @@ import math
 
 import numpy as np
 
-__all__ = ["lowest_ball", "lowest_flat", "lowest_bull", "bull_resolution", "BISECTIONS"]
+__all__ = ["lowest_ball", "lowest_flat", "lowest_bull", "bull_resolution", "lowest_along", "move_frames",
+           "lowest_in_frame", "BISECTIONS"]
 
 BISECTIONS = 30
 
@@ -107,3 +108,48 @@ def bull_resolution(corner: float, longest_mm: float, steps: int = BISECTIONS) -
     """How much lower than :func:`lowest_bull` a bull nose can sweep along moves up to ``longest_mm`` sideways."""
     w = min(longest_mm, 1.0e300) / 2.0**steps
     return math.sqrt(max(2.0 * corner * w - w * w, 0.0))
+
+
+def move_frames(a, b):
+    """The moves ``a -> b`` (``(..., 3)`` tip positions) turned to rise, in their own horizontal frames.
+
+    Returns ``(ax, ay, ux, uy, seg)``: the start, the unit direction and
+    ``seg`` as :func:`lowest_ball` takes it, less the tool radius
+    (``seg[1]`` is the start's height until :func:`lowest_in_frame` adds it).
+    """
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    up = (b[..., 2] >= a[..., 2])[..., None]
+    a, b = np.where(up, a, b), np.where(up, b, a)
+    d = b - a
+    length = np.hypot(d[..., 0], d[..., 1])
+    moving = length > 0.0
+    safe = np.where(moving, length, 1.0)
+    ux, uy = np.where(moving, d[..., 0] / safe, 1.0), np.where(moving, d[..., 1] / safe, 0.0)
+    m = np.where(moving, d[..., 2] / safe, 0.0)
+    return a[..., 0], a[..., 1], ux, uy, (a[..., 2], a[..., 2], length, m, m / np.sqrt(1.0 + m * m))
+
+
+def lowest_in_frame(frame, px, py, r, corner):
+    """Lowest height of the tool's lower surface over ``(px, py)`` along moves in :func:`move_frames`; NaN where none.
+
+    ``r`` and ``corner`` are the tool's radius and corner radius (``r`` for a ball, 0 for a flat end).
+    """
+    ax, ay, ux, uy, (az, _, length, m, k) = frame
+    seg = (az, az + r, length, m, k)
+    wx, wy = px - ax, py - ay
+    with np.errstate(invalid="ignore"):
+        ca, ce = wx * ux + wy * uy, wy * ux - wx * uy
+        if corner <= 0.0:
+            return lowest_flat(ca, ce, seg, r)
+        if corner >= r:
+            return lowest_ball(ca, ce, seg, r)
+        return lowest_bull(ca, ce, seg, r, corner)
+
+
+def lowest_along(a, b, px, py, r, corner):
+    """Lowest height of the tool's lower surface over ``(px, py)`` along the moves ``a -> b``; NaN where none.
+
+    ``a`` and ``b`` are ``(..., 3)`` tip positions broadcast with ``px`` and
+    ``py``; ``r`` and ``corner`` as :func:`lowest_in_frame` takes them.
+    """
+    return lowest_in_frame(move_frames(a, b), px, py, r, corner)
