@@ -333,7 +333,7 @@ def test_garbage_from_a_baud_mismatch_says_to_check_the_settings(run_cli, tmp_pa
                                  "none", "--stopbits", 1, "--timeout", "20", "--quiet", "-o", tmp_path / "x.nc")
         t.join(10)
     assert status == 3, err
-    assert "127 of the 131 characters" in err and "check that the baud rate, parity" in err
+    assert "127 of the 131 characters" in err and "check the baud rate and format (38400 baud, 8N1)" in err
     assert not (tmp_path / "x.nc").exists()
 
 

@@ -33,7 +33,7 @@ way: computed from what surely arrived, never from what only left the port,
 with the blocks that may have run named as those that may be repeated.
 
 Characters from the control other than DC1 and DC3 (and the harmless DC2,
-DC4 and NUL) are what a line at the wrong baud rate or character format
+DC4, NUL and the line ends, spaces and ``%`` that end a punch) are what a line at the wrong baud rate or character format
 makes of the control's DC3: the send stops with a fault that says to check
 them, since the control cannot read what is sent either.
 """
@@ -61,7 +61,8 @@ _SETTLE_S = 0.05
 _SETTLE_NETWORK_S = 0.25
 _HARDWARE = {"rtscts": "cts", "dtrdsr": "dsr"}
 _CARRIER_POLL_S = 0.1
-_HARMLESS = frozenset((DC1, DC2, DC3, DC4, 0x00))  # NUL: an idle line or a break
+# NUL: an idle line or a break; CR, LF, space and %: the tail of a punch or request just before the send.
+_HARMLESS = frozenset((DC1, DC2, DC3, DC4, 0x00, 0x0A, 0x0D, 0x20, 0x25))
 
 
 class Sender:

@@ -1,0 +1,237 @@
+"""The DNC server never loses a punch: shared folders, bursts, punch-alls, odd numbers, links, stops (pty pairs)."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from lagsym.dnc import profile
+from lagsym.dnc.config import load_config
+from lagsym.dnc.server import serve
+from simcontrol import PtyPair, SimControl, punch
+
+pytestmark = pytest.mark.socat
+ROOT = Path(__file__).resolve().parent.parent
+BAUD = 38400
+
+
+def wait_until(check, timeout=60.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if check():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def config_text(devices, received="received", extra=""):
+    tables = []
+    for i, device in enumerate(devices):
+        tables.append(f'[[port]]\nname = "p{i}"\ndevice = "{device}"\nprofile = "fanuc"\nprograms = "programs"\n'
+                      f'received = "{received}"\nrequest_delay_s = 0\n{extra}[port.line]\nbaud = {BAUD}\n')
+    return "\n".join(tables)
+
+
+class Server:
+    """``serve`` in a thread on the given devices; its log lines per port and its status lines."""
+
+    def __init__(self, tmp_path, devices, received="received", extra=""):
+        (tmp_path / "programs").mkdir(exist_ok=True)
+        cfg = tmp_path / "dnc.toml"
+        cfg.write_text(config_text(devices, received, extra))
+        self.config = load_config(cfg)
+        self.logs = {p.name: [] for p in self.config.ports}
+        self.lock = threading.Lock()
+        self.stop = threading.Event()
+        self.listening = {p.name: threading.Event() for p in self.config.ports}
+        self.thread = threading.Thread(target=serve, args=(self.config, self.stop, self.log_for, self.status),
+                                       daemon=True)
+        self.thread.start()
+        for event in self.listening.values():
+            assert event.wait(20)
+        time.sleep(0.3)
+
+    def log_for(self, port):
+        def log(line):
+            with self.lock:
+                self.logs[port.name].append(line)
+        return log
+
+    def status(self, name, text):
+        if text.startswith("listening") and name in self.listening:
+            self.listening[name].set()
+
+    def lines(self, port, start):
+        with self.lock:
+            return [line for line in self.logs[port] if line.startswith(start)]
+
+    def close(self):
+        self.stop.set()
+        self.thread.join(10)
+
+
+def framed(number, body="G0 X1.\nM30"):
+    return f"%\nO{number}\n{body}\n%\n"
+
+
+def test_two_ports_sharing_one_folder_punching_at_once_lose_nothing(tmp_path):
+    pairs = [PtyPair(), PtyPair()]
+    server = Server(tmp_path, [p.near for p in pairs])
+    try:
+        # Both ports punch the same program numbers at the same moments: every punch needs a name of its own.
+        texts = {i: [framed(5000 + k % 3, f"(PORT {i} PUNCH {k})\nG0 X{k}.\nM30") for k in range(30)] for i in (0, 1)}
+
+        def punches(i):
+            for text in texts[i]:
+                punch(pairs[i].far, b"\x12" + text.encode() + b"\x14", BAUD, delay_s=0.05)
+
+        threads = [threading.Thread(target=punches, args=(i,)) for i in (0, 1)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(300)
+        received = tmp_path / "received"
+        assert wait_until(lambda: len(server.lines("p0", "received")) + len(server.lines("p1", "received")) == 60)
+    finally:
+        server.close()
+        for p in pairs:
+            p.close()
+    saved = sorted(path.read_text() for path in received.glob("*.nc"))
+    assert saved == sorted(texts[0] + texts[1])
+    names = [re.search(r"saved as (\S+)", line)[1] for port in ("p0", "p1") for line in server.lines(port, "received")]
+    assert len(set(names)) == 60 and {n for n in names} == {path.name for path in received.glob("*.nc")}
+
+
+def test_a_burst_of_300_small_punches_saves_all_300(tmp_path):
+    pair = PtyPair()
+    server = Server(tmp_path, [pair.near])
+    texts = [framed(7000 + k) for k in range(300)]
+    try:
+        punch(pair.far, b"".join(b"\x12" + t.encode() + b"\x14" for t in texts), BAUD, delay_s=0.05)
+        assert wait_until(lambda: len(server.lines("p0", "received")) == 300)
+    finally:
+        server.close()
+        pair.close()
+    received = tmp_path / "received"
+    assert sorted(p.name for p in received.glob("*.nc")) == sorted(f"{7000 + k}.nc" for k in range(300))
+    assert all((received / f"{7000 + k}.nc").read_text() == texts[k] for k in range(300))
+
+
+def test_a_punch_all_is_split_and_odd_numbers_are_saved_not_lost(tmp_path):
+    pair = PtyPair()
+    server = Server(tmp_path, [pair.near])
+    received = tmp_path / "received"
+    try:
+        # Three programs in one % frame.
+        punch(pair.far, b"\x12%\nO1001\nG0 X1.\nM99\nO1002\nG0 X2.\nM99\nO1003 (MAIN)\nM98 P1001\nM30\n%\x14", BAUD)
+        assert wait_until(lambda: len(server.lines("p0", "received")) == 3)
+        # A real program numbered as the drip request, whose first comment looks like a program number.
+        program = "%\nO9998 (O1234)\nG21 G90\nG0 X10. Y10.\nG1 Z-1. F100.\nM30\n%\n"
+        punch(pair.far, b"\x12" + program.encode() + b"\x14", BAUD)
+        assert wait_until(lambda: (received / "9998.nc").exists())
+        # A program number of 300 digits.
+        huge = "%\nO" + "7" * 300 + "\nG0 X1.\nM30\n%\n"
+        punch(pair.far, b"\x12" + huge.encode() + b"\x14", BAUD)
+        assert wait_until(lambda: (received / "unnumbered.nc").exists())
+    finally:
+        server.close()
+        pair.close()
+    assert (received / "1001.nc").read_text() == "%\nO1001\nG0 X1.\nM99\n%\n"
+    assert (received / "1002.nc").read_text() == "%\nO1002\nG0 X2.\nM99\n%\n"
+    assert (received / "1003.nc").read_text() == "%\nO1003 (MAIN)\nM98 P1001\nM30\n%\n"
+    assert (received / "9998.nc").read_text() == program
+    assert not server.lines("p0", "request")
+    assert (received / "unnumbered.nc").read_text() == huge
+    assert any("O-number has 300 digits" in line for line in server.lines("p0", "received"))
+    assert not any("ONone" in line or "None.nc" in line for line in server.logs["p0"])
+
+
+def test_a_link_in_the_received_folder_is_never_written_through(tmp_path):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    received = tmp_path / "received"
+    received.mkdir()
+    (received / "2001.nc").symlink_to(outside / "stolen.nc")  # dangling
+    (tmp_path / "programs").mkdir()
+    (tmp_path / "programs" / "1234.nc").symlink_to(outside / "secret.nc")
+    (outside / "secret.nc").write_text("%\nO1234\nM30\n%\n")
+    pair = PtyPair()
+    server = Server(tmp_path, [pair.near])
+    try:
+        punch(pair.far, b"\x12%\nO2001\nG0 X1.\nM30\n%\x14", BAUD)
+        assert wait_until(lambda: (received / "2001.received-2.nc").exists())
+        punch(pair.far, b"%\nO9999 (PRG=1234)\nM30\n%\n", BAUD)
+        assert wait_until(lambda: server.lines("p0", "request for upload of O1234: "))
+    finally:
+        server.close()
+        pair.close()
+    assert not (outside / "stolen.nc").exists() and (received / "2001.nc").is_symlink()
+    assert "symbolic link" in server.lines("p0", "request for upload of O1234")[0]
+    assert not server.lines("p0", "sent")
+
+
+def test_failed_punches_are_kept_with_their_reason(tmp_path):
+    pair = PtyPair()
+    server = Server(tmp_path, [pair.near], extra="max_punch_bytes = 2000\n")
+    failed = tmp_path / "received" / "failed"
+    try:
+        # Control codes no program holds, as a baud rate that does not match makes of text.
+        garbage = b"\x12%\nO3001\n" + bytes([1, 2, 5, 6, 7, 8, 11, 12, 14, 15]) * 3 + b"\nM30\n%\x14"
+        punch(pair.far, garbage, BAUD)
+        assert wait_until(lambda: len(list(failed.glob("*.reason"))) == 1)
+        long = b"\x12%\nO3002\n" + b"G1 X1. Y2.\n" * 400 + b"M30\n%\x14"
+        punch(pair.far, long, BAUD)
+        assert wait_until(lambda: len(list(failed.glob("*.reason"))) == 2)
+    finally:
+        server.close()
+        pair.close()
+    kept = sorted(failed.glob("*.punch"), key=lambda p: p.stat().st_mtime_ns)
+    assert kept[0].read_bytes() == garbage[:-1]  # its DC4, after the closing %, went with the next punch
+    assert "baud rate" in kept[0].with_suffix(".reason").read_text()
+    # The first punch's DC4 came after its closing %: it opens the next punch's bytes, kept with them.
+    wire = kept[1].read_bytes()
+    assert wire[:1] == b"\x14" and long.startswith(wire[1:]) and len(wire) > 2000
+    reason = kept[1].with_suffix(".reason").read_text()
+    assert "max_punch_bytes (2000)" in reason
+    assert f"the {len(long) - len(wire) + 1} bytes after the limit were discarded" in reason
+    assert not list((tmp_path / "received").glob("*.nc"))
+    assert len(server.lines("p0", "failed punch")) == 2
+
+
+def test_sigterm_mid_punch_keeps_what_arrived(tmp_path):
+    pair = PtyPair()
+    (tmp_path / "programs").mkdir()
+    cfg = tmp_path / "dnc.toml"
+    cfg.write_text(config_text([pair.near]).replace(f"baud = {BAUD}", "baud = 9600"))
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen([sys.executable, "-m", "lagsym", "dnc", "serve", str(cfg)], cwd=tmp_path, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    data = b"\x12%\nO4001\n" + b"G1 X1. Y2. Z3.\n" * 300 + b"M30\n%\x14"
+    sim = None
+    try:
+        assert "listening" in proc.stdout.readline()
+        sim = threading.Thread(target=punch, args=(pair.far, data, 9600), daemon=True)
+        sim.start()
+        failed = tmp_path / "received" / "failed"
+        assert wait_until(lambda: any(p.stat().st_size > 500 for p in failed.glob("*.punch")))
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        if sim is not None:
+            sim.join(30)
+        pair.close()
+    assert proc.returncode == 0, err
+    (kept,) = failed.glob("*.punch")
+    assert 500 < len(kept.read_bytes()) < len(data) and data.startswith(kept.read_bytes())
+    assert "stopped" in kept.with_suffix(".reason").read_text()
+    assert "failed punch after" in (tmp_path / "p0.log").read_text()
