@@ -201,7 +201,8 @@ def test_failed_punches_are_kept_with_their_reason(tmp_path):
     assert wire[:1] == b"\x14" and long.startswith(wire[1:]) and len(wire) > 2000
     reason = kept[1].with_suffix(".reason").read_text()
     assert "max_punch_bytes (2000)" in reason
-    assert f"the {len(long) - len(wire) + 1} bytes after the limit were discarded" in reason
+    # Dropped: the rest up to its closing %; the DC4 after that is no punch of its own.
+    assert f"the {len(long) - (len(wire) - 1) - 1} bytes after the limit were discarded" in reason
     assert not list((tmp_path / "received").glob("*.nc"))
     assert len(server.lines("p0", "failed punch")) == 2
 
@@ -235,3 +236,86 @@ def test_sigterm_mid_punch_keeps_what_arrived(tmp_path):
     assert 500 < len(kept.read_bytes()) < len(data) and data.startswith(kept.read_bytes())
     assert "stopped" in kept.with_suffix(".reason").read_text()
     assert "failed punch after" in (tmp_path / "p0.log").read_text()
+
+
+@pytest.mark.slow
+def test_soak_two_ports_punching_and_requesting_at_random_with_faults(tmp_path):
+    # Two ports share one folder; each, at random, punches one program or a punch-all, a burst of small
+    # punches, garbage, a punch past max_punch_bytes, or a request.  In the end every program punched is in
+    # exactly one file, every failed punch in exactly one failed/ file with its bytes, and every log line
+    # names a file that holds what it says.  LAGSYM_SOAK_S lengthens it.
+    import random
+
+    duration = float(os.environ.get("LAGSYM_SOAK_S", "120"))
+    (tmp_path / "programs").mkdir()
+    (tmp_path / "programs" / "1234.nc").write_text(framed(1234, "G0 X5.\nM30"))
+    pairs = [PtyPair(), PtyPair()]
+    server = Server(tmp_path, [p.near for p in pairs], extra="max_punch_bytes = 3000\n")
+    programs, failed_bytes, requests = [], [], [0, 0]
+    serial_no = iter(range(1, 10**6))
+
+    def program():
+        n = next(serial_no)
+        return framed(6000 + n % 7, f"(TAG {n})\nG1 X{n}. F100.\nM30")
+
+    def run(i, seed):
+        rng = random.Random(seed)
+        deadline = time.monotonic() + duration
+        while time.monotonic() < deadline:
+            kind = rng.choice(["one", "all", "burst", "garbage", "long", "request"])
+            if kind == "one":
+                text = program()
+                programs.append(text)
+                data = b"\x12" + text.encode() + b"\x14"
+            elif kind == "all":
+                parts = [program() for _ in range(rng.randint(2, 4))]
+                programs.extend(parts)
+                data = b"\x12%\n" + "".join(p[2:-2] for p in parts).encode() + b"%\x14"
+            elif kind == "burst":
+                parts = [program() for _ in range(rng.randint(5, 30))]
+                programs.extend(parts)
+                data = b"".join(b"\x12" + p.encode() + b"\x14" for p in parts)
+            elif kind == "garbage":
+                data = b"\x12%\nO5555\n" + bytes(rng.choice([1, 2, 5, 6, 7]) for _ in range(40)) + b"\n\x14"
+                failed_bytes.append(data)
+            elif kind == "long":
+                data = b"\x12%\nO5556\n" + b"G1 X1. Y2.\n" * 400 + b"M30\n%\x14"
+                failed_bytes.append(data)
+            else:
+                data = b"%\nO9999 (PRG=1234)\nM30\n%\n"
+                requests[i] += 1
+            punch(pairs[i].far, data, BAUD, delay_s=0.05)
+            if kind in ("long", "request"):
+                time.sleep(1.5)  # the rest of a long punch is drained; an upload goes back
+    threads = [threading.Thread(target=run, args=(i, 1000 + i)) for i in (0, 1)]
+    try:
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(duration + 300)
+        received = tmp_path / "received"
+        expected_lines = len(programs)
+        assert wait_until(lambda: sum(len(server.lines(p, "received")) for p in ("p0", "p1")) >= expected_lines,
+                          timeout=120)
+        assert wait_until(lambda: len(list((received / "failed").glob("*.reason"))) >= len(failed_bytes))
+        time.sleep(2)
+    finally:
+        server.close()
+        for p in pairs:
+            p.close()
+    saved = sorted(p.read_text() for p in received.glob("*.nc"))
+    assert saved == sorted(programs)  # each program exactly once
+    # Every failed punch, once: its bytes (after a DC4 or line end left from the punch before) as sent, or the
+    # start of them up to the limit for an over-long one.
+    kept = sorted(p.read_bytes().lstrip(b"\x14\r\n") for p in (received / "failed").glob("*.punch"))
+    assert len(kept) == len(failed_bytes)
+    for data in failed_bytes:
+        match = [k for k in kept if k == data or (len(k) > 3000 and data.startswith(k))]
+        assert match, data[:40]
+        kept.remove(match[0])
+    for port in ("p0", "p1"):
+        for line in server.lines(port, "received"):
+            name = re.search(r"saved as (\S+)", line)[1]
+            number = re.match(r"received O(\d+)", line)[1]
+            assert f"\nO{number}\n" in (received / name).read_text()
+        assert len(server.lines(port, "sent O1234 (upload)")) == requests[int(port[1])]

@@ -48,7 +48,8 @@ _COMMENT = re.compile(r"\([^)]*\)")
 # Controls number programs with 4 to 8 digits; a longer "number" is no program number (and no file name).
 _MAX_DIGITS = 9
 _RETRY_S = 1.0
-_DRAIN_IDLE_S = 1.0  # a punch cut off at max_punch_bytes ends when the line has been this quiet
+_NOT_TEXT = bytes(range(33)) + b"\x7f"  # control codes, blank and DEL: no program character
+_DRAIN_IDLE_S = 1.0  # a punch cut off at max_punch_bytes without its end ends when the line is this quiet
 
 
 def program_number(text: str) -> int | None:
@@ -76,8 +77,8 @@ def split_programs(text: str) -> list[str]:
 
     Examples
     --------
-    >>> split_programs("%\nO1\nM30\nO2\nM99\n%\n")
-    ['%\nO1\nM30\n%\n', '%\nO2\nM99\n%\n']
+    >>> split_programs("%\\nO1\\nM30\\nO2\\nM99\\n%\\n")
+    ['%\\nO1\\nM30\\n%\\n', '%\\nO2\\nM99\\n%\\n']
     """
     lines = text.splitlines()
     framed = bool(lines) and lines[0] == "%" and lines[-1] == "%"
@@ -130,12 +131,26 @@ class _Spool:
     """A punch on its way to disk: every byte in ``failed/PORT-TIME.punch``, removed once the program is saved."""
 
     def __init__(self, folder: Path, port: str):
-        self.folder, self.port = folder, port
+        self.folder, self.port = folder, re.sub(r"[^A-Za-z0-9_.-]", "_", port)
         self.path: Path | None = None
         self.fd: int | None = None
         self.size = 0
+        self.error: str | None = None  # the disk refused: the punch is still received, in memory
+        self.text = False  # whether anything but leader, line ends and control codes arrived
 
     def write(self, chunk: bytes) -> None:
+        self.text = self.text or bool(chunk.translate(None, _NOT_TEXT))
+        if self.error is not None:
+            return
+        try:
+            self._write(chunk)
+        except OSError as e:
+            self.error = e.strerror or str(e)
+            if self.fd is not None:
+                os.close(self.fd)
+                self.fd = None
+
+    def _write(self, chunk: bytes) -> None:
         if self.fd is None:
             self.folder.mkdir(parents=True, exist_ok=True)
             stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -155,9 +170,11 @@ class _Spool:
 
     def close(self) -> None:
         if self.fd is not None:
-            os.fsync(self.fd)
-            os.close(self.fd)
-            self.fd = None
+            try:
+                os.fsync(self.fd)
+            finally:
+                os.close(self.fd)
+                self.fd = None
 
     def discard(self) -> None:
         self.close()
@@ -165,10 +182,16 @@ class _Spool:
             self.path.unlink(missing_ok=True)
 
     def keep(self, reason: str) -> Path | None:
-        self.close()
-        if self.path is None:
+        if not self.text:  # the line end and DC4 after a program, a leader: no punch to keep
+            self.discard()
             return None
-        create_exclusive(self.path.with_suffix(".reason"), (reason + "\n").encode("utf-8", errors="replace"))
+        self.close()
+        if self.path is None or self.error is not None:
+            return None
+        try:
+            create_exclusive(self.path.with_suffix(".reason"), (reason + "\n").encode("utf-8", errors="replace"))
+        except OSError:
+            pass  # the bytes are kept; the log line still gives the reason
         return self.path
 
 
@@ -233,6 +256,8 @@ class _PortService:
                 reason += f"; the {self.drain()} bytes after the limit were discarded"
             kept = spool.keep(reason)
             where = f"kept in failed/{kept.name} with its reason" if kept else "nothing had arrived"
+            if spool.error is not None:
+                where = f"it could not be kept ({spool.error})"
             self.log(f"failed punch after {len(e.wire)} bytes: {reason}; {where}")
             self.status(f"failed punch ({reason}); {where}")
             if e.line_lost or self.stop.is_set():
@@ -258,17 +283,30 @@ class _PortService:
         spool.discard()
 
     def drain(self) -> int:
-        """Read and drop what arrives until the line has been quiet for the idle time; how many bytes."""
-        count = len(self.inbox.pending)
-        self.inbox.pending.clear()
+        """Read and drop the rest of a punch cut off at its limit, up to its end; how many bytes.
+
+        The end is the DC4 or ETX after it, or its closing ``%`` (what follows is kept for the next punch), or
+        failing those a quiet line for :data:`_DRAIN_IDLE_S`.
+        """
+        ends = {0x14, 0x03} | ({ord("%")} if self.port.settings.percent else set())
+        mask = 0x7F if self.port.settings.bytesize == 7 else 0xFF
+        count = 0
         quiet_since = time.monotonic()
         while not self.stop.is_set() and time.monotonic() - quiet_since < _DRAIN_IDLE_S:
-            chunk = self.line.read(4096)
-            if chunk:
-                count += len(chunk)
-                quiet_since = time.monotonic()
+            if self.inbox.pending:
+                chunk = bytes(self.inbox.pending)
+                self.inbox.pending.clear()
             else:
+                chunk = self.line.read(4096)
+            if not chunk:
                 self.stop.wait(0.01)
+                continue
+            quiet_since = time.monotonic()
+            end = next((i for i, byte in enumerate(chunk) if byte & mask in ends), None)
+            if end is not None:
+                self.inbox.pending[:0] = chunk[end + 1:]
+                return count + end + 1
+            count += len(chunk)
         return count
 
     def save(self, text: str) -> None:
