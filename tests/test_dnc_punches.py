@@ -307,10 +307,11 @@ def test_soak_two_ports_punching_and_requesting_at_random_with_faults(tmp_path):
     assert saved == sorted(programs)  # each program exactly once
     # Every failed punch, once: its bytes (after a DC4 or line end left from the punch before) as sent, or the
     # start of them up to the limit for an over-long one.
-    kept = sorted(p.read_bytes().lstrip(b"\x14\r\n") for p in (received / "failed").glob("*.punch"))
+    files = [p.read_bytes() for p in (received / "failed").glob("*.punch")]
+    kept = sorted((len(b), b.lstrip(b"\x14\r\n")) for b in files)
     assert len(kept) == len(failed_bytes)
     for data in failed_bytes:
-        match = [k for k in kept if k == data or (len(k) > 3000 and data.startswith(k))]
+        match = [k for k in kept if k[1] == data or (k[0] > 3000 and data.startswith(k[1]))]
         assert match, data[:40]
         kept.remove(match[0])
     for port in ("p0", "p1"):
@@ -319,3 +320,26 @@ def test_soak_two_ports_punching_and_requesting_at_random_with_faults(tmp_path):
             number = re.match(r"received O(\d+)", line)[1]
             assert f"\nO{number}\n" in (received / name).read_text()
         assert len(server.lines(port, "sent O1234 (upload)")) == requests[int(port[1])]
+
+
+def test_a_punch_that_starts_during_a_send_is_saved(tmp_path):
+    # The server uploads a long program; before it ends the control starts punching (the operator pressed
+    # PUNCH): the send stops and the punch is saved, not read as the send's flow control and lost.
+    from simcontrol import program_text
+
+    (tmp_path / "programs").mkdir()
+    (tmp_path / "programs" / "1234.nc").write_text(program_text(2000).replace("O1000", "O1234"))
+    pair = PtyPair()
+    server = Server(tmp_path, [pair.near])
+    program = framed(4242, "G0 X4.\nM30")
+    try:
+        punch(pair.far, b"%\nO9999 (PRG=1234)\nM30\n%\n", BAUD)
+        assert wait_until(lambda: server.lines("p0", "sending "))
+        time.sleep(0.5)
+        punch(pair.far, b"\x12" + program.encode() + b"\x14", BAUD, delay_s=0.05)
+        assert wait_until(lambda: (tmp_path / "received" / "4242.nc").exists())
+    finally:
+        server.close()
+        pair.close()
+    assert (tmp_path / "received" / "4242.nc").read_text() == program
+    assert server.lines("p0", "send of O1234 (upload) stopped")

@@ -24,9 +24,10 @@ file is created only when the whole program has arrived, exclusively and
 never through a symbolic link: a FILE that appeared meanwhile is kept and
 the program saved beside it (FILE.received-2.nc, exit 2); an existing file
 is replaced only with --overwrite.  Once the port is open it says so: then
-press PUNCH; on a terminal, characters, blocks and rate show as they arrive.  Exit status 3 on a line fault, a busy port, a timeout, a program
-without its closing %, garbage (a baud rate or parity that does not match
-the control's), Ctrl-C, SIGTERM or SIGHUP.
+press PUNCH; on a terminal, characters, blocks and rate show as they
+arrive.  Exit status 3 on a line fault, a busy port, a timeout, a program
+without its closing %, garbage (check the baud rate and format: they must
+match the control's), Ctrl-C, SIGTERM or SIGHUP.
 
 examples:
   lagsym receive --port /dev/ttyUSB0 --profile fanuc -o from-control.nc

@@ -216,7 +216,7 @@ def run(args, out, err) -> int:
     if not args.quiet:
         out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
                   f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")
-        if not result.confirmed and result.last_answered_block >= result.blocks:
+        if not result.confirmed and result.answered_to_end:
             out.write(f"the control answered XON/XOFF {result.answers} times, the last after the last block\n")
         elif not result.confirmed and result.answers:
             out.write(f"the control answered XON/XOFF {result.answers} times, the last after block "

@@ -40,7 +40,8 @@ class TransferResult:
     flow control) showed the control on the line throughout; over XON/XOFF
     alone only the control's answers show what it took: ``answers`` counts
     them (DC3 and DC1) and ``last_answered_block`` is the last block that had
-    left the port when the control last answered (what surely reached it).
+    left the port when the control last answered (what surely reached it);
+    ``answered_to_end`` says the control answered after the last block.
     """
 
     blocks: int
@@ -52,6 +53,7 @@ class TransferResult:
     confirmed: bool = False
     answers: int = 0
     last_answered_block: int = 0
+    answered_to_end: bool = False
 
     @property
     def throughput(self) -> float:

@@ -33,9 +33,10 @@ way: computed from what surely arrived, never from what only left the port,
 with the blocks that may have run named as those that may be repeated.
 
 Characters from the control other than DC1 and DC3 (and the harmless DC2,
-DC4, NUL and the line ends, spaces and ``%`` that end a punch) are what a line at the wrong baud rate or character format
-makes of the control's DC3: the send stops with a fault that says to check
-them, since the control cannot read what is sent either.
+DC4, NUL and the line ends, spaces and ``%`` that end a punch) are what a
+line at the wrong baud rate or character format makes of the control's
+DC3: the send stops with a fault that says to check them, since the
+control cannot read what is sent either.
 """
 
 from __future__ import annotations
@@ -63,6 +64,7 @@ _HARDWARE = {"rtscts": "cts", "dtrdsr": "dsr"}
 _CARRIER_POLL_S = 0.1
 # NUL: an idle line or a break; CR, LF, space and %: the tail of a punch or request just before the send.
 _HARMLESS = frozenset((DC1, DC2, DC3, DC4, 0x00, 0x0A, 0x0D, 0x20, 0x25))
+_UNFLOW_KEPT = 4096  # of those, the most handed on with a punch that stops a send
 
 
 class Sender:
@@ -70,8 +72,10 @@ class Sender:
 
     def __init__(self, line, segments, settings: LineSettings, mode: str, port: str, *,
                  progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None,
-                 resumable_from: int = 2):
+                 resumable_from: int = 2, stray: Callable[[bytes], None] | None = None):
         self.line, self.settings, self.mode, self.port = line, settings, mode, port
+        self.stray = stray  # given what the control sent that is not flow control (a service keeps it)
+        self.unflow = bytearray()  # the harmless characters so far that were no flow control: a punch's DC2 and %
         self.resumable_from = resumable_from  # no resume before this block can approach the part
         self.progress, self.log = progress, log or (lambda _m: None)
         self.data = b"".join(b for _, b in segments)
@@ -215,16 +219,22 @@ class Sender:
             self.known = max(self.known, min(self.echoed, self.pos))
             self.answers += 1
             return
-        for byte in incoming:
+        for index, byte in enumerate(incoming):
             if byte in (DC1, DC3) and self.settings.flow == "xonxoff":
                 self.answers += 1
                 self.known = max(self.known, self.left)
             elif byte not in _HARMLESS:
+                if self.stray is not None:
+                    self.stray(bytes(self.unflow[-_UNFLOW_KEPT:]) + incoming[index:])
                 raise self.fault(f"the control answered 0x{byte:02X}, a character no control sends during a "
                                  f"transfer (line noise, or a baud rate or format that does not match): check the "
                                  f"baud rate and format ({self.settings.baud} baud, {self.format_text()}) against "
                                  "the control's", "set the same baud rate and format on both sides and clear the "
                                  "control")
+            else:
+                self.unflow.append(byte)
+                if len(self.unflow) > 2 * _UNFLOW_KEPT:
+                    del self.unflow[:-_UNFLOW_KEPT]
             if byte == DC3 and self.settings.flow == "xonxoff":
                 if not self.paused:
                     self.paused, self.pause_since = True, now
@@ -338,4 +348,5 @@ class Sender:
         self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF, {self.answers} answers from the "
                  f"control, the last after block {self.last_sure_block()}")
         return TransferResult(self.blocks_total, total, elapsed, self.xoffs, self.max_in_flight, self.cps,
-                              confirmed=self.vouched, answers=self.answers, last_answered_block=self.last_sure_block())
+                              confirmed=self.vouched, answers=self.answers, last_answered_block=self.last_sure_block(),
+                              answered_to_end=self.blocks_within(self.known) == self.blocks_total)

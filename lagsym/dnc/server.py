@@ -36,6 +36,7 @@ from ..errors import LagsymError
 from .blocks import parse_program
 from .config import PortConfig, ServerConfig
 from .receiver import Inbox, ReceiveFault, receive_program
+from .results import LineFault
 from .store import create_exclusive, read_no_link, save_beside
 from .transfer import send_program
 
@@ -350,8 +351,17 @@ class _PortService:
             if self.stop.is_set():
                 raise KeyboardInterrupt  # a stopping service ends the send as Ctrl-C does, with the resume block
 
-        result = send_program(self.port.device, program, self.port.settings, mode, progress=progress, log=self.log,
-                              line=self.line)
+        try:
+            result = send_program(self.port.device, program, self.port.settings, mode, progress=progress,
+                                  log=self.log, line=self.line, stray=self.inbox.pending.extend)
+        except LineFault as e:
+            if not self.inbox.pending:
+                raise
+            # The control sent text during the send: a punch begun, kept for the receive that comes next.
+            self.log(f"send of O{wanted} ({mode}) stopped: {e}; the control is punching, {len(self.inbox.pending)} "
+                     "bytes kept for it")
+            self.status(f"send of O{wanted} stopped: the control is punching")
+            return
         self.log(f"sent O{wanted} ({mode}): {result.blocks} blocks, {result.bytes} bytes in {result.elapsed_s:.1f} s")
         self.status(f"sent O{wanted} ({mode})")
 
