@@ -172,6 +172,9 @@ class SimControl:
     discard_after_bytes : int or None
         Keep reading the line but record nothing after this many bytes: a
         control that stopped taking the program while its port stays up.
+    garble_answers : bool
+        Answer with what a line at another baud rate makes of DC3 and DC1
+        (characters no control sends), as a control set up differently does.
     pair : PtyPair
         What to hang up when cutting the line.
     """
@@ -257,7 +260,7 @@ class _Control:
     def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
                  buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
                  drop_on_xoff=None, drop_settle_s=1.0, drop_after_bytes=None, xon_after_s=None, hold_on_xoff=False,
-                 discard_after_bytes=None):
+                 discard_after_bytes=None, garble_answers=False):
         self.cps = chars_per_s(baud, bytesize, parity, stopbits)
         self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
         self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
@@ -265,6 +268,8 @@ class _Control:
         self.socat_pid, self.count, self.halt = socat_pid, count, halt
         self.xon_after_s = xon_after_s
         self.hold_on_xoff, self.discard_after_bytes = hold_on_xoff, discard_after_bytes
+        # DC3 (0x13) and DC1 (0x11) sent at 4800 baud and read at 9600 come out as other characters.
+        self.xoff_byte, self.xon_byte = (b"\xe6", b"\x9e") if garble_answers else (DC3, DC1)
         self.buffered = 0.0
         self.count_in = 0  # every character taken from the line, recorded or not
         self.port = _FdPort(path) if isinstance(path, int) else serial.Serial(path, baudrate=baud, timeout=0)
@@ -360,7 +365,7 @@ class _Control:
                         return
                 self.count.value = len(self.received)
                 if crossed:
-                    self.port.write(DC3)
+                    self.port.write(self.xoff_byte)
                     self.pending_now, self.tail = self.port.in_waiting, self.after
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
@@ -377,7 +382,7 @@ class _Control:
             if self.xoff and not self.ignore_xon and drop_at is None and self.buffered <= self.low:
                 self.close_episode()
                 self.xoff = False
-                self.port.write(DC1)
+                self.port.write(self.xon_byte)
             time.sleep(_LOOP_S)
 
 

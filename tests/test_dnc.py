@@ -99,6 +99,7 @@ def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp
         got = b""
         while len(got) < 6000:
             got += conn.recv(4096)
+            conn.sendall(b"\x13\x11")  # the control answers XOFF and XON: what came before it holds
         conn.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
         conn.close()
 
@@ -278,7 +279,7 @@ def _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path):
     pair, sim = line(baud=baud)
     log = tmp_path / "resume.log"
     status, out, err2 = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
-                                "--mode", "drip", "--start-block", start, "--quiet", "--log", log)
+                                "--mode", "drip", "--start-block", start, "--no-handshake-expected", "--quiet", "--log", log)
     assert status == 0, err2
     setup = list(resume_setup(parse_program(text), start))
     tail = blocks[start - 1:]
@@ -310,10 +311,14 @@ def test_a_feed_hold_stalls_with_exit_3_and_a_resume_block_that_allows_for_the_b
     assert "the line was lost" not in err and "reconnect" not in err  # a stall, told as a stall
     first = sim.stop()
     assert first["xoffs"] == 1
+    # Surely reached: what had left the port when the control said XOFF; the rest (what was on the line
+    # then) left the port too, and nothing shows more.
     last = int(re.search(r"block (\d+) surely reached", err).group(1))
-    assert last == len(first["received"].replace(b"\x00", b"").decode().split("\n")) - 2
+    held = len(first["received"].replace(b"\x00", b"").decode().split("\n")) - 2
+    left = re.search(r"blocks \d+ to (\d+) left the port", err)
+    assert last <= held and (left is None and last == held or left and int(left[1]) == held)
     start = _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path)
-    assert start < last and f"blocks {start} to {last} are repeated if they had already run" in err
+    assert start < last and f"blocks {start} to {held} are repeated if they had already run" in err
 
 
 @needs_socat
@@ -350,7 +355,11 @@ def test_a_cut_mid_block_loses_nothing(line, tmp_path):
     # cut, the message names the range that may have arrived too.
     assert got == list(prog.blocks[:len(got)])
     assert fault.last_block <= len(got) <= fault.last_sent_block
-    assert f"blocks {fault.last_block + 1} to {fault.last_sent_block} were on their way" in str(fault)
+    # The control never answered: nothing surely reached it, and the message says what left the port.
+    assert fault.last_block == 0 and "no block surely reached the control" in str(fault)
+    assert f"blocks 1 to {fault.last_left_block} left the port" in str(fault)
+    if fault.last_sent_block > fault.last_left_block:
+        assert f"blocks {fault.last_left_block + 1} to {fault.last_sent_block} were on their way" in str(fault)
 
 
 @needs_socat

@@ -82,7 +82,7 @@ def test_a_fault_within_the_set_up_asks_for_the_program_from_the_start():
     segments = transfer_segments(program, settings, "drip")
     for sure, says in ((150, "then send again"), (1000, "then resume with --start-block")):
         sender = Sender(None, segments, settings, "drip", "loop://", progress=None, log=None, resumable_from=start)
-        sender.sure = sender.pos = sure
+        sender.known = sender.left = sender.pos = sure
         fault = sender.fault("the control held XOFF", "release the feed hold")
         assert says in str(fault), str(fault)
         assert fault.start_block in (1, None) or fault.start_block >= start

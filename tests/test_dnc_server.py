@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from lagsym.dnc import parse_program, profile, transfer_segments
-from simcontrol import PtyPair, SimControl, program_text, punch
+from simcontrol import PtyPair, SimControl, chars_per_s, program_text, punch
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
@@ -72,7 +72,8 @@ def test_the_server_end_to_end_on_two_ports(tmp_path):
         # Requests: O9999 uploads, O9998 drip-feeds the program its first comment names.
         for request, mode in (("%\nO9999 (PRG=1234)\nM30\n%\n", "upload"), ("%\nO9998 (O1234)\nM30\n%\n", "drip")):
             punch(mill.far, request.encode(), 19200)
-            sim = SimControl(mill.far, baud=19200)
+            # The control runs slower than the line, so a drip feed hears its XOFF and XON.
+            sim = SimControl(mill.far, baud=19200, drain_cps=0.5 * chars_per_s(19200))
             sim.start()
             expected = b"".join(b for _, b in transfer_segments(parse_program(served), fanuc, mode))
             assert sim.wait_for(len(expected), timeout=30), mode

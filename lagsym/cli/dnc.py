@@ -15,9 +15,12 @@ from ..io import event_log
 DESCRIPTION = """Serve one or more serial ports as a shop's DNC service, as configured in a
 TOML file (see docs/dnc.md): a program punched from a control is saved under
 its program number (O1234 as 1234.nc; an existing file is kept and the new
-one saved beside it as 1234.received-2.nc); a short program numbered as the
-port's request number (O9999 to upload, O9998 to drip-feed) whose first
-comment names a program, (PRG=1234) or (O1234), has that program sent back
+one saved beside it as 1234.received-2.nc, each name taken by an exclusive
+create), each program of a punch-all in a file of its own; a punch that
+fails is kept byte for byte in the received folder's failed/ with a .reason
+file.  A short program numbered as the port's request number (O9999 to
+upload, O9998 to drip-feed) holding only a first comment that names a
+program, (PRG=1234) or (O1234), and an end, has that program sent back
 after request_delay_s.  Each port has its own log; a status line per port
 goes to standard output.  A fault on one port never stops the others.
 SIGTERM, SIGHUP or Ctrl-C stops the server within 2 s.  --check reads and

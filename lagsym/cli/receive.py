@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+from pathlib import Path
 
 from ..dnc import receive_program
-from ..errors import InputError
-from ..io import check_output, event_log
-from ._common import emit, number
+from ..dnc.store import create_exclusive, save_beside
+from ..errors import InputError, OutputError
+from ..io import check_output, event_log, write_text
+from ._common import number
 from .send import add_line_arguments, check_log, line_settings
 
 MAX_WAIT_S = 86_400.0  # a day: the longest --timeout or --idle-timeout
@@ -17,11 +20,14 @@ DESCRIPTION = """Wait for a program from a CNC control (PUNCH or OUTPUT on the c
 write it to FILE, or to standard output.  The program runs from DC2 (or its
 first character) to DC4, its closing %, ETX, or a silence of --idle-timeout
 seconds; leader and control codes are dropped and blocks end in LF.  The
-file is written only when the whole program has arrived, and an existing
-file only with --overwrite.  Once the port is open it says so: then press
-PUNCH.  Exit status 3 on a line fault, a busy port, a timeout, a program
-without its closing %, garbage (a baud rate or parity that does not match
-the control's), Ctrl-C, SIGTERM or SIGHUP.
+file is created only when the whole program has arrived, exclusively and
+never through a symbolic link: a FILE that appeared meanwhile is kept and
+the program saved beside it (FILE.received-2.nc, exit 2); an existing file
+is replaced only with --overwrite.  Once the port is open it says so: then
+press PUNCH; on a terminal, characters, blocks and rate show as they
+arrive.  Exit status 3 on a line fault, a busy port, a timeout, a program
+without its closing %, garbage (check the baud rate and format: they must
+match the control's), Ctrl-C, SIGTERM or SIGHUP.
 
 examples:
   lagsym receive --port /dev/ttyUSB0 --profile fanuc -o from-control.nc
@@ -40,7 +46,7 @@ def add_arguments(p) -> None:
 
 def run(args, out, err) -> int:
     to_file = args.output and args.output != "-"
-    if to_file and os.path.exists(args.output) and not args.overwrite:
+    if to_file and os.path.lexists(args.output) and not args.overwrite:
         raise InputError(f"{args.output} exists; give another -o FILE, or --overwrite to replace it")
     if to_file:
         check_output(args.output)  # before the control punches: a program that cannot be saved would be lost
@@ -51,11 +57,50 @@ def run(args, out, err) -> int:
             err.write(f"waiting on {args.port} for {args.timeout:g} s: start the output (PUNCH) on the control now\n")
             err.flush()
 
-    with event_log(args.log) as log:
+    with event_log(args.log) as log, progress_bar(err, args.quiet) as bar:
         text = receive_program(args.port, settings, start_timeout_s=args.timeout, idle_timeout_s=args.idle_timeout,
-                               log=log, ready=ready)
-    emit(text, args.output, out)
+                               log=log, ready=ready, progress=bar)
+    if to_file:
+        save(text, args.output, args.overwrite)
+    else:
+        out.write(text)
     check_log(log, f"received {text.count(chr(10))} lines into {args.output if to_file else 'standard output'}")
     if not args.quiet and to_file:
         err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
     return 0
+
+
+def save(text: str, output: str, overwrite: bool) -> None:
+    """Create ``output`` (replace it with ``overwrite``); a file that appeared meanwhile is kept, never replaced."""
+    if overwrite:
+        write_text(output, text)
+        return
+    try:
+        if create_exclusive(Path(output), text.encode("ascii")):
+            return
+    except OSError as e:
+        raise OutputError(f"cannot write {output}: {e.strerror or e}") from None
+    path = Path(output)
+    other = save_beside(path.parent, path.stem, path.suffix, text.encode("ascii"))
+    raise OutputError(f"{output} appeared while lagsym waited and was kept; the program is saved as {other} "
+                      "instead")
+
+
+@contextlib.contextmanager
+def progress_bar(err, quiet: bool):
+    """Characters, blocks and rate of the arriving program on ``err`` (a terminal only), as ``send`` shows them."""
+    if quiet:
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import Progress, SpinnerColumn, TextColumn
+
+    console = Console(file=err, stderr=True)
+    columns = (SpinnerColumn(), TextColumn("{task.description}"), TextColumn("{task.fields[state]}"))
+    with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
+        task = bar.add_task("receiving", state="waiting")
+
+        def update(p) -> None:
+            bar.update(task, state=f"{p.chars} characters, {p.blocks} blocks, {p.rate_chars_s:.0f} characters/s")
+
+        yield update

@@ -40,9 +40,13 @@ approach to where the program was), then block N onwards.
 The port is a device or a pyserial URL: /dev/ttyUSB0, COM3,
 socket://host:4001, rfc2217://host:4001, loop://; a device is opened
 exclusively.  Exit status 3 on a line fault, a stall, a busy port, Ctrl-C,
-SIGTERM or SIGHUP; the message says which --start-block resumes.  Over
-XON/XOFF alone nothing proves that the control took the program: the summary
-says so unless a --carrier signal or hardware flow control watched the line.
+SIGTERM or SIGHUP; the message says which --start-block resumes.  A block
+surely reached the control only when the control answered (XOFF/XON) after
+it left the port, or a --carrier signal or hardware flow control watched the
+line; the summary and the faults word apart what left the port and what
+surely arrived.  A drip feed the control never answered at all is a fault
+(exit 3) unless --no-handshake-expected; so are answers no control sends
+(check the baud rate and format).
 
 examples:
   lagsym send O1000.nc --port /dev/ttyUSB0 --baud 9600 --bytesize 7 --parity even --stopbits 2 --flow xonxoff
@@ -122,6 +126,8 @@ def line_settings(args):
         overrides["wait_for_xon"] = True
     if getattr(args, "realtime", False):
         overrides["realtime"] = True
+    if getattr(args, "no_handshake_expected", False):
+        overrides["handshake_expected"] = False
     if args.profile:
         return profile(args.profile, **overrides)
     return LineSettings(**overrides)
@@ -187,6 +193,9 @@ def add_arguments(p) -> None:
                    help=f"most characters in flight: about half what the control takes past XOFF (default "
                         f"{d.overrun_chars}; a Fanuc takes ~10; a larger N keeps a fast line busy)")
     t.add_argument("--wait-for-xon", action="store_true", help="wait for the control's DC1 before sending")
+    t.add_argument("--no-handshake-expected", action="store_true",
+                   help="a drip feed the control never answers with XOFF/XON is not a fault (a control that reads "
+                        "faster than the line); without it such a feed ends with exit 3")
     t.add_argument("--realtime", action="store_true",
                    help="send at real-time priority (SCHED_FIFO), so a busy computer keeps a small window "
                         "busy at a high baud rate; needs root, CAP_SYS_NICE or an rtprio limit")
@@ -207,7 +216,14 @@ def run(args, out, err) -> int:
     if not args.quiet:
         out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
                   f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")
-        if not result.confirmed:
-            out.write("the control confirmed nothing: over XON/XOFF alone nothing proves it took the program; "
-                      "check it holds the last block (a --carrier signal watches the line)\n")
+        if not result.confirmed and result.answered_to_end:
+            out.write(f"the control answered XON/XOFF {result.answers} times, the last after the last block\n")
+        elif not result.confirmed and result.answers:
+            out.write(f"the control answered XON/XOFF {result.answers} times, the last after block "
+                      f"{result.last_answered_block}: block {result.last_answered_block} surely reached it; the "
+                      "blocks after it left the port but nothing shows that the control holds them: check that it "
+                      "holds the last block (a --carrier signal watches the line)\n")
+        elif not result.confirmed:
+            out.write("the control confirmed nothing: it never answered XON/XOFF, so nothing shows it took the "
+                      "program; check it holds the last block (a --carrier signal watches the line)\n")
     return 0

@@ -38,6 +38,10 @@ class PortConfig:
         Wait after a request, so the operator can switch the control to read.
     log : Path
         This port's log file (default: ``NAME.log`` beside the configuration).
+    max_punch_bytes : int
+        The longest punch kept as a program; a longer one is cut off and
+        kept in the ``failed`` folder (every punch streams to disk as it
+        arrives, so this bounds the disk a runaway punch takes, and memory).
     """
 
     name: str
@@ -49,6 +53,7 @@ class PortConfig:
     request_drip: int | None = 9998
     request_delay_s: float = 5.0
     log: Path | None = None
+    max_punch_bytes: int = 16 * 1024 * 1024
 
 
 @dataclass(frozen=True)
@@ -60,7 +65,7 @@ class ServerConfig:
 
 
 _PORT_KEYS = ("name", "device", "profile", "programs", "received", "request_upload", "request_drip",
-              "request_delay_s", "log", "line")
+              "request_delay_s", "log", "max_punch_bytes", "line")
 
 
 def _bad(source: str, key: str, why: str) -> InputError:
@@ -101,11 +106,14 @@ def _port(source: str, index: int, table, base: Path) -> PortConfig:
     programs, received = base / table["programs"], base / table["received"]
     if not programs.is_dir():
         raise _bad(source, f"{where}.programs", f"{programs} is not a folder")
+    limit = table.get("max_punch_bytes", PortConfig.max_punch_bytes)
+    if isinstance(limit, bool) or not isinstance(limit, int) or not 1 <= limit <= 2**40:
+        raise _bad(source, f"{where}.max_punch_bytes", f"{limit!r} must be a whole number of bytes from 1 to 2**40")
     log = table.get("log")
     if log is not None and not isinstance(log, str):
         raise _bad(source, f"{where}.log", "must be a file name")
     return PortConfig(table["name"], table["device"], settings, programs, received, numbers["request_upload"],
-                      numbers["request_drip"], float(delay), base / (log or f"{table['name']}.log"))
+                      numbers["request_drip"], float(delay), base / (log or f"{table['name']}.log"), limit)
 
 
 def load_config(path: str | Path) -> ServerConfig:

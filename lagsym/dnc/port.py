@@ -10,6 +10,7 @@ on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
 from __future__ import annotations
 
 import errno
+import fcntl
 import select
 import termios
 import time
@@ -17,6 +18,7 @@ import time
 import serial
 
 from ..errors import TransferError
+from .lock import other_openers, release_lock_file, take_lock_file
 from .settings import PARITIES, LineSettings, check_port
 
 __all__ = ["Port", "LINE_ERRORS", "WriteTimeout"]
@@ -48,6 +50,15 @@ class Port:
 
     def __init__(self, name: str, settings: LineSettings, write_timeout: float | None):
         check_port(name, "port")
+        self._lock_file = None
+        local = "://" not in name
+        if local:  # the lock file and the look for other openers, before touching the line (see lagsym.dnc.lock)
+            self._lock_file, holder = take_lock_file(name)
+            others = [holder] if holder else other_openers(name)
+            if others:
+                release_lock_file(self._lock_file)
+                raise TransferError(f"cannot open {name}: the port is in use by another program ({'; '.join(others)}); "
+                                    "close it and try again")
         try:
             ser = serial.serial_for_url(name, do_not_open=True)
             ser.baudrate = settings.baud
@@ -66,7 +77,13 @@ class Port:
                 ser.write_timeout = write_timeout
             ser.dtr = settings.dtr
             ser.open()
+            if local and type(ser) is serial.Serial:
+                try:  # the kernel refuses any further open (but root's): a cat started later cannot steal DC3
+                    fcntl.ioctl(ser.fd, termios.TIOCEXCL)
+                except OSError:
+                    pass  # a device without it (not a terminal): flock and the lock file still hold
         except (ValueError, KeyError, *LINE_ERRORS) as e:  # KeyError: pyserial formatting its own URL message
+            release_lock_file(self._lock_file)
             raise TransferError(_open_failure(name, e)) from None
         self._ser = ser
         # A local device can be waited on: the sender sleeps until the control says something or the line needs
@@ -120,10 +137,17 @@ class Port:
 
     def close(self) -> None:
         """Close the port; a line already lost needs no closing."""
+        if self._fd is not None:
+            try:  # the flag outlives this open while the far end keeps the device open (a pty relay)
+                fcntl.ioctl(self._fd, termios.TIOCNXCL)
+            except (OSError, ValueError):
+                pass
         try:
             self._ser.close()
         except LINE_ERRORS:
             pass
+        release_lock_file(self._lock_file)
+        self._lock_file = None
 
 
 def _open_failure(name: str, e: BaseException) -> str:

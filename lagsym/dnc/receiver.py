@@ -6,6 +6,12 @@ checked before it is believed: characters no program holds (control codes,
 8-bit bytes, and with ``iso_check`` anything outside the ISO 840 tape code)
 are what a baud rate or parity that does not match the control's produces,
 and the message says to check them.
+
+A receive that fails part way raises :class:`ReceiveFault`, which carries
+every byte that arrived (``wire``), so that a service can keep a failed
+punch.  A service that keeps its port open passes an :class:`Inbox`: what
+arrived after the end of one program (a punch-all, or punches back to back)
+stays there for the next call, and ``sink`` sees every byte as it arrives.
 """
 
 from __future__ import annotations
@@ -13,17 +19,46 @@ from __future__ import annotations
 import signal
 import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from ..errors import Terminated, TransferError
 from .blocks import DC1, DC2, DC3, DC4, ISO_840
 from .settings import LineSettings
 
-__all__ = ["receive_program"]
+__all__ = ["receive_program", "ReceiveFault", "ReceiveProgress", "Inbox"]
 
 _ETX = 0x03
 _DROPPED = frozenset((0x00, 0x7F, DC1, DC3, DC4, _ETX))
 _BLANKS = frozenset(b" \t\r\n")
 _LINE_CODES = frozenset(b"\r\n\t")
+
+
+class ReceiveFault(TransferError):
+    """A receive that failed part way; ``wire`` holds every byte that arrived, ``reason`` the short why."""
+
+    def __init__(self, message: str, wire: bytes, reason: str, line_lost: bool = False, too_long: bool = False):
+        super().__init__(message)
+        self.wire, self.reason, self.line_lost, self.too_long = wire, reason, line_lost, too_long
+
+
+@dataclass(frozen=True)
+class ReceiveProgress:
+    """Where a receive stands: characters and blocks of the program so far, and the time since it started."""
+
+    chars: int
+    blocks: int
+    elapsed_s: float
+
+    @property
+    def rate_chars_s(self) -> float:
+        return self.chars / self.elapsed_s if self.elapsed_s > 0 else 0.0
+
+
+@dataclass
+class Inbox:
+    """Bytes read from the line but not yet taken by a program (a service keeps one per port)."""
+
+    pending: bytearray = field(default_factory=bytearray)
 
 
 def _garbage(raw: bytes, settings: LineSettings) -> int:
@@ -43,10 +78,11 @@ def _settings_text(settings: LineSettings) -> str:
 
 
 def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float = 60.0,
-                    idle_timeout_s: float = 5.0, progress: Callable[[int], None] | None = None,
+                    idle_timeout_s: float = 5.0, progress: Callable[[ReceiveProgress], None] | None = None,
                     log: Callable[[str], None] | None = None,
                     ready: Callable[[], None] | None = None,
-                    should_stop: Callable[[], bool] | None = None, line=None) -> str:
+                    should_stop: Callable[[], bool] | None = None, line=None, inbox: Inbox | None = None,
+                    sink: Callable[[bytes], None] | None = None, max_bytes: int | None = None) -> str:
     """Receive a program the control punches out, as text with ``\\n`` line ends.
 
     Parameters
@@ -58,10 +94,19 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
     ready : callable, optional
         Called once the port is open and lagsym is listening (the moment to
         press PUNCH).
+    progress : callable, optional
+        Called with a :class:`ReceiveProgress` after every read once the program has started.
     should_stop : callable, optional
-        Looked at between reads; True gives up the wait (a service stopping).
+        Looked at between reads; True gives up the wait (a service stopping),
+        and a program part way in is a :class:`ReceiveFault` with what arrived.
     line : lagsym.dnc.port.Port, optional
         A port already open (a service keeps its port), used and left open.
+    inbox : Inbox, optional
+        Read first, and left holding what arrived after the program's end.
+    sink : callable, optional
+        Called with every byte of this program as it arrives (a service streams it to disk).
+    max_bytes : int, optional
+        A program longer than this is a :class:`ReceiveFault`.
 
     Raises
     ------
@@ -75,40 +120,72 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
     owned = line is None
     if owned:
         line = Port(port, settings, write_timeout=1.0)
-    raw = bytearray()
+    punch = _Punch(inbox or Inbox(), sink, max_bytes)
     try:
         if ready:
             ready()
-        raw, percents = _collect(line, port, settings, start_timeout_s=start_timeout_s,
-                                 idle_timeout_s=idle_timeout_s, progress=progress, log=log or (lambda _m: None),
-                                 should_stop=should_stop)
+        _collect(line, port, settings, punch, start_timeout_s=start_timeout_s, idle_timeout_s=idle_timeout_s,
+                 progress=progress, log=log or (lambda _m: None), should_stop=should_stop)
     except KeyboardInterrupt as e:
         what = f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated) else "stopped by the user"
-        raise TransferError(f"receive on {port} {what}; nothing was saved: start lagsym receive again, "
-                            "then punch the program again") from None
+        raise ReceiveFault(f"receive on {port} {what}; nothing was saved ({len(punch.wire)} bytes had arrived): "
+                           "start lagsym receive again, then punch the program again", bytes(punch.wire),
+                           what) from None
     except TransferError:
         raise
     except LINE_ERRORS as e:
-        raise TransferError(f"the line on {port} was lost after {len(raw)} bytes ({e}); "
-                            "reconnect and punch the program again") from None
+        raise ReceiveFault(f"the line on {port} was lost after {len(punch.wire)} bytes ({e}); "
+                           "reconnect and punch the program again", bytes(punch.wire), f"line lost ({e})",
+                           line_lost=True) from None
     finally:
         if owned:
             line.close()
-    return _program_text(bytes(raw), percents, port, settings)
+    try:
+        return _program_text(bytes(punch.raw), punch.percents, port, settings)
+    except TransferError as e:
+        raise ReceiveFault(str(e), bytes(punch.wire), str(e)) from None
 
 
-def _collect(line, port, settings, *, start_timeout_s, idle_timeout_s, progress, log, should_stop):
-    """The program's bytes (leader and control codes dropped) and how many ``%`` they hold."""
-    raw = bytearray()
+class _Punch:
+    """One program arriving: every byte off the line for it (``wire``) and the program's own (``raw``)."""
+
+    def __init__(self, inbox: Inbox, sink, max_bytes):
+        self.inbox, self.sink, self.max_bytes = inbox, sink, max_bytes
+        self.wire = bytearray()
+        self.raw = bytearray()
+        self.percents = 0
+        self.blocks = 0  # lines with program text ended so far (not the % lines)
+        self.in_block = False
+
+    def take(self, chunk: bytes) -> None:
+        self.wire += chunk
+        if self.sink is not None:
+            self.sink(chunk)
+
+    def give_back(self, rest: bytes) -> None:
+        """Bytes after the program's end, for the next program."""
+        self.inbox.pending[:0] = rest
+
+
+def _collect(line, port, settings, punch: _Punch, *, start_timeout_s, idle_timeout_s, progress, log,
+             should_stop) -> None:
+    """Fill ``punch`` with the program's bytes (leader and control codes dropped) and count its ``%``."""
+    raw = punch.raw
     started = ended = False
-    percents = 0
     begin = last_data = time.monotonic()
     mask = 0x7F if settings.bytesize == 7 else 0xFF
     while not ended:
         now = time.monotonic()
         if should_stop is not None and should_stop():
+            if started:
+                raise ReceiveFault(f"receive on {port} stopped after {len(punch.wire)} bytes of a program",
+                                   bytes(punch.wire), "the service stopped while the program arrived")
             raise TransferError(f"receive on {port} stopped before a program arrived")
-        chunk = line.read(4096)
+        if punch.inbox.pending:
+            chunk = bytes(punch.inbox.pending)
+            punch.inbox.pending.clear()
+        else:
+            chunk = line.read(4096)
         if not chunk:
             if not started and now - begin > start_timeout_s:
                 raise TransferError(f"nothing arrived on {port} in {start_timeout_s:g} s; start the output "
@@ -119,7 +196,8 @@ def _collect(line, port, settings, *, start_timeout_s, idle_timeout_s, progress,
             time.sleep(0.01)
             continue
         last_data = now
-        for byte in chunk:
+        used = len(chunk)
+        for index, byte in enumerate(chunk):
             byte &= mask
             if byte == DC2:
                 started = True
@@ -127,30 +205,44 @@ def _collect(line, port, settings, *, start_timeout_s, idle_timeout_s, progress,
                 continue
             if byte in (DC4, _ETX) and started:
                 log("DC4/ETX: the control stopped punching")
+                used = index + 1
                 ended = True
                 break
             if byte in _DROPPED:
                 continue
             if not started and byte in _BLANKS:  # the line end after the last program's closing % (and its
                 continue                          # DC4) may come in a later read: it does not start a program
+            if not started:
+                begin = now
             started = True
             if byte == ord("%"):
-                percents += 1
+                punch.percents += 1
+            elif byte in (0x0A, 0x0D):
+                punch.blocks += punch.in_block
+                punch.in_block = False
+            elif byte not in _BLANKS:
+                punch.in_block = True
             raw.append(byte)
-            if settings.percent and percents >= 2 and byte == ord("%"):
+            if settings.percent and punch.percents >= 2 and byte == ord("%"):
+                used = index + 1
                 ended = True
                 break
-        if progress:
-            progress(len(raw))
-    return raw, percents
+        punch.take(chunk[:used])
+        punch.give_back(chunk[used:])
+        if punch.max_bytes is not None and len(punch.wire) > punch.max_bytes:
+            raise ReceiveFault(f"the program from {port} is longer than the limit of {punch.max_bytes} bytes; "
+                               "raise max_punch_bytes or split the program", bytes(punch.wire),
+                               f"longer than max_punch_bytes ({punch.max_bytes})", too_long=True)
+        if progress and started:
+            progress(ReceiveProgress(len(raw), punch.blocks, time.monotonic() - begin))
 
 
 def _program_text(raw: bytes, percents: int, port: str, settings: LineSettings) -> str:
     bad = _garbage(raw, settings)
     if bad:
         raise TransferError(f"{bad} of the {len(raw)} characters from {port} are not program text (garbage); "
-                            f"check that the baud rate, parity, data bits and stop bits ({_settings_text(settings)}) "
-                            "match the control's, then punch it again")
+                            f"check the baud rate and format ({_settings_text(settings)}): baud rate, parity, data "
+                            "bits and stop bits must match the control's; then punch it again")
     text = raw.decode("ascii").replace("\r\n", "\n").replace("\r", "\n")
     if settings.percent:
         first = text.find("%")

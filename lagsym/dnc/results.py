@@ -38,7 +38,10 @@ class TransferResult:
 
     ``confirmed`` is True when a hardware signal (the carrier, or CTS/DSR
     flow control) showed the control on the line throughout; over XON/XOFF
-    alone nothing the control does proves that it took what was sent.
+    alone only the control's answers show what it took: ``answers`` counts
+    them (DC3 and DC1) and ``last_answered_block`` is the last block that had
+    left the port when the control last answered (what surely reached it);
+    ``answered_to_end`` says the control answered after the last block.
     """
 
     blocks: int
@@ -48,6 +51,9 @@ class TransferResult:
     max_in_flight_at_xoff: int
     chars_per_s: float
     confirmed: bool = False
+    answers: int = 0
+    last_answered_block: int = 0
+    answered_to_end: bool = False
 
     @property
     def throughput(self) -> float:
@@ -61,13 +67,19 @@ class LineFault(TransferError):
     Attributes
     ----------
     last_block : int
-        The last program block that surely reached the control (0: none).
+        The last program block that surely reached the control (0: none): it
+        had left the port when the control last answered, or a watched signal
+        vouched for the control.
     start_block : int or None
         The ``--start-block`` that resumes a drip feed, or None for an upload
         (which must be sent again whole).
     last_sent_block : int
         The last block written whole: blocks after ``last_block`` up to this
         one were on their way and may have arrived too.
+    last_left_block : int
+        The last block that had left the port (by the line clock and the
+        output queue): what the computer knows it sent, not what the control
+        holds.
     may_repeat : tuple of int or None
         ``(first, last)``: the blocks from ``start_block`` that had arrived
         but may not have run (they waited in the control's buffer), so a
@@ -75,8 +87,9 @@ class LineFault(TransferError):
     """
 
     def __init__(self, message: str, last_block: int, start_block: int | None, last_sent_block: int | None = None,
-                 may_repeat: tuple[int, int] | None = None):
+                 may_repeat: tuple[int, int] | None = None, last_left_block: int | None = None):
         super().__init__(message)
+        self.last_left_block = last_block if last_left_block is None else last_left_block
         self.may_repeat = may_repeat
         self.last_block = last_block
         self.start_block = start_block

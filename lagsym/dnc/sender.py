@@ -14,15 +14,29 @@ and many USB adapters keep sending after it anyway.  A Fanuc accepts only
 about 10 characters past DC3 before alarm 087, so the default keeps 4 or
 fewer in flight, which leaves room for the DC3 to travel back.
 
-A block counts as *delivered* once all its bytes have had time to leave the
-line (by the line clock and the driver's output queue), a short settling
-time has passed, and a later look at the port found it still healthy.  In a
-drip feed a delivered block is not yet a block that ran: up to
-``LineSettings.buffer_chars`` characters may wait in the control's buffer,
-and a reset clears them.  A fault therefore names the last delivered block
-and a ``--start-block`` that is safe either way: the first block that may
-not have run, with the blocks up to the last delivered one named as those
-that may be repeated.
+Two counts are kept apart.  What the sender knows for itself: the bytes the
+operating system took (written) and the bytes that have *left the port* (by
+the line clock and the driver's output queue, plus a short settling time).
+What the control holds, which only the control can show: a block *surely
+reached the control* only when the control answered after it had left the
+port (a DC3 or DC1, or a watched carrier or CTS/DSR signal that stayed up).
+A control that dies while its line stays up (a pseudo-terminal relay, a
+UART that drains into nothing) takes everything the port sends and answers
+nothing, so only the answers count.  A drip feed that the control never
+answered at all is a fault (``LineSettings.handshake_expected``).
+
+In a drip feed a block that reached the control is not yet a block that ran:
+up to ``LineSettings.buffer_chars`` characters may wait in the control's
+buffer, and a reset clears them.  A fault therefore names the last block
+that surely reached the control and a ``--start-block`` that is safe either
+way: computed from what surely arrived, never from what only left the port,
+with the blocks that may have run named as those that may be repeated.
+
+Characters from the control other than DC1 and DC3 (and the harmless DC2,
+DC4, NUL and the line ends, spaces and ``%`` that end a punch) are what a
+line at the wrong baud rate or character format makes of the control's
+DC3: the send stops with a fault that says to check them, since the
+control cannot read what is sent either.
 """
 
 from __future__ import annotations
@@ -33,7 +47,7 @@ import time
 from collections.abc import Callable
 
 from ..errors import Terminated, TransferError
-from .blocks import DC1, DC3
+from .blocks import DC1, DC2, DC3, DC4
 from .results import LineFault, TransferProgress, TransferResult
 from .settings import CARRIER_LOSS_S, LineSettings
 
@@ -48,6 +62,9 @@ _SETTLE_S = 0.05
 _SETTLE_NETWORK_S = 0.25
 _HARDWARE = {"rtscts": "cts", "dtrdsr": "dsr"}
 _CARRIER_POLL_S = 0.1
+# NUL: an idle line or a break; CR, LF, space and %: the tail of a punch or request just before the send.
+_HARMLESS = frozenset((DC1, DC2, DC3, DC4, 0x00, 0x0A, 0x0D, 0x20, 0x25))
+_UNFLOW_KEPT = 4096  # of those, the most handed on with a punch that stops a send
 
 
 class Sender:
@@ -55,8 +72,10 @@ class Sender:
 
     def __init__(self, line, segments, settings: LineSettings, mode: str, port: str, *,
                  progress: Callable[[TransferProgress], None] | None, log: Callable[[str], None] | None,
-                 resumable_from: int = 2):
+                 resumable_from: int = 2, stray: Callable[[bytes], None] | None = None):
         self.line, self.settings, self.mode, self.port = line, settings, mode, port
+        self.stray = stray  # given what the control sent that is not flow control (a service keeps it)
+        self.unflow = bytearray()  # the harmless characters so far that were no flow control: a punch's DC2 and %
         self.resumable_from = resumable_from  # no resume before this block can approach the part
         self.progress, self.log = progress, log or (lambda _m: None)
         self.data = b"".join(b for _, b in segments)
@@ -71,8 +90,14 @@ class Sender:
         self.cps = settings.chars_per_s
         network = "://" in port and not port.startswith("loop://")
         self.settle_s = _SETTLE_NETWORK_S if network else _SETTLE_S
-        self.pos = 0  # bytes written to the port
-        self.sure = 0  # bytes surely on the control's side
+        self.pos = 0  # bytes the operating system took
+        self.left = 0  # bytes that have left the port (line clock, output queue, settling time)
+        self.known = 0  # bytes that surely reached the control: left the port before it last answered
+        self.answers = 0  # flow-control answers heard from the control (DC1, DC3)
+        # A watched carrier or CTS/DSR signal vouches for the control throughout; loop:// echoes what it got.
+        self.vouched = bool(settings.carrier != "none" or _HARDWARE.get(settings.flow))
+        self.echo = port.lower().startswith("loop://")
+        self.echoed = 0
         self.line_free = 0.0  # when the last written byte will have left the line
         self.paused = settings.wait_for_xon
         self.pause_since = 0.0
@@ -101,53 +126,68 @@ class Sender:
         """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
         return max(self.in_flight(now), self.in_flight(now - self.settle_s))
 
-    def blocks_surely_done(self) -> int:
+    def blocks_within(self, count: int) -> int:
+        """How many program blocks end within the first ``count`` bytes."""
         done = 0
         for end, _number in self.ends:
-            if end > self.sure:
+            if end > count:
                 break
             done += 1
         return done
 
-    def last_sure_block(self) -> int:
-        done = self.blocks_surely_done()
+    def last_block_within(self, count: int) -> int:
+        """The number of the last program block wholly within the first ``count`` bytes."""
+        done = self.blocks_within(count)
         return self.ends[done - 1][1] if done else self.first_block - 1
 
+    def last_sure_block(self) -> int:
+        return self.last_block_within(self.known)
+
+    def last_left_block(self) -> int:
+        return self.last_block_within(self.left)
+
     def last_sent_block(self) -> int:
-        sent = [number for end, number in self.ends if end <= self.pos]
-        return sent[-1] if sent else self.first_block - 1
+        return self.last_block_within(self.pos)
 
     def report(self, start: float, now: float) -> None:
         if self.progress:
-            self.progress(TransferProgress(self.blocks_surely_done(), self.blocks_total, self.sure, len(self.data),
-                                           now - start, self.paused))
+            self.progress(TransferProgress(self.blocks_within(self.left), self.blocks_total, self.left,
+                                           len(self.data), now - start, self.paused))
 
     def last_run_block(self) -> int:
-        """The last block that surely ran: delivered, with the control's buffer's worth of characters behind it."""
-        ran = self.sure - (self.settings.buffer_chars if self.mode == "drip" else 0)
-        done = [number for end, number in self.ends if end <= ran]
-        return done[-1] if done else self.first_block - 1
+        """The last block that surely ran: surely arrived, with the control's buffer's worth of characters behind it."""
+        return self.last_block_within(self.known - (self.settings.buffer_chars if self.mode == "drip" else 0))
+
+    def whereabouts(self) -> str:
+        """What surely reached the control, and apart from it what only left the port or the computer."""
+        last, left, sent = self.last_sure_block(), self.last_left_block(), self.last_sent_block()
+        where = f"block {last} surely reached the control" if last else "no block surely reached the control"
+        if left > last:
+            where += f"; blocks {last + 1} to {left} left the port, but the control did not answer after them, " \
+                     "so nothing shows that it holds them"
+        if sent > max(left, last):
+            where += f" (blocks {max(left, last) + 1} to {sent} were on their way and may have arrived too)"
+        return where
 
     def fault(self, what: str, todo: str) -> LineFault:
         """The fault, with the last block that surely arrived and (drip) the block that resumes safely."""
         last = self.last_sure_block()
-        where = f"block {last} surely reached the control" if last else "no block surely reached the control"
+        where = self.whereabouts()
         sent = self.last_sent_block()
-        if sent > last:
-            where += f" (blocks {last + 1} to {sent} were on their way and may have arrived too)"
         repeat = None
         if self.mode == "drip":
             resume = self.last_run_block() + 1
             if resume < self.resumable_from:  # before the program has placed the tool: from the start
                 resume = 1
-            if resume <= last:
-                repeat = (max(resume, self.first_block), last)
-                where += (f"; the control's buffer ({self.settings.buffer_chars} characters) may still hold blocks "
-                          f"{repeat[0]} to {last} unexecuted")
+            if resume <= sent:
+                repeat = (max(resume, self.first_block), sent)
+                if resume <= last:
+                    where += (f"; the control's buffer ({self.settings.buffer_chars} characters) may still hold "
+                              f"blocks {repeat[0]} to {last} unexecuted")
             hint = (f"{todo}, then resume with --start-block {resume}" if resume > 1
                     else f"{todo}, then send again")
             if repeat:
-                hint += (f" (safe whether or not a reset cleared the buffer: blocks {repeat[0]} to {last} are "
+                hint += (f" (safe whether or not a reset cleared the buffer: blocks {repeat[0]} to {sent} are "
                          "repeated if they had already run)")
             if last and last >= self.ends[-1][1] and repeat is None:
                 resume = None
@@ -158,7 +198,7 @@ class Sender:
             message = (f"{what} on {self.port}; {where}; the upload is incomplete: {todo}, "
                        "then send the whole program again")
         self.log(f"fault: {message}")
-        return LineFault(message, last, resume, sent, repeat)
+        return LineFault(message, last, resume, sent, repeat, self.last_left_block())
 
     def interrupted(self, e: KeyboardInterrupt) -> LineFault:
         """The fault for Ctrl-C, SIGTERM or SIGHUP."""
@@ -169,9 +209,32 @@ class Sender:
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""
         incoming = self.line.read(4096)
-        # Everything that had left the line before this look is on the far side.
-        self.sure = max(self.sure, self.pos - self.unsettled(now))
-        for byte in incoming:
+        # Everything that had left the line before this look has left the port; whether the control took it
+        # only its answers show.
+        self.left = max(self.left, self.pos - self.unsettled(now))
+        if self.vouched:
+            self.known = self.left
+        if self.echo and incoming:  # loop:// gives back what it took
+            self.echoed += len(incoming)
+            self.known = max(self.known, min(self.echoed, self.pos))
+            self.answers += 1
+            return
+        for index, byte in enumerate(incoming):
+            if byte in (DC1, DC3) and self.settings.flow == "xonxoff":
+                self.answers += 1
+                self.known = max(self.known, self.left)
+            elif byte not in _HARMLESS:
+                if self.stray is not None:
+                    self.stray(bytes(self.unflow[-_UNFLOW_KEPT:]) + incoming[index:])
+                raise self.fault(f"the control answered 0x{byte:02X}, a character no control sends during a "
+                                 f"transfer (line noise, or a baud rate or format that does not match): check the "
+                                 f"baud rate and format ({self.settings.baud} baud, {self.format_text()}) against "
+                                 "the control's", "set the same baud rate and format on both sides and clear the "
+                                 "control")
+            else:
+                self.unflow.append(byte)
+                if len(self.unflow) > 2 * _UNFLOW_KEPT:
+                    del self.unflow[:-_UNFLOW_KEPT]
             if byte == DC3 and self.settings.flow == "xonxoff":
                 if not self.paused:
                     self.paused, self.pause_since = True, now
@@ -195,6 +258,10 @@ class Sender:
         if self.carrier and now - self.carrier_checked >= _CARRIER_POLL_S:
             self.carrier_checked = now  # a network port may wait on the server to tell its modem lines
             self.check_carrier(now)
+
+    def format_text(self) -> str:
+        s = self.settings
+        return f"{s.bytesize}{s.parity[0].upper()}{s.stopbits:g}"
 
     def check_carrier(self, now: float) -> None:
         """The carrier signal down for :data:`CARRIER_LOSS_S` is a lost line, whatever the port still says."""
@@ -267,9 +334,19 @@ class Sender:
         time.sleep(self.settle_s)
         now = time.monotonic()
         self.poll(now)
-        self.sure = self.pos
+        self.left = self.pos
+        if self.vouched:
+            self.known = self.pos
         self.report(start, now)
         elapsed = finished - start
-        self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF")
+        if self.mode == "drip" and self.settings.handshake_expected and not self.vouched and not self.answers:
+            raise self.fault("the control never answered with flow control (no DC3 or DC1) during the whole "
+                             f"drip feed of {self.blocks_total} blocks, so nothing shows that it took any of them "
+                             "(a control that stopped or died while the line stayed up takes everything and says "
+                             "nothing)", "check what the control holds; for a control that never sends XOFF give "
+                             "--no-handshake-expected")
+        self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF, {self.answers} answers from the "
+                 f"control, the last after block {self.last_sure_block()}")
         return TransferResult(self.blocks_total, total, elapsed, self.xoffs, self.max_in_flight, self.cps,
-                              confirmed=bool(self.carrier or self.hardware))
+                              confirmed=self.vouched, answers=self.answers, last_answered_block=self.last_sure_block(),
+                              answered_to_end=self.blocks_within(self.known) == self.blocks_total)

@@ -89,6 +89,12 @@ class LineSettings:
     iso_check : bool
         Refuse characters outside the ISO 840 tape code in what is sent, and
         report them in what is received.
+    handshake_expected : bool
+        A drip feed expects the control to answer with flow control (DC3 or
+        DC1, or the CTS/DSR/carrier signals) at least once: a drip feed the
+        control never answered ends as a fault, since nothing shows that a
+        control took any of it.  False for a control that reads faster than
+        the line and never says XOFF.
     realtime : bool
         Send from a thread at real-time priority (:mod:`lagsym.dnc.priority`),
         so that a loaded computer wakes the sender in time to keep a small
@@ -114,6 +120,7 @@ class LineSettings:
     tv_check: bool = False
     iso_check: bool = False
     realtime: bool = False
+    handshake_expected: bool = True
 
     def __post_init__(self):
         if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
@@ -135,7 +142,7 @@ class LineSettings:
             raise InputError(f"control buffer {self.buffer_chars!r} must be 0 to 1000000 characters")
         if self.memory_chars is not None and (not isinstance(self.memory_chars, int) or self.memory_chars < 1):
             raise InputError(f"control memory {self.memory_chars!r} must be a positive number of characters")
-        for name in ("percent", "dtr", "wait_for_xon", "tv_check", "iso_check", "realtime"):
+        for name in ("percent", "dtr", "wait_for_xon", "tv_check", "iso_check", "realtime", "handshake_expected"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} {getattr(self, name)!r} must be true or false")
         if not isinstance(self.overrun_chars, int) or not 1 <= self.overrun_chars <= 4096:

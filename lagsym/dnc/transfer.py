@@ -66,7 +66,7 @@ def transfer_segments(program: Program, settings: LineSettings, mode: str = "upl
 def send_program(port: str, program: Program, settings: LineSettings, mode: str = "upload", *,
                  start_block: int = 1, safe_z: str | None = None,
                  progress: Callable[[TransferProgress], None] | None = None, log: Callable[[str], None] | None = None,
-                 line=None) -> TransferResult:
+                 line=None, stray: Callable[[bytes], None] | None = None) -> TransferResult:
     """Send a program to a control over a serial line.
 
     Parameters
@@ -92,6 +92,10 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
         Called with one line of text per event (XOFF, XON, fault, end).
     line : lagsym.dnc.port.Port, optional
         A port already open (a service keeps its port), used and left open.
+    stray : callable, optional
+        Given the characters from the control that stopped the send as no
+        flow control (from the first such one on), before the fault: a
+        service keeps them, since they may be the start of a punch.
 
     Returns
     -------
@@ -111,10 +115,10 @@ def send_program(port: str, program: Program, settings: LineSettings, mode: str 
     segments = transfer_segments(program, settings, mode, start_block, safe_z)
     with realtime(settings.realtime):  # refused before the port opens
         return _send(port, program, settings, mode, start_block=start_block, segments=segments, progress=progress,
-                     log=log, line=line)
+                     log=log, line=line, stray=stray)
 
 
-def _send(port, program, settings, mode, *, start_block, segments, progress, log, line) -> TransferResult:
+def _send(port, program, settings, mode, *, start_block, segments, progress, log, line, stray) -> TransferResult:
     """Open the line (unless given one), run the sender and name every fault truly."""
     from .port import LINE_ERRORS, Port, WriteTimeout  # serial loads only when a line is used
     from .sender import Sender
@@ -125,7 +129,7 @@ def _send(port, program, settings, mode, *, start_block, segments, progress, log
         line = Port(port, settings, write_timeout=timeout)
     try:
         sender = Sender(line, segments, settings, mode, port, progress=progress, log=log,
-                        resumable_from=first_resumable_block(program) if start_block <= 1 else 2)
+                        resumable_from=first_resumable_block(program) if start_block <= 1 else 2, stray=stray)
     except BaseException:
         if owned:
             line.close()
