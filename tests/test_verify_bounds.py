@@ -18,7 +18,7 @@ from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.toolpath import plan_toolpath
 from lagsym.verify import program_resolution_mm, simulate_cut
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, ROOT
 from swept_check import polynomial_heights, swept_ball_window, window_check
 
 EX2 = EXAMPLES / "paper-example-2.json"
@@ -143,3 +143,8 @@ def test_readme_finishing_material_left_is_not_understated(run_cli, tmp_path):
     # Inside, between the passes on the flank.
     inner = window_check(surf, 20.0, a, b, 3.0, (53.6, 23.3), (0.2, 0.2), box=box)
     assert report.scallop_mm >= inner["left_normal"]
+    # docs/toolpaths.md quotes the figure and the limit the README's verify line accepts.
+    text = " ".join((ROOT / "docs" / "toolpaths.md").read_text().split())
+    assert (f"bounds it at {report.left_mm:.4f} mm normal to the surface "
+            f"({report.left_height_mm:.4f} mm above it)") in text
+    assert 0.1 < report.left_mm <= 0.12
