@@ -25,9 +25,13 @@ from __future__ import annotations
 import threading
 from typing import Callable, Protocol
 
-__all__ = ["Progress", "Tally", "Counting", "no_progress", "prefixed", "MOST_CALLS", "PIECE"]
+__all__ = ["Progress", "Tally", "Counting", "no_progress", "prefixed", "MOST_CALLS", "PIECE", "COMPILING", "ANNOUNCED"]
 
 MOST_CALLS = 200  # reports a stage with a known total makes at most, besides its last
+# A stage that is a wait, not work: a listener that draws no bars still says it began (a first run after an
+# install compiles the cutter kernel, which keeps the command silent for a while).
+COMPILING = "compiling the cutter kernel, once after an install or upgrade"
+ANNOUNCED = frozenset({COMPILING})
 PIECE = 1 << 14  # items of a batch done between two reports: positions of a drop-cutter (a multiple of its chunk)
 
 

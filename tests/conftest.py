@@ -44,6 +44,25 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.skip(reason=line))
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _cutter_kernel_compiled():
+    """The cutter kernel compiled into Numba's cache before any test runs.
+
+    A cold cache (a fresh clone) makes the first command that drops a cutter
+    say "compiling the cutter kernel" on standard error, which tests of a
+    command's exact output do not expect; tests/test_first_run.py checks that
+    line with a cache of its own.
+    """
+    import numpy as np
+
+    from lagsym import lagrange_surface, read_points
+    from lagsym.toolpath import drop_cutter
+
+    surface = lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
+    x, y = surface.grid.x[0], surface.grid.y[0]
+    drop_cutter(surface, np.array([float(x)]), np.array([float(y)]), 1.0)
+
+
 @pytest.fixture(autouse=True)
 def _socat(request):
     """Tests marked ``socat`` need Debian's socat for their pseudo-terminal pairs."""

@@ -4,8 +4,9 @@ The library reports its work to a :class:`lagsym.progress.Progress` callable;
 this module turns the reports into rich bars on standard error, one line a
 stage, and only when standard error is a terminal that can draw them (not
 ``TERM=dumb``).  Piped or redirected, nothing is drawn and rich is not even
-imported, so standard error holds what it would without bars and standard
-output is never touched.  The bars are transient: when the work ends they are
+imported, and standard output is never touched; standard error gets one line
+only when a stage that is a wait begins (compiling the cutter kernel after an
+install), so a silent command is never mistaken for a hung one.  The bars are transient: when the work ends they are
 erased and the command's own lines follow.  ``NO_COLOR`` leaves them plain
 (rich honours it).
 """
@@ -14,6 +15,8 @@ from __future__ import annotations
 
 import contextlib
 import os
+
+from ..progress import ANNOUNCED
 
 __all__ = ["progress_bar", "draws_bars"]
 
@@ -28,11 +31,25 @@ def draws_bars(err) -> bool:
     return terminal and os.environ.get("TERM", "") != "dumb"
 
 
+def _announcer(err):
+    """Where no bar is drawn, the stages that are a wait (:data:`~lagsym.progress.ANNOUNCED`) still get one line
+    when they begin, so a silent command is never a hung one; everything else is left unsaid."""
+    said = set()
+
+    def announce(done: int, total: int | None, stage: str) -> None:
+        if stage.rpartition(": ")[2] in ANNOUNCED and stage not in said:
+            said.add(stage)
+            err.write(f"lagsym: {stage} ...\n")
+            err.flush()
+
+    return announce
+
+
 @contextlib.contextmanager
 def progress_bar(err):
     """A :class:`~lagsym.progress.Progress` drawing on ``err`` while the block runs, or None where nothing is drawn."""
     if not draws_bars(err):
-        yield None
+        yield _announcer(err)
         return
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn

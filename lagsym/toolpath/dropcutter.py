@@ -30,6 +30,7 @@ input, lays out the lattice and shares the positions out in chunks.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import weakref
@@ -40,12 +41,13 @@ from numpy.polynomial import chebyshev as C
 
 from ..cutter import corner_radius
 from ..errors import ToolpathError
+from ..progress import COMPILING, Progress
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..values import positive
 from .newton import jet_coefficients, kernel_geometry
 from .workers import Workers
 
-__all__ = ["CL_MARGIN", "drop_cutter"]
+__all__ = ["CL_MARGIN", "drop_cutter", "telling_compiles"]
 
 CL_MARGIN = 1e-7
 """Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
@@ -209,6 +211,29 @@ class _Lattice(NamedTuple):
     reach2: np.ndarray
     neighbours: np.ndarray
     nearest: np.ndarray
+
+
+@contextlib.contextmanager
+def telling_compiles(progress: Progress | None):
+    """A block in which a compilation of the kernel that keeps the caller waiting over two seconds is reported to
+    ``progress`` as the stage :data:`~lagsym.progress.COMPILING` (a first run after an install); numba is loaded.
+
+    Keep the block to one small drop: the report comes from a timer thread,
+    and no other report may be made meanwhile.
+    """
+    from .kernel import told_if_compiling
+
+    told = []
+
+    def tell() -> None:
+        told.append(True)
+        if progress is not None:
+            progress(0, None, COMPILING)
+
+    with told_if_compiling(tell):
+        yield
+    if told and progress is not None:
+        progress(1, 1, COMPILING)
 
 
 def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):

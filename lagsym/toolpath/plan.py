@@ -22,7 +22,7 @@ from ..progress import Progress, Tally
 from ..values import positive
 from . import chordal
 from .arcs import Arcs, fit_arcs
-from .dropcutter import drop_cutter
+from .dropcutter import drop_cutter, telling_compiles
 from .filter import filter_rows
 from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
                       tool_reach, within_reach)
@@ -164,7 +164,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
     kappa = ev.curvature_bound() / mm_per_unit
     # Drop-cutter's compiled kernel loaded here (the first time, compiled), before the workers fork: they share it.
-    cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
+    with telling_compiles(progress):
+        cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
     # Worker processes on the other cores, where the plan is large enough to pay for starting them.
     with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
         cl = replace(cl, workers=workers)

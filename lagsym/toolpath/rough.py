@@ -44,7 +44,7 @@ from ..machine import DIRECTIONS, MachineSettings, Tool
 from ..progress import Progress, Tally
 from ..values import choice, finite, positive
 from .chordal import check_moves, crosses_box_edge, lift
-from .dropcutter import drop_cutter
+from .dropcutter import drop_cutter, telling_compiles
 from .pattern import levels as spaced
 from .plan import MAX_PLAN_POINTS
 from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
@@ -207,6 +207,8 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     check_rough_request(tool, stock, spec, ev, place, max_points=max_samples, option="--max-samples")
     sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
     drop = _Drop(surface, ev, place, tool, box, spec.stock_to_leave_mm)
+    with telling_compiles(progress):  # the kernel loaded (the first time, compiled) before any stage reports
+        floor_at(drop, [np.array([box[0]])], [np.array([box[2]])])
     if spec.pattern == "offset":
         x, y = offset_line(stock, box, tool.radius_mm, spec)
         floors = floor_at(drop, [x], [y], progress=progress)
