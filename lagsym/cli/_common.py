@@ -127,7 +127,7 @@ class Given:
         except InputError:
             span = f"above {self.low:g}, up to {self.high:g}" if self.above else f"from {self.low:g} to {self.high:g}"
             shown = f" ({value:g} mm)" if factor != 1.0 else ""
-            raise InputError(f"{option} = {self.text!r}{shown} is out of range: give {span} {self.unit}") from None
+            raise InputError(f"{option} = {self.text!r}{shown} is out of range: give a number {span} {self.unit}") from None
 
 
 def measure(low: float, high: float, unit: str, *, above: bool = False):

@@ -209,6 +209,9 @@ class Sender:
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""
         incoming = self.line.read(4096)
+        # An answer read now may have been sent at any time since the last look found none, and the control may
+        # have taken only what had settled by then: answers vouch for that, not for what has left since.
+        vouched_for = self.left
         # Everything that had left the line before this look has left the port; whether the control took it
         # only its answers show.
         self.left = max(self.left, self.pos - self.unsettled(now))
@@ -222,7 +225,7 @@ class Sender:
         for index, byte in enumerate(incoming):
             if byte in (DC1, DC3) and self.settings.flow == "xonxoff":
                 self.answers += 1
-                self.known = max(self.known, self.left)
+                self.known = max(self.known, vouched_for)
             elif byte not in _HARMLESS:
                 if self.stray is not None:
                     self.stray(bytes(self.unflow[-_UNFLOW_KEPT:]) + incoming[index:])
