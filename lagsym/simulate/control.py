@@ -12,6 +12,7 @@ from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND
 
 from ..controls import Control, control
 from .alarms import BlockAlarm
+from .probing import ProbeCrash
 from .result import SimMoves
 
 __all__ = ["ControlState"]
@@ -159,7 +160,10 @@ class ControlState:
         for axis, letter in enumerate("XYZ"):
             if letter in words:
                 end[axis] = words[letter] if self.absolute else self.ctx.add(self.pos[axis], words[letter])
-        touch = self.target.touch(start, [float(p) for p in end])
+        try:
+            touch = self.target.touch(start, [float(p) for p in end])
+        except ProbeCrash as e:
+            raise BlockAlarm("probe", str(e)) from None
         if touch is None:
             if self.probing.checks_contact:
                 raise BlockAlarm("probe", f"{name} move finished without making contact")

@@ -23,11 +23,15 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["ProbeTarget", "probe_target"]
+__all__ = ["ProbeTarget", "ProbeCrash", "probe_target"]
 
 _GRID = 121  # offsets a side on the disk
 _REFINE = 3  # finer grids around the best offset
 _STEPS = 400  # samples along a move that is not straight down, before the first contact is bisected
+
+
+class ProbeCrash(Exception):
+    """A probing move that starts with the tip on or in the surface (the simulator turns it into an alarm)."""
 
 
 @dataclass(frozen=True)
@@ -68,10 +72,18 @@ class ProbeTarget:
         return best[0]
 
     def touch(self, start, end):
-        """Where the tip's centre stops moving from ``start`` to ``end`` (x, y, z), or None without contact."""
+        """Where the tip's centre stops moving from ``start`` to ``end`` (x, y, z), or None without contact.
+
+        Raises
+        ------
+        ProbeCrash
+            When the tip is at or below the surface at the start: the move there went into the part.
+        """
         (x0, y0, z0), (x1, y1, z1) = start, end
-        if z0 <= self.rest(x0, y0):
-            return (x0, y0, z0)  # touching already
+        h0 = self.rest(x0, y0)
+        if z0 <= h0:
+            raise ProbeCrash(f"the probe tip is already on or in the {self.name} at the start "
+                             f"(z {z0:g}, the surface needs the centre at {h0:.4f}): the move there went into the part")
         if math.isclose(x0, x1, abs_tol=1e-12) and math.isclose(y0, y1, abs_tol=1e-12):
             h = self.rest(x0, y0)
             return (x0, y0, h) if z1 <= h else None
