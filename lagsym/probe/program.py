@@ -34,6 +34,7 @@ from fractions import Fraction
 
 from ..controls import control, names
 from ..errors import InputError
+from ..gcode.limits import check_blocks
 from ..gcode.numbers import fixed
 from ..values import as_exact
 from .plan import ProbePlan
@@ -167,4 +168,5 @@ def probe_program(plan: ProbePlan, settings: ProbeSettings, dialect: str = "fanu
     lines.append(c.framing.end)
     if c.framing.percent:
         lines.append("%")
+    check_blocks(lines, c)
     return "\n".join(lines) + "\n"
