@@ -296,16 +296,71 @@ def test_an_alarm_line_in_the_results(tmp_path):
 
 # --------------------------------------------------------------------------- the documented example
 
+PAGE = Path(__file__).resolve().parent.parent / "docs" / "probing.md"
 
-def test_example_results_are_what_the_documented_commands_print(tmp_path):
-    """examples/probe-results.txt, quoted in docs/probing.md, comes from these two commands."""
-    doc = (Path(__file__).resolve().parent.parent / "docs" / "probing.md").read_text()
-    commands = [line.strip() for line in doc.splitlines()
-                if line.strip().startswith("lagsym probe ") or line.strip().startswith("lagsym simulate probe.nc")]
-    assert len(commands) == 2
-    for line in commands:
+
+def _page_commands():
+    doc = PAGE.read_text()
+    return [line.strip() for line in doc.splitlines()
+            if line.strip().startswith(("lagsym probe --box", 'lagsym simulate probe.nc --surface "'))]
+
+
+def _run_page_commands(tmp_path):
+    reports = []
+    for line in _page_commands():
         argv = [a.replace("examples/probe-results.txt", str(tmp_path / "r.txt")) for a in shlex.split(line)[1:]]
         argv = [str(tmp_path / a) if a == "probe.nc" else a for a in argv]
-        status, _, err = run(argv)
+        status, out, err = run(argv)
         assert status == 0, err
-    assert (tmp_path / "r.txt").read_text() == (EXAMPLES / "probe-results.txt").read_text()
+        reports.append(out + err)
+    return reports
+
+
+def test_example_results_are_what_the_documented_commands_print(tmp_path):
+    """examples/probe-results.txt, quoted in docs/probing.md, comes from the page's two commands, and the
+    page quotes what they print."""
+    assert len(_page_commands()) == 2
+    reports = _run_page_commands(tmp_path)
+    text = (tmp_path / "r.txt").read_text()
+    assert text == (EXAMPLES / "probe-results.txt").read_text()
+    doc = PAGE.read_text()
+    assert reports[0].splitlines()[0] in doc
+    assert "\n".join(text.splitlines()[:3]) in doc
+
+
+def _lebesgue(nodes) -> float:
+    """The largest of sum_j |l_j(t)| over a fine grid of the nodes' interval, in plain NumPy."""
+    nodes = np.asarray(nodes, dtype=float)
+    t = np.linspace(nodes.min(), nodes.max(), 20001)
+    total = np.zeros_like(t)
+    for j, xj in enumerate(nodes):
+        others = np.delete(nodes, j)
+        total += np.abs(np.prod((t[:, None] - others) / (xj - others), axis=1))
+    return float(total.max())
+
+
+def test_the_probing_page_quotes_the_lebesgue_constants():
+    doc = " ".join(PAGE.read_text().split())
+    for n in (7, 11):
+        cheb = _lebesgue(np.polynomial.chebyshev.chebpts2(n))
+        even = _lebesgue(np.linspace(-1, 1, n))
+        assert f"| {n} | {cheb:.3g} | {even:.3g} |" in doc
+
+
+def test_the_probing_page_quotes_the_fits_amplification(tmp_path):
+    """The page's example probed at 9 x 9 Chebyshev and even nodes and fitted with degree 6."""
+    line = _page_commands()[1]
+    formula = shlex.split(line)[4]
+    figures = {}
+    for spacing in ("chebyshev", "even"):
+        prog, res = tmp_path / f"{spacing}.nc", tmp_path / f"{spacing}.txt"
+        assert run(["probe", "--box", "0,100,0,60", "--top", 10, "--bottom", 2, "--tip-radius", 1, "--degree", 6,
+                    "--spacing", spacing, "-o", prog])[0] == 0
+        assert run(["simulate", prog, "--surface", formula, "--tip-radius", 1, "--print-output", res,
+                    "-o", tmp_path / "m.csv"])[0] == 0
+        status, _, err = run(["fit", res, "--degree", 6])
+        assert status == 0
+        figures[spacing] = re.search(r"amplification of errors in the points: ([\d.]+)", err).group(1)
+    doc = " ".join(PAGE.read_text().split())
+    assert (f"amplifies errors in the points up to {figures['chebyshev']} times with Chebyshev nodes and "
+            f"{figures['even']} times with even ones") in doc
