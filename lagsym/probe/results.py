@@ -58,7 +58,7 @@ class ProbeResults:
 
 def is_probe_results(text: str) -> bool:
     """Whether ``text`` holds a probing program's header line."""
-    return _HEADER.search(text[:4096]) is not None
+    return re.search(r"^[\s\x00-\x1f]*" + _HEADER.pattern, text[:4096], re.I | re.M) is not None
 
 
 def _number(text: str) -> Fraction:
