@@ -65,3 +65,51 @@ def test_a_dprnt_stream_cut_mid_line_is_refused_naming_the_node(tmp_path):
     assert err.count(b"\n") == 1 and err.startswith(b"lagsym: error:"), err
     assert b"node 5: the line is cut mid-way" in err, err
     assert not target.exists()
+
+
+def test_the_dnc_server_keeps_probe_results_and_refuses_a_missing_node(tmp_path):
+    """A DPRNT punch to ``lagsym dnc serve``: kept as probe-results.txt; one with a node missing in failed/."""
+    import os
+    import re
+    import time
+
+    config_text = re.search(r"```toml\n(.*?)```", (ROOT / "docs" / "dnc.md").read_text(), re.DOTALL).group(1)
+    lines = _printed()
+    data = "".join(line + "\r\n" for line in lines).encode("ascii")
+    missing = data.replace(("".join(line + "\r\n" for line in lines[3:4])).encode("ascii"), b"")
+    mill, lathe = PtyPair(), PtyPair()
+    (tmp_path / "dnc" / "programs").mkdir(parents=True)
+    cfg = tmp_path / "dnc.toml"
+    cfg.write_text(config_text.replace("/dev/ttyUSB0", mill.near).replace("/dev/ttyUSB1", lathe.near))
+    proc = subprocess.Popen([sys.executable, "-m", "lagsym", "dnc", "serve", str(cfg)], cwd=tmp_path,
+                            env=dict(os.environ, PYTHONPATH=str(ROOT)), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    received = tmp_path / "dnc" / "received" / "mill1"
+    log = tmp_path / "dnc" / "mill1.log"
+
+    def wait_until(check, timeout=30.0):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if check():
+                return True
+            time.sleep(0.05)
+        return False
+
+    try:
+        assert wait_until(lambda: log.exists() and "listening" in proc.stdout.readline())
+        time.sleep(0.5)
+        punch(mill.far, DC2 + data + DC4, 19200)
+        assert wait_until(lambda: (received / "probe-results.txt").exists())
+        assert (received / "probe-results.txt").read_text() == "".join(line.rstrip() + "\n" for line in lines)
+        assert wait_until(lambda: f"received probe results: {len(lines) - 2} nodes" in log.read_text())
+        punch(mill.far, DC2 + missing + DC4, 19200)
+        assert wait_until(lambda: "failed probe results" in log.read_text())
+        assert "node 3 of 16 missing" in log.read_text()
+        assert not (received / "probe-results.received-2.txt").exists()
+        reasons = list((received / "failed").glob("*.reason"))
+        assert len(reasons) == 1 and "node 3 of 16 missing" in reasons[0].read_text()
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
+        mill.close()
+        lathe.close()
