@@ -364,3 +364,91 @@ def test_the_probing_page_quotes_the_fits_amplification(tmp_path):
     doc = " ".join(PAGE.read_text().split())
     assert (f"amplifies errors in the points up to {figures['chebyshev']} times with Chebyshev nodes and "
             f"{figures['even']} times with even ones") in doc
+
+
+# --------------------------------------------------------------------------- the loop in one job file
+
+JOB = """dialect = "{dialect}"
+safe_z = 20
+[probe]
+box = [0, 40, 0, 30]
+top = 6
+bottom = 2
+tip_radius = 1
+degree = 2
+fit_degree = 2
+[stock]
+top_above = 1
+[tools.ball]
+number = 2
+shape = "ball"
+diameter = 6
+[[operations]]
+kind = "finish"
+tool = "ball"
+stepover = 2
+step = 1
+tolerance = {tolerance}
+"""
+
+
+def test_the_loop_in_one_job_file(tmp_path):
+    """lagsym job writes the probing program; after the simulated measurement, --measured fits it and writes the
+    finishing program, whose header names the results and the fit's residuals (as 'lagsym fit' reports them),
+    checked by brute force against the formula."""
+    job = tmp_path / "job.toml"
+    job.write_text(JOB.format(dialect="fanuc", tolerance=TOLERANCE))
+    prog, results, part = tmp_path / "probe.nc", tmp_path / "results.txt", tmp_path / "part.nc"
+    status, _, err = run(["job", job, "-o", prog])
+    assert status == 0, err
+    assert prog.read_text().count("G31 ") == 25
+    assert run(["simulate", prog, "--surface", TRUE, "--tip-radius", 1, "--print-output", results,
+                "-o", tmp_path / "m.csv"])[0] == 0
+    status, _, err = run(["job", job, "--measured", results, "-o", part])
+    assert status == 0, err
+    # the residuals as 'lagsym fit' reports them for the same results, read on their own path
+    status, fit_report, _ = run(["fit", results, "--degree", 2, "-o", tmp_path / "s.json"])
+    largest = float(re.search(r"residuals: max ([\d.e+-]+)", fit_report).group(1))
+    head = part.read_text().split("G21", 1)[0]
+    import hashlib
+
+    assert f"(MEASURED RESULTS.TXT SHA256 {hashlib.sha256(results.read_bytes()).hexdigest()[:16].upper()})" in head
+    assert f"RESIDUALS MAX {largest:.4g}".upper() in head
+    pts = _moves(part.read_text())
+    over = pts[(pts[:, 0] >= BOX[0]) & (pts[:, 0] <= BOX[1]) & (pts[:, 1] >= BOX[2]) & (pts[:, 1] <= BOX[3])]
+    at = over[:, 2] + 3.0 - _centre_heights(parse_formula(TRUE), over[:, 0], over[:, 1], 3.0)
+    stated = largest + 5e-5 + 1e-4 + 2e-5  # the fit, the printed digit, the tip compensation, the brute force
+    assert -at.min() <= stated
+    assert at.max() <= stated + TOLERANCE + 5e-4
+
+
+def test_job_probe_stage_errors_are_one_line(tmp_path):
+    job = tmp_path / "job.toml"
+    job.write_text(JOB.format(dialect="grbl", tolerance=TOLERANCE))
+    status, _, err = run(["job", job])
+    one_line_error(status, err)
+    assert "a probe stage is written for fanuc, haas, linuxcnc, not 'grbl'" in err
+    job.write_text('points = "p.json"\n' + JOB.format(dialect="fanuc", tolerance=TOLERANCE))
+    one_line_error(*run(["job", job])[::2])
+    job.write_text(JOB.format(dialect="fanuc", tolerance=TOLERANCE).replace("degree = 2\n", "degree = 1\n", 1))
+    status, _, err = run(["job", job, "--measured", EXAMPLES / "probe-results.txt", "-o", tmp_path / "x.nc"])
+    one_line_error(status, err)
+    assert "49 nodes, but the job's probe stage has 16" in err and not (tmp_path / "x.nc").exists()
+    status, _, err = run(["job", EXAMPLES / "example-4-job.toml", "--measured", EXAMPLES / "probe-results.txt"])
+    one_line_error(status, err)
+    assert "has no [probe] table" in err
+
+
+def test_the_probing_page_quotes_the_job_header(tmp_path):
+    """docs/probing.md's job commands run, and the header lines it quotes are those the program has."""
+    doc = PAGE.read_text()
+    commands = [line.strip() for line in doc.splitlines() if line.strip().startswith("lagsym job examples/probe-job")]
+    assert len(commands) == 2
+    for line in commands:
+        argv = [str(tmp_path / a) if a.endswith(".nc") else str(EXAMPLES.parent / a) if a.startswith("examples/")
+                else a for a in shlex.split(line)[1:]]
+        status, _, err = run(argv)
+        assert status == 0, err
+    program = (tmp_path / "probed-job.nc").read_text()
+    quoted = re.search(r"```\n(\(MEASURED .*?)```", doc, re.DOTALL).group(1).splitlines()
+    assert len(quoted) == 3 and all(line in program.splitlines() for line in quoted)
