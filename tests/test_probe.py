@@ -131,6 +131,17 @@ def test_simulator_refuses_a_probing_move_without_a_surface_and_the_other_contro
         simulate("G0 X0 Y0 Z5\nG31 Z-1 F100\nM2\n", "linuxcnc", 15, target=probe_target(parse_formula("0"), 0))
 
 
+def test_a_probing_mode_carried_on_without_its_word_is_refused():
+    """G38.2 is a motion mode on LinuxCNC: a later block of axis words alone would probe again, which the
+    simulator does not run; a Fanuc's G31 is one-shot, and the next block moves in the mode before it."""
+    t = probe_target(parse_formula("1"), 0)
+    for block in ("Z5", "#1=5\nZ#1"):
+        with pytest.raises(ControlAlarm, match="G38.2 mode without its G38.2 word"):
+            simulate(f"G0 X0 Y0 Z5\nG38.2 Z-1 F100\n{block}\nM2\n", "linuxcnc", 15, target=t)
+    sim = simulate("G0 X0. Y0. Z5.\nG31 Z-1. F100.\nZ5.\nM30\n", "fanuc", 8, target=t)
+    assert [(m.motion, m.z) for m in sim.moves] == [("G0", 5.0), ("G1", 1.0), ("G0", 5.0)]
+
+
 def test_simulated_probe_stops_where_the_ball_rests_on_the_surface():
     """Against a plane the tip centre rests r * sqrt(1 + a^2 + b^2) above it (exactly)."""
     a, b, r = 0.3, -0.2, 2.0

@@ -65,7 +65,9 @@ def _leaders(blocks, labels) -> list[int]:
 
 def _modal_g(m, g) -> None:
     if m.probing is not None and f"G{_code(g)}" == m.probing.move:
-        m.probe_pending = round(float(g), 1)  # this block's move probes (G31 is one-shot; lagsym writes G38.2 each time)
+        m.probe_pending = round(float(g), 1)  # this block's move probes
+        if m.probing.checks_contact:
+            m.motion = m.probing.move  # G38.2 is a motion mode on LinuxCNC; G31 is one-shot on a Fanuc
         return
     why = unrun_code("G", g)
     if why is not None:
@@ -109,8 +111,8 @@ def _constant_words(m, run) -> None:
                     values[letter] = v
             if "F" in values:
                 m.feed = values["F"]
-            if m.motion in ("G2", "G3") and any(a in values for a in "XYZ"):
-                _arc()
+            if m.motion not in ("G0", "G1") and m.probe_pending is None and any(a in values for a in "XYZ"):
+                _arc(m)
             m.move(b.line, values)
         except (BlockAlarm, ArithmeticError) as e:
             raise alarm_at(e, b) from None
@@ -132,8 +134,12 @@ def _send(m, b) -> None:
         raise alarm_at(e, b) from None
 
 
-def _arc() -> None:
-    raise BlockAlarm("arc", "arcs are outside what the simulator runs")
+def _arc(m) -> None:
+    """Refuse a move in a motion mode the simulator does not run: an arc, or a probing mode carried on."""
+    if m.motion in ("G2", "G3"):
+        raise BlockAlarm("arc", "arcs are outside what the simulator runs")
+    raise BlockAlarm("not-run", f"a move in {m.motion} mode without its {m.motion} word: the simulator runs a "
+                                f"probing move only in the block that gives it")
 
 
 def _environment(m, labels) -> dict:

@@ -28,8 +28,8 @@ from decimal import Decimal
 
 from ..gcode.program import END_M, unrun_code
 from .alarms import BlockAlarm, ControlAlarm
-from .blocks import (probe_code, Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
-                     OWhile, Stop, While, Words)
+from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
+                     OWhile, Stop, While, Words, probe_code)
 from .control import ControlState
 
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
