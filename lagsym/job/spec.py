@@ -248,7 +248,7 @@ def _probe(table: dict, dialect: str, source: str) -> ProbeStage:
     for key in _REQUIRED_PROBE:
         if key not in table:
             raise InputError(f"{source}: missing key probe.{key}")
-    if dialect not in PROBE_DIALECTS:
+    if control(dialect).probing is None:
         raise InputError(f"{source}: a probe stage is written for {', '.join(PROBE_DIALECTS)}, not {dialect!r}")
     box = table["box"]
     if len(box) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in box):
