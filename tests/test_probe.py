@@ -21,7 +21,7 @@ from lagsym.controls import CONTROLS
 from lagsym.errors import InputError
 from lagsym.formula import parse_formula
 from lagsym.gcode.limits import check_blocks
-from lagsym.probe import PROBE_DIALECTS, ProbeSettings, node_plan, probe_program, read_results
+from lagsym.probe import ProbeSettings, node_plan, probe_program, read_results, surface_points
 from lagsym.simulate import ControlAlarm, simulate
 from lagsym.simulate.probing import probe_target
 
@@ -463,3 +463,29 @@ def test_the_probing_page_quotes_the_job_header(tmp_path):
     program = (tmp_path / "probed-job.nc").read_text()
     quoted = re.search(r"```\n(\(MEASURED .*?)```", doc, re.DOTALL).group(1).splitlines()
     assert len(quoted) == 3 and all(line in program.splitlines() for line in quoted)
+
+
+def test_tip_compensation_on_a_bowl_against_the_formula():
+    """docs/probing.md: a bowl probed with a 3 mm tip; the points within 0.000002 mm of the formula, where the
+    heights straight below the centres would be off by 0.08 mm (both computed here in NumPy)."""
+    f = parse_formula("3 + 0.02*(x-20)**2 + 0.01*y**2")
+    r = 3.0
+    plan = node_plan(BOX, 4, margin=2)
+    text = probe_program(plan, ProbeSettings(r, 40, 0), "linuxcnc")
+    res = read_results("\n".join(simulate(text, "linuxcnc", 15, target=probe_target(f, r)).output) + "\n")
+    sp = surface_points(res)
+    pts = np.array([[float(v) for v in p] for p in sp.points])
+    assert [p[:2] for p in sp.points] == [p[:2] for p in res.points]
+    err = float(np.max(np.abs(pts[:, 2] - f(pts[:, 0], pts[:, 1]))))
+    doc = " ".join(PAGE.read_text().split())
+    assert err <= 2e-6 and "come within 0.000002 mm of the surface" in doc
+    assert err <= sp.bound
+    # straight below: a least-squares 4x4 polynomial through the centres, its slope at each node
+    c = np.array([[float(v) for v in p] for p in res.points])
+    basis = lambda x, y: np.stack([x ** a * y ** b for a in range(5) for b in range(5)], axis=-1)  # noqa: E731
+    coef = np.linalg.lstsq(basis(c[:, 0], c[:, 1]), c[:, 2], rcond=None)[0]
+    h = 1e-5
+    gx = (basis(c[:, 0] + h, c[:, 1]) @ coef - basis(c[:, 0] - h, c[:, 1]) @ coef) / (2 * h)
+    gy = (basis(c[:, 0], c[:, 1] + h) @ coef - basis(c[:, 0], c[:, 1] - h) @ coef) / (2 * h)
+    below = c[:, 2] - r * np.sqrt(1 + gx ** 2 + gy ** 2)
+    assert f"would be off by {np.max(np.abs(below - f(c[:, 0], c[:, 1]))):.2f} mm" in doc

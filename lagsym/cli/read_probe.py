@@ -14,10 +14,11 @@ from, its SHA-256, the tip radius and the compensation) that 'lagsym fit'
 reads.  'lagsym fit' also reads the results file directly.
 
 The positions are those of the tip's centre.  The tip radius is taken off
-vertically along the normal of a least-squares fit of the centres (--degree;
-by default chosen by cross-validation): exact for a plane, and on a curved
-surface within r^2/2 sin^2(slope) times the curvature, which is estimated and
-reported.
+along the normal of a least-squares fit of the centres (the contact points,
+exact but for that fit's slope), and each contact's height is carried back
+to its node along a fit of the contacts, so the points keep the probed grid
+(--degree for both fits; by default chosen by cross-validation).  The
+estimated error of that step is reported.
 
 A node missing or given twice, a line cut mid-way, or results that stop
 without their END line (the control raised an alarm, or the line was cut)

@@ -12,14 +12,18 @@ mid-way, no ``END`` (the stream stopped: the control raised an alarm or the
 line was cut), a line that is none of these.
 
 The positions are those of the probe tip's centre.  :func:`surface_points`
-takes the tip radius off vertically: the centres lie on the surface offset
-by ``r`` along its normal, and the surface below a centre ``(x, y, z_c)`` is
-``z_c - r * sqrt(1 + |grad g|**2)``, with ``g`` the fitted offset surface
-(whose normal at the centre is the surface's normal at the contact).  That
-is exact for a plane; on a curved surface it is off by at most
-``r**2 / 2 * sin(theta)**2 * kappa``, ``theta`` the slope and ``kappa`` the
-largest curvature between the contact and the point below the centre, which
-:func:`surface_points` estimates from the fit's second derivatives and states.
+takes the tip radius off in two steps.  The centres lie on the surface
+offset by ``r`` along its normal, and the normal of that offset surface at a
+centre is the part's normal at the contact: so a fit ``g`` of the centres
+gives each contact point, ``c - r * n`` with ``n = (-g_x, -g_y, 1) / sqrt(1 +
+|grad g|**2)``, exact but for ``g``'s slope.  The contacts lie up to
+``r * sin(slope)`` beside their nodes; a fit ``f`` of the contacts carries
+each contact's height back to its node (``z + f(node) - f(contact)``), so
+the points keep the nodes' x and y (the grid and the box the program
+probed).  The error of that step is about the distance times the error of
+``f``'s slope, estimated from the disagreement of the two fits' slopes at
+the contacts and stated with the result (plus the 0.000001 the numbers are
+written to).
 """
 
 from __future__ import annotations
@@ -138,37 +142,58 @@ class SurfacePoints:
         r = float(self.results.tip_radius)
         if r == 0:
             return "tip radius 0: the centres are the surface points"
-        return (f"tip radius {r:g} {self.results.units} taken off vertically along the normal of a degree "
-                f"{self.degree[0]}x{self.degree[1]} fit of the tip centres (largest shift {self.largest_shift:.4f}, "
-                f"approximation within about {self.bound:.2g} {self.results.units})")
+        return (f"tip radius {r:g} {self.results.units} taken off along the normal of a fit of the tip centres, "
+                f"the contact heights carried to the nodes along a degree {self.degree[0]}x{self.degree[1]} fit of "
+                f"the contacts (largest shift {self.largest_shift:.4f}, approximation within about "
+                f"{self.bound:.2g} {self.results.units})")
+
+
+def _poly(c, x: float, y: float, dx: int = 0, dy: int = 0) -> float:
+    """The fit's polynomial ``sum c[a][b] x**a y**b`` (or its ``dx``, ``dy`` derivative) at a point, in floats."""
+    total = 0.0
+    for a, row in enumerate(c):
+        for b, v in enumerate(row):
+            if a < dx or b < dy or v == 0:
+                continue
+            k = math.perm(a, dx) * math.perm(b, dy)
+            total += k * float(v) * x ** (a - dx) * y ** (b - dy)
+    return total
 
 
 def surface_points(results: ProbeResults, degree=None) -> SurfacePoints:
-    """The surface points below the tip centres (see the module's notes); ``degree`` of the normals' fit
-    (default: chosen by cross-validation)."""
+    """The surface points below the tip centres (see the module's notes).
+
+    ``degree`` of the two fits (default: chosen by cross-validation, up to one less than the nodes a side).
+    """
     from ..fit import fit_surface
 
-    r = results.tip_radius
+    r = float(results.tip_radius)
     if r == 0:
         return SurfacePoints(results.points, results, None, 0.0, 0.0)
-    fit = fit_surface(results.points, degree, source=results.source, units=results.units)
-    c = fit.coefficients
+    nx, ny = len({p[0] for p in results.points}), len({p[1] for p in results.points})
+    top = None if degree is not None else (min(nx - 1, 8), min(ny - 1, 8))
+    centres = fit_surface(results.points, degree, max_degree=top, source=results.source, units=results.units)
     scale = 10 ** DECIMALS
-    out, bound, largest = [], 0.0, 0.0
+    contacts, shifts = [], []
     for x, y, z in results.points:
-        gx = sum(a * c[a][b] * x ** (a - 1) * y ** b for a in range(1, len(c)) for b in range(len(c[a])))
-        gy = sum(b * c[a][b] * x ** a * y ** (b - 1) for a in range(len(c)) for b in range(1, len(c[a])))
-        hxx = sum(a * (a - 1) * c[a][b] * x ** (a - 2) * y ** b for a in range(2, len(c)) for b in range(len(c[a])))
-        hyy = sum(b * (b - 1) * c[a][b] * x ** a * y ** (b - 2) for a in range(len(c)) for b in range(2, len(c[a])))
-        hxy = sum(a * b * c[a][b] * x ** (a - 1) * y ** (b - 1) for a in range(1, len(c)) for b in range(1, len(c[a])))
-        slope2 = float(gx) ** 2 + float(gy) ** 2
-        shift = float(r) * math.sqrt(1 + slope2)
-        mean, half = (float(hxx) + float(hyy)) / 2, math.hypot((float(hxx) - float(hyy)) / 2, float(hxy))
-        kappa = abs(mean) + half  # the largest second derivative in any direction
-        bound = max(bound, float(r) ** 2 / 2 * slope2 / (1 + slope2) * kappa)
-        largest = max(largest, shift)
-        out.append((x, y, Fraction(round((z - Fraction(shift)) * scale), scale)))
-    return SurfacePoints(tuple(out), results, fit.degree, bound, largest)
+        gx, gy = _poly(centres.coefficients, float(x), float(y), 1), _poly(centres.coefficients, float(x), float(y), 0, 1)
+        q = math.sqrt(1 + gx * gx + gy * gy)
+        n = (-gx / q, -gy / q, 1 / q)  # the centres' surface's normal: the part's normal at the contact
+        contacts.append(tuple(Fraction(round((float(v) - r * k) * scale), scale) for v, k in zip((x, y, z), n)))
+        shifts.append((gx, gy, q))
+    part = fit_surface(contacts, degree, max_degree=top, source=results.source, units=results.units)
+    c = part.coefficients
+    out, bound, largest = [], 0.0, 0.0
+    for (x, y, z), (px, py, pz), (gx, gy, q) in zip(results.points, contacts, shifts):
+        fx, fy, ux, uy = float(x), float(y), float(px), float(py)
+        height = float(pz) + _poly(c, fx, fy) - _poly(c, ux, uy)  # the contact's height, carried to the node
+        # the two fits' slopes at the contact disagree by this much: over the way back to the node, the error
+        gap = math.hypot(_poly(c, ux, uy, 1) - gx, _poly(c, ux, uy, 0, 1) - gy)
+        rounding = (1 + math.hypot(gx, gy)) * 10.0 ** -DECIMALS  # the contacts and the height written to 6 places
+        bound = max(bound, math.hypot(fx - ux, fy - uy) * gap + rounding)
+        largest = max(largest, abs(float(z) - height))
+        out.append((x, y, Fraction(round(Fraction(height) * scale), scale)))
+    return SurfacePoints(tuple(out), results, part.degree, bound, largest)
 
 
 def points_json(sp: SurfacePoints) -> str:
