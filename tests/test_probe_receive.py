@@ -1,4 +1,5 @@
-"""Probe results over the serial line: a simulated Fanuc's DPRNT output punched over a pty pair to ``lagsym receive``."""
+"""Probe results over the serial line: a simulated Fanuc's DPRNT output punched over a pty pair to ``lagsym receive``
+and to the DNC server."""
 
 from __future__ import annotations
 

@@ -37,7 +37,8 @@ examples:
 def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=PROBE_DIALECTS, default=PROBE_DIALECTS[0],
                    help=f"the control: {dialect_help(PROBE_DIALECTS)}")
-    p.add_argument("--box", metavar="X0,X1,Y0,Y1", help="the region to probe, in mm (needed unless the nodes are listed)")
+    p.add_argument("--box", metavar="X0,X1,Y0,Y1",
+                   help="the region to probe, in mm (needed unless the nodes are listed)")
     p.add_argument("--degree", default="4", metavar="P[xQ]",
                    help="the fit degree wanted in x and y (default 4): degree + 1 + margin nodes a side")
     p.add_argument("--margin", type=count(0, 20), default=2, metavar="N",

@@ -176,7 +176,8 @@ def surface_points(results: ProbeResults, degree=None) -> SurfacePoints:
     scale = 10 ** DECIMALS
     contacts, shifts = [], []
     for x, y, z in results.points:
-        gx, gy = _poly(centres.coefficients, float(x), float(y), 1), _poly(centres.coefficients, float(x), float(y), 0, 1)
+        cc = centres.coefficients
+        gx, gy = _poly(cc, float(x), float(y), 1), _poly(cc, float(x), float(y), 0, 1)
         q = math.sqrt(1 + gx * gx + gy * gy)
         n = (-gx / q, -gy / q, 1 / q)  # the centres' surface's normal: the part's normal at the contact
         contacts.append(tuple(Fraction(round((float(v) - r * k) * scale), scale) for v, k in zip((x, y, z), n)))

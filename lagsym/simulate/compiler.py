@@ -158,7 +158,8 @@ def _environment(m, labels) -> dict:
     return {"m": m, "V": m.vars, "NM": m.names, "POS": m.pos, "Z": Decimal(0), "ONE": Decimal(1),
             "ZERO": Decimal(0), "P": ctx.plus, "POW": ctx.power, "DIV": m.divide, "MOD": mod, "FUNC": m.func,
             "ATAN2": m.atan2, "GET": m.get, "GETN": m.named, "CHECK": m.check, "CONST": m.const, "JUMP": jump,
-            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc, "RUNWORDS": _run_words, "SEND": _send, "WORDS": _constant_words, "STOPS": STOPS,
+            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc,
+            "RUNWORDS": _run_words, "SEND": _send, "WORDS": _constant_words, "STOPS": STOPS,
             "A_LINE": line, "A_RAPID": rapid, "A_X": x, "A_Y": y, "A_Z": z, "A_F": feed}
 
 

@@ -75,7 +75,8 @@ def _statement(line: int, raw: str, t: str) -> Block:
 
 
 def _dprnt(body: str) -> tuple:
-    """The items of ``DPRNT[..]``: text (``*`` prints a space) and variables ``#n[ab]``, a digits before and b after the point."""
+    """The items of ``DPRNT[..]``: text (``*`` prints a space) and variables ``#n[ab]``, ``a`` digits before the
+    point and ``b`` after it."""
     items, pos = [], 0
     for m in _DPRNT_VAR.finditer(body):
         items += _text(body[pos:m.start()])
