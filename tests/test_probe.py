@@ -489,3 +489,21 @@ def test_tip_compensation_on_a_bowl_against_the_formula():
     gy = (basis(c[:, 0], c[:, 1] + h) @ coef - basis(c[:, 0], c[:, 1] - h) @ coef) / (2 * h)
     below = c[:, 2] - r * np.sqrt(1 + gx ** 2 + gy ** 2)
     assert f"would be off by {np.max(np.abs(below - f(c[:, 0], c[:, 1]))):.2f} mm" in doc
+
+
+def test_simulate_probes_a_surface_file(tmp_path):
+    """--surface may be a fitted surface file: a dry run against the surface fitted from a first run prints the
+    heights of the first run within the fit's residuals and the printed last digit."""
+    prog, first, second = tmp_path / "p.nc", tmp_path / "r1.txt", tmp_path / "r2.txt"
+    assert run(["probe", "--box", ",".join(map(str, BOX)), "--top", 6, "--bottom", 2, "--tip-radius", 0,
+                "--degree", 2, "--margin", 1, "-o", prog])[0] == 0
+    assert run(["simulate", prog, "--surface", TRUE, "--print-output", first, "-o", tmp_path / "m.csv"])[0] == 0
+    status, report, err = run(["fit", first, "--degree", 2, "-o", tmp_path / "s.json"])
+    assert status == 0, err
+    largest = float(re.search(r"residuals: max ([\d.e+-]+)", report).group(1))
+    status, _, err = run(["simulate", prog, "--surface", tmp_path / "s.json", "--print-output", second,
+                          "-o", tmp_path / "m2.csv"])
+    assert status == 0, err
+    a, b = read_results(first.read_text()), read_results(second.read_text())
+    assert [p[:2] for p in a.points] == [p[:2] for p in b.points]
+    assert max(abs(float(p[2] - q[2])) for p, q in zip(a.points, b.points)) <= largest + 1e-4
