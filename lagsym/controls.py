@@ -43,7 +43,7 @@ from typing import Mapping
 from .errors import InputError
 from .values import choice
 
-__all__ = ["Control", "Framing", "MacroLanguage", "CONTROLS", "control", "names", "VARIABLE_PROFILES",
+__all__ = ["Control", "Framing", "MacroLanguage", "Probing", "CONTROLS", "control", "names", "VARIABLE_PROFILES",
            "WORK_OFFSET_WORDS", "work_offset"]
 
 VARIABLE_PROFILES = ("full", "small")
@@ -130,6 +130,39 @@ class MacroLanguage:
 
 
 @dataclass(frozen=True)
+class Probing:
+    """How a control probes with a touch probe and hands the results out.
+
+    Attributes
+    ----------
+    move : str
+        The probing move: ``G31`` (Fanuc, Haas: a skip move) or ``G38.2``
+        (LinuxCNC: probe toward the workpiece, an error without contact).
+    result_variables : tuple of int
+        The variables holding the position where the probe tripped, X, Y, Z
+        (#5061-#5063 on a Fanuc 0i/16/18/21, a Haas and LinuxCNC).
+    output : str
+        How the results leave the control: ``dprnt`` (``POPEN``, ``DPRNT[..]``,
+        ``PCLOS`` to the serial port) or ``log`` (LinuxCNC's ``(LOGOPEN,..)``,
+        ``(LOG,..)``, ``(LOGCLOSE)`` to a file).
+    alarm_variable : int or None
+        The variable a program writes to raise an alarm (Fanuc ``#3000``);
+        None where the probing move stops the program on its own.
+    checks_contact : bool
+        The control stops with an error when the probing move ends without contact.
+    """
+
+    move: str
+    result_variables: tuple[int, int, int]
+    output: str
+    alarm_variable: int | None = None
+    checks_contact: bool = False
+
+
+_SKIP_PROBING = Probing(move="G31", result_variables=(5061, 5062, 5063), output="dprnt", alarm_variable=3000)
+
+
+@dataclass(frozen=True)
 class Control:
     """One control family: its limits, its program framing, its macro language and its serial-line profile.
 
@@ -168,6 +201,8 @@ class Control:
         default ``$12``); 0 where it interpolates arcs exactly.
     dnc_profile : str or None
         The serial-line profile (:data:`lagsym.dnc.PROFILES`) that pairs with it.
+    probing : Probing or None
+        How it probes and hands out the results; None where lagsym writes no probing program for it.
     """
 
     name: str
@@ -186,6 +221,7 @@ class Control:
     point_lists: bool = True
     chord_mm: float = 0.0
     dnc_profile: str | None = None
+    probing: Probing | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "macro_variables", MappingProxyType(dict(self.macro_variables)))
@@ -215,7 +251,7 @@ CONTROLS: Mapping[str, Control] = MappingProxyType({c.name: c for c in (
         framing=_FANUC_FRAMING,
         macro=MacroLanguage("fanuc", default_precision=8, rounds=True, fix_toward_zero=True, vacant_zero=True,
                             counts_digits=True, integer_increments=True, table_base=500, table_tiles=8),
-        dnc_profile="fanuc"),
+        dnc_profile="fanuc", probing=_SKIP_PROBING),
     Control(
         name="haas", title="Haas mills (classic and NGC), Fanuc-compatible Custom Macro B",
         max_block=128, axis_digits=8, tools=200, length_offsets=200,
@@ -228,7 +264,7 @@ CONTROLS: Mapping[str, Control] = MappingProxyType({c.name: c for c in (
                         tool_change="M06"),
         macro=MacroLanguage("fanuc", default_precision=8, rounds=True, fix_toward_zero=True, vacant_zero=True,
                             counts_digits=True, integer_increments=True, table_base=800, table_tiles=8),
-        dnc_profile="haas"),
+        dnc_profile="haas", probing=_SKIP_PROBING),
     Control(
         name="linuxcnc", title="LinuxCNC (rs274ngc)",
         max_block=255, axis_digits=9, tools=99999, length_offsets=99999,
@@ -236,7 +272,8 @@ CONTROLS: Mapping[str, Control] = MappingProxyType({c.name: c for c in (
         program_numbers=(1, 9999), variables=((1, 5602),),
         framing=Framing(percent=False, program_word=None, safe_start="G17 G40 G49 G80 G90 G94", end="M02",
                         tool_change="M06"),
-        macro=MacroLanguage("linuxcnc", default_precision=15, rounds=True, table_base=1000, table_tiles=8)),
+        macro=MacroLanguage("linuxcnc", default_precision=15, rounds=True, table_base=1000, table_tiles=8),
+        probing=Probing(move="G38.2", result_variables=(5061, 5062, 5063), output="log", checks_contact=True)),
     Control(
         name="heidenhain", title="Heidenhain TNC (Q parameters), as on Bridgeport mills",
         max_block=128, axis_digits=9, tools=32767, length_offsets=0,
@@ -286,16 +323,19 @@ def work_offset(text, what: str = "work offset", exact: bool = False) -> str:
     return word
 
 
-def names(*, point_lists: bool = False, macros: bool = False) -> tuple[str, ...]:
-    """The names of the registered controls: all, or those lagsym writes point lists or macros for.
+def names(*, point_lists: bool = False, macros: bool = False, probing: bool = False) -> tuple[str, ...]:
+    """The names of the registered controls: all, or those lagsym writes point lists, macros or probing programs for.
 
     Examples
     --------
     >>> names(point_lists=True)
     ('fanuc', 'haas', 'linuxcnc', 'grbl')
+    >>> names(probing=True)
+    ('fanuc', 'haas', 'linuxcnc')
     """
     return tuple(c.name for c in CONTROLS.values()
-                 if (c.point_lists or not point_lists) and (c.macro is not None or not macros))
+                 if (c.point_lists or not point_lists) and (c.macro is not None or not macros)
+                 and (c.probing is not None or not probing))
 
 
 def control(name, what: str = "dialect", options: tuple[str, ...] | None = None) -> Control:

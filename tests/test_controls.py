@@ -210,4 +210,5 @@ def test_the_docs_table_is_the_registry():
                               f"{c.tools or '-'} / {c.length_offsets or '-'}", c.work_offset_text,
                               f"{c.program_numbers[0]}-{c.program_numbers[1]}", m.name if m else "-",
                               str(m.default_precision) if m else "-",
-                              f"`{c.dnc_profile}`" if c.dnc_profile else "-"], name
+                              f"`{c.dnc_profile}`" if c.dnc_profile else "-",
+                              f"{c.probing.move}, {c.probing.output}" if c.probing else "-"], name

@@ -27,6 +27,9 @@ COMMANDS = {
     "equation": ["--digits", "--max-terms"],
     "curve": ["--digits"],
     "check": [],
+    "probe": ["--tip-radius", "--top", "--bottom", "--clearance", "--overtravel", "--retract", "--feed", "--margin",
+              "--program-number", "--degree", "--nodes", "--box"],
+    "read-probe": ["--degree"],
     "fit": ["--degree", "--max-degree", "--threshold"],
     "sample": ["--nx", "--ny", "--step", "--x0", "--max-points"],
     "compare": ["--samples", "--degree", "--tolerance"],
@@ -79,6 +82,8 @@ def _args(cmd: str, files: dict[str, Path]) -> list[str]:
         return [cmd, str(files["job"])]
     if cmd == "dnc":
         return [cmd, "serve", str(files["job"]), "--check"]
+    if cmd == "probe":
+        return [cmd, "--box", "0,10,0,10", "--top", "5", "--bottom", "0", "--tip-radius", "1"]
     if cmd == "rough":
         return [cmd, str(files["points"]), "--stock-above", "1"]
     return [cmd, str(files["points"])]

@@ -57,6 +57,8 @@ class _ParserExit(Exception):
 COMMANDS = {
     "equation": "print the exact Lagrange surface z = F(x, y) through a grid of control points",
     "curve": "print the exact Lagrange curve y = F(x) through a set of points",
+    "probe": "write a probing program: measure the part on the machine at Chebyshev-spaced nodes",
+    "read-probe": "read a probing program's results (DPRNT text, LinuxCNC log) into surface points",
     "fit": "fit an exact least-squares polynomial surface to measured points (a grid or scattered) and write it",
     "check": "measure degree, spacing ratio, Lebesgue constants, amplification of data errors and overshoot",
     "sample": "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)",
@@ -77,7 +79,7 @@ COMMANDS = {
 
 def command_module(name: str):
     """The module of the command ``name`` (imported on first use)."""
-    return importlib.import_module(f"{__name__}.{name}")
+    return importlib.import_module(f"{__name__}.{name.replace('-', '_')}")
 
 
 def _chosen(argv: Sequence[str]) -> str | None:

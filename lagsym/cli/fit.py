@@ -9,6 +9,8 @@ from ..errors import InputError
 from ..export.surfacejson import write_surface_json
 from ..fit import CRITERIA, MAX_DEGREE, fit_surface
 from ..io import read_scattered_points, read_text
+from ..io.points import ScatteredPoints
+from ..probe import is_probe_results, read_results, surface_points
 from ..values import exact_number, NotANumber
 from ._common import COLUMNS_HELP, emit, exact
 
@@ -29,10 +31,15 @@ lagsym-surface JSON document; standard output without -o, the report then on
 standard error) is read by every command that reads a points file:
 equation, check, sample, export, toolpath, rough, job, macro, plot.
 
+FILE may also be the results a 'lagsym probe' program sent back (DPRNT text
+or a LinuxCNC log): they are read as 'lagsym read-probe' reads them, the
+probe's tip radius taken off.
+
 examples:
   lagsym fit examples/probe-12x12.csv -o surface.json
   lagsym fit examples/probe-12x12.csv --degree 4x3 --threshold 0.05 -o surface-4x3.json
   lagsym fit examples/probe-scattered.csv --criterion loo -o scattered.json
+  lagsym fit examples/probe-results.txt -o probed.json
   lagsym toolpath surface.json -o part.nc"""
 
 
@@ -71,8 +78,19 @@ def read_weights(path: str) -> list:
     return out
 
 
+def _probe_results(path: str):
+    """The surface points of a probing program's results file (``lagsym read-probe``), or None for any other file."""
+    if path == "-":
+        return None
+    name, text = read_text(path)
+    if not is_probe_results(text):
+        return None
+    sp = surface_points(read_results(text, name))
+    return ScatteredPoints(sp.points, name, sp.results.units, f"probe results: {sp.describe()}", plain=False)
+
+
 def run(args, out, err) -> int:
-    data = read_scattered_points(args.file, args.columns)
+    data = _probe_results(args.file) or read_scattered_points(args.file, args.columns)
     if not data.plain:
         err.write(f"{data.source}: read as {data.layout}\n")
     weights = read_weights(args.weights) if args.weights else None

@@ -14,12 +14,23 @@ header.  See docs/roughing.md for the job file.
 
 On a terminal, a progress bar on standard error shows the planning of each operation.
 
+A job whose surface is measured on the machine has a [probe] table instead
+of points (docs/probing.md): then 'lagsym job JOB.toml' writes the probing
+program, and after the measurement 'lagsym job JOB.toml --measured RESULTS'
+reads the results (DPRNT text or a LinuxCNC log, as 'lagsym read-probe'),
+takes the tip radius off, fits the exact surface and writes the machining
+program, whose header names the results file and the fit's residuals.
+
 examples:
-  lagsym job examples/example-4-job.toml -o job.ngc"""
+  lagsym job examples/example-4-job.toml -o job.ngc
+  lagsym job examples/probe-job.toml -o probe-job.nc
+  lagsym job examples/probe-job.toml --measured examples/probe-results.txt -o probed-job.nc"""
 
 
 def add_arguments(p) -> None:
     p.add_argument("job", help="job file (TOML)")
+    p.add_argument("--measured", metavar="RESULTS",
+                   help="a job with a [probe] table: the probing program's results, fitted into the job's surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     add_max_points(p)
@@ -43,7 +54,12 @@ def run(args, out, err) -> int:
     from ..job import job_program, plan_job, read_job
     from ._progress import progress_bar
 
-    spec = guard_job(read_job(args.job), args, err)
+    spec = read_job(args.job)
+    if spec.probe is not None and not args.measured:
+        return _probe_program(spec, args, out, err)
+    if args.measured:
+        spec = measured_job(spec, args.measured, err)
+    spec = guard_job(spec, args, err)
     with progress_bar(err) as progress:
         planned = plan_job(spec, args.max_points, args.max_samples, progress=progress)
     prog = job_program(planned)
@@ -61,7 +77,51 @@ def guard_job(spec, args, err):
 
     from ..io import read_points
 
-    return replace(spec, notes=conditioning_notes(read_points(spec.points), args, err))
+    grid = spec.grid if spec.grid is not None else read_points(spec.points)
+    return replace(spec, notes=spec.notes + conditioning_notes(grid, args, err))
+
+
+def _probe_program(spec, args, out, err) -> int:
+    """The job's probe stage: its probing program."""
+    from ..probe import probe_program
+    from ._common import emit
+
+    stage = spec.probe
+    text = probe_program(stage.plan, stage.settings, spec.dialect, program_number=spec.program_number,
+                         work_offset=spec.work_offset)
+    emit(text, args.output, out)
+    err.write(f"{spec.source}: probe stage: {stage.plan.describe()}, {len(stage.plan)} probing moves on "
+              f"{spec.dialect}; run it, then: lagsym job {args.job} --measured RESULTS\n")
+    return 0
+
+
+def measured_job(spec, results_path: str, err):
+    """The job with its surface fitted to the probe results at ``results_path``, the header naming both."""
+    from dataclasses import replace
+
+    from ..errors import InputError
+    from ..fit import fit_surface
+    from ..io import read_text
+    from ..probe import read_results, surface_points
+
+    if spec.probe is None:
+        raise InputError(f"--measured: {spec.source} has no [probe] table; its surface is {spec.points}")
+    name, text = read_text(results_path)
+    results = read_results(text, name)
+    if len(results.points) != len(spec.probe.plan):
+        raise InputError(f"{name}: {len(results.points)} nodes, but the job's probe stage has "
+                         f"{len(spec.probe.plan)}: results of another program?")
+    sp = surface_points(results, spec.probe.fit_degree)
+    fit = fit_surface(sp.points, spec.probe.fit_degree, source=name, units=results.units)
+    err.write(f"{name}: {len(sp.points)} nodes; {sp.describe()}; fit degree {fit.degree[0]}x{fit.degree[1]}: "
+              f"residuals max {fit.max_residual:.4g} mm, RMS {fit.rms:.4g} mm\n")
+    from pathlib import Path
+
+    notes = (f"MEASURED {Path(name).name} SHA256 {results.sha256[:16]}",
+             f"TIP RADIUS {float(results.tip_radius):g} MM TAKEN OFF, WITHIN {sp.bound:.2g} MM",
+             f"FIT DEGREE {fit.degree[0]}X{fit.degree[1]} OF {len(sp.points)} POINTS: RESIDUALS MAX "
+             f"{fit.max_residual:.4g} MM RMS {fit.rms:.4g} MM")
+    return replace(spec, grid=fit.surface.grid, notes=spec.notes + notes)
 
 
 def report(planned, prog, err) -> None:

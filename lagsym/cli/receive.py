@@ -10,6 +10,7 @@ from ..dnc import receive_program
 from ..dnc.store import create_exclusive, save_beside
 from ..errors import InputError, OutputError
 from ..io import check_output, event_log, write_text
+from ..probe.results import is_probe_results, read_results
 from ._common import number
 from .send import add_line_arguments, check_log, line_settings
 
@@ -28,6 +29,12 @@ press PUNCH; on a terminal, characters, blocks and rate show as they
 arrive.  Exit status 3 on a line fault, a busy port, a timeout, a program
 without its closing %, garbage (check the baud rate and format: they must
 match the control's), Ctrl-C, SIGTERM or SIGHUP.
+
+The output of a 'lagsym probe' program (POPEN, DPRNT lines, PCLOS) is taken
+by its header line as probe results, without % around it: every node is
+checked as 'lagsym read-probe' checks it before the file is written, and
+results with a node missing or a line cut (the control stopped, or the line
+did) are refused in one line naming the node, exit status 2, nothing written.
 
 examples:
   lagsym receive --port /dev/ttyUSB0 --profile fanuc -o from-control.nc
@@ -60,6 +67,7 @@ def run(args, out, err) -> int:
     with event_log(args.log) as log, progress_bar(err, args.quiet) as bar:
         text = receive_program(args.port, settings, start_timeout_s=args.timeout, idle_timeout_s=args.idle_timeout,
                                log=log, ready=ready, progress=bar)
+    results = read_results(text, args.port) if is_probe_results(text) else None  # checked whole before saving
     if to_file:
         save(text, args.output, args.overwrite)
     else:
@@ -67,6 +75,9 @@ def run(args, out, err) -> int:
     check_log(log, f"received {text.count(chr(10))} lines into {args.output if to_file else 'standard output'}")
     if not args.quiet and to_file:
         err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
+    if results is not None and not args.quiet:
+        err.write(f"probe results: {len(results.points)} nodes, tip radius {float(results.tip_radius):g} "
+                  f"{results.units}, every node there: read them with lagsym read-probe\n")
     return 0
 
 

@@ -244,6 +244,11 @@ def _program_text(raw: bytes, percents: int, port: str, settings: LineSettings) 
                             f"check the baud rate and format ({_settings_text(settings)}): baud rate, parity, data "
                             "bits and stop bits must match the control's; then punch it again")
     text = raw.decode("ascii").replace("\r\n", "\n").replace("\r", "\n")
+    from ..probe.results import is_probe_results
+
+    if is_probe_results(text):  # a probing program's DPRNT output (POPEN .. PCLOS): no % around it
+        lines = [line.rstrip() for line in text.split("\n")]
+        return "\n".join(line for line in lines if line) + "\n"
     if settings.percent:
         first = text.find("%")
         if first < 0 or percents < 2:

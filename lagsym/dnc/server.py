@@ -32,7 +32,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from ..errors import LagsymError
+from ..errors import InputError, LagsymError
+from ..probe.results import is_probe_results, read_results
 from .blocks import parse_program
 from .config import PortConfig, ServerConfig
 from .receiver import Inbox, ReceiveFault, receive_program
@@ -267,6 +268,9 @@ class _PortService:
         except BaseException as e:
             spool.keep(f"the receive ended without a program ({type(e).__name__}: {e})")
             raise
+        if is_probe_results(text):
+            self.save_results(text, spool)
+            return
         programs = split_programs(text)
         number = program_number(programs[0])
         requests = (self.port.request_upload, self.port.request_drip)
@@ -309,6 +313,23 @@ class _PortService:
                 return count + end + 1
             count += len(chunk)
         return count
+
+    def save_results(self, text: str, spool) -> None:
+        """Keep a probing program's results (its DPRNT output) as ``probe-results.txt``, checked whole first;
+        results with a node missing or a line cut are kept in ``failed/`` with the reason, as a failed punch."""
+        try:
+            results = read_results(text, self.port.device)
+        except InputError as e:
+            kept = spool.keep(f"probe results refused: {e}")
+            self.log(f"failed probe results: {e}; kept in failed/{kept.name if kept else '?'}")
+            self.status(f"failed probe results ({e})")
+            return
+        self.port.received.mkdir(parents=True, exist_ok=True)
+        path = save_beside(self.port.received, "probe-results", ".txt", text.encode("ascii"))
+        spool.discard()
+        self.log(f"received probe results: {len(results.points)} nodes, tip radius {float(results.tip_radius):g} "
+                 f"{results.units}, saved as {path.name}")
+        self.status(f"received probe results as {path.name}")
 
     def save(self, text: str) -> None:
         """Save one program under its number; one log line saying where."""

@@ -100,7 +100,9 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     each planner's own stages after the operation's label
     (``rough T1: dropping the tool``; :mod:`lagsym.progress`).
     """
-    surface = lagrange_surface(read_points(spec.points))
+    if spec.grid is None and spec.points is None:
+        raise InputError(f"{spec.source}: the job's surface is measured: fit the measurement first (--measured)")
+    surface = lagrange_surface(spec.grid if spec.grid is not None else read_points(spec.points))
     ev = surface_evaluator(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:

@@ -36,7 +36,7 @@ from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
 from ..values import in_range
 
-__all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KINDS", "COOLANTS"]
+__all__ = ["JobSpec", "OperationSpec", "ToolSpec", "ProbeStage", "read_job", "parse_job", "KINDS", "COOLANTS"]
 
 KINDS = ("rough", "semi-finish", "finish", "cross-finish")
 """Operation kinds, in the order a machinist runs them."""
@@ -46,7 +46,10 @@ JOB_DIALECTS = names(point_lists=True)
 
 _TOP = {"points": str, "dialect": str, "units": str, "scale": float, "origin": list, "work_offset": str,
         "program_number": int, "safe_z": float, "rapid": float, "title": str, "stock": dict, "tools": dict,
-        "operations": list, "variables": str}
+        "operations": list, "variables": str, "probe": dict}
+_PROBE = {"box": list, "top": float, "bottom": float, "tip_radius": float, "degree": int, "margin": int,
+          "spacing": str, "clearance": float, "overtravel": float, "feed": float, "fit_degree": int}
+_REQUIRED_PROBE = ("box", "top", "bottom", "tip_radius")
 _STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
 _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float, "flute_length": float,
          "reach": float}
@@ -82,8 +85,22 @@ class OperationSpec:
 
 
 @dataclass(frozen=True)
+class ProbeStage:
+    """A job's probe stage: the node plan and the probe's settings, and the degree the measurement is fitted with
+    (None: chosen by cross-validation)."""
+
+    plan: object
+    settings: object
+    fit_degree: int | None = None
+
+
+@dataclass(frozen=True)
 class JobSpec:
-    """A whole job as read from its file (lengths in mm)."""
+    """A whole job as read from its file (lengths in mm).
+
+    With a probe stage (``probe``), ``points`` is None until the measurement
+    is fitted: ``grid`` then holds the fitted surface's grid.
+    """
 
     source: str
     points: Path
@@ -101,6 +118,8 @@ class JobSpec:
     operations: tuple
     variables: str = "full"
     notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
+    probe: ProbeStage | None = None
+    grid: object = None  # the surface's grid when it does not come from the points file (a fitted measurement)
 
 
 def read_job(path) -> JobSpec:
@@ -171,9 +190,12 @@ def _length(value, key: str, source: str) -> float:
 def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobSpec:
     """A :class:`JobSpec` from the parsed TOML ``data``; ``base`` is where a relative points path starts."""
     _keys(data, _TOP, "", source)
-    for key in ("points", "tools", "operations", "stock"):
+    for key in ("tools", "operations", "stock"):
         if key not in data:
             raise InputError(f"{source}: missing key {key!r}")
+    if ("points" in data) == ("probe" in data):
+        raise InputError(f"{source}: give points (a points file) or a [probe] table (the surface measured on the "
+                         f"machine), {'not both' if 'points' in data else 'one of them'}")
     origin = data.get("origin", [0.0, 0.0, 0.0])
     if len(origin) != 3 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in origin):
         raise InputError(f"{source}: origin = {origin!r} must be three numbers [X, Y, Z] in mm")
@@ -202,8 +224,9 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
     low, high = control(dialect).program_numbers
     if not low <= program_number <= high:
         raise InputError(f"{source}: program_number = {program_number} must be {low} to {high}")
+    probe = _probe(data["probe"], dialect, source) if "probe" in data else None
     return JobSpec(
-        source=source, points=base / data["points"],
+        source=source, points=base / data["points"] if "points" in data else None, probe=probe,
         dialect=dialect,
         units=_choice(data.get("units", "mm"), UNITS, "units", source),
         mm_per_unit=_positive(data.get("scale", 1.0), "scale", source),
@@ -213,8 +236,39 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         program_number=program_number,
         safe_z_mm=_length(data.get("safe_z", 50.0), "safe_z", source),
         rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
-        title=data.get("title", Path(data["points"]).stem),
+        title=data.get("title", Path(data["points"]).stem if "points" in data else "probed"),
         stock=_stock(data["stock"], source), tools=tools, operations=ops, variables=variables)
+
+
+def _probe(table: dict, dialect: str, source: str) -> ProbeStage:
+    """The ``[probe]`` table: the box, the part's top and bottom, the tip radius, the plan and the approach."""
+    from ..probe import PROBE_DIALECTS, SPACINGS, ProbeSettings, node_plan
+
+    _keys(table, _PROBE, "probe.", source)
+    for key in _REQUIRED_PROBE:
+        if key not in table:
+            raise InputError(f"{source}: missing key probe.{key}")
+    if control(dialect).probing is None:
+        raise InputError(f"{source}: a probe stage is written for {', '.join(PROBE_DIALECTS)}, not {dialect!r}")
+    box = table["box"]
+    if len(box) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in box):
+        raise InputError(f"{source}: probe.box = {box!r} must be four numbers [x0, x1, y0, y1] in mm")
+    for key in ("top", "bottom"):
+        _length(table[key], f"probe.{key}", source)
+    for k, v in enumerate(box):
+        _length(v, f"probe.box[{k}]", source)
+    spacing = _choice(table.get("spacing", "chebyshev"), SPACINGS[:2], "probe.spacing", source)
+    fit_degree = table.get("fit_degree")
+    if fit_degree is not None and not 0 <= fit_degree <= 12:
+        raise InputError(f"{source}: probe.fit_degree = {fit_degree} must be 0 to 12")
+    try:
+        plan = node_plan(tuple(box), table.get("degree", 4), spacing=spacing, margin=table.get("margin", 2))
+        settings = ProbeSettings(str(table["tip_radius"]), str(table["top"]), str(table["bottom"]),
+                                 clearance_mm=str(table.get("clearance", 2)),
+                                 overtravel_mm=str(table.get("overtravel", 2)), feed_mm_min=str(table.get("feed", 100)))
+    except InputError as e:
+        raise InputError(f"{source}: probe: {e}") from None
+    return ProbeStage(plan, settings, fit_degree)
 
 
 def _stock(table: dict, source: str) -> dict:

@@ -18,6 +18,13 @@ constant.  It returns the moves the control would make, or raises
 * a runaway loop (:mod:`~lagsym.simulate.runaway`): back at a block with
   nothing changed, too many blocks without a move, or too many blocks in all.
 
+A probing move (Fanuc/Haas ``G31``, LinuxCNC ``G38.2``) runs against a
+surface given as ``target`` (:mod:`~lagsym.simulate.probing`): it stops
+where the probe's ball tip touches, sets ``#5061``-``#5063``, and what the
+program prints (``POPEN``/``DPRNT``/``PCLOS``, LinuxCNC's
+``(LOGOPEN,..)``/``(LOG,..)``/``(LOGCLOSE)``) is the run's ``output``.
+Without a target a probing move is refused, as every code it does not run.
+
 The simulator covers what lagsym emits plus the common core of each language
 (``IF [..] GOTO n``, ``IF [..] THEN``, ``GOTO``, the functions every Macro B
 control has); it is not a full interpreter of any control.

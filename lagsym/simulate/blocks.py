@@ -15,7 +15,11 @@ from decimal import Decimal
 from typing import ClassVar
 
 __all__ = ["Block", "Nop", "Stop", "Assign", "AssignNamed", "Words", "While", "End", "IfThen", "Goto",
-           "IfGoto", "Label", "IfGotoLabel", "OWhile", "OEndWhile", "OIf", "OElseIf", "OElse", "OEndIf"]
+           "IfGoto", "Label", "IfGotoLabel", "OWhile", "OEndWhile", "OIf", "OElseIf", "OElse", "OEndIf", "Output",
+           "PROBE_CODES", "probe_code"]
+
+PROBE_CODES = (31.0, 38.2)
+"""The probing moves the simulator runs against a given surface: Fanuc/Haas ``G31`` and LinuxCNC ``G38.2``."""
 
 Expr = Callable[..., Decimal]
 Ref = Callable[..., int]
@@ -174,3 +178,32 @@ class OEndIf(Block):
 
     KEYWORD: ClassVar[str] = "endif"
     oword: str
+
+
+@dataclass(frozen=True)
+class Output(Block):
+    """Text the program sends out: Fanuc ``POPEN``, ``DPRNT[..]``, ``PCLOS``; LinuxCNC ``(LOGOPEN,..)``,
+    ``(LOG,..)``, ``(LOGCLOSE)``.
+
+    ``action`` is ``open``, ``print`` or ``close``; ``items`` the parts of a
+    printed line in order: ``("text", s)``, ``("var", n, digits, decimals)``
+    (a Fanuc ``#n[ab]``) or ``("param", n)`` (a LinuxCNC ``#n``, printed as
+    ``%f``); ``name`` the file a LinuxCNC log opens.
+    """
+
+    action: str
+    items: tuple = ()
+    name: str = ""
+
+
+def probe_code(b: Block) -> float | None:
+    """The probing move (:data:`PROBE_CODES`) a block of words makes, or None."""
+    if not isinstance(b, Words):
+        return None
+    for letter, e in b.words:
+        node = getattr(e, "node", None)
+        if letter == "G" and node is not None and node[0] in ("num", "dec"):
+            code = round(float(node[1]), 1)
+            if code in PROBE_CODES:
+                return code
+    return None

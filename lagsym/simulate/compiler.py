@@ -30,7 +30,7 @@ from decimal import ROUND_HALF_UP, Decimal
 from ..gcode.program import unrun_code
 from .alarms import BlockAlarm, alarm_at
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile,
-                     OIf, OWhile, Stop, While, Words)
+                     OIf, OWhile, Output, Stop, While, Words, probe_code)
 from .codegen import STOPS, Segment
 from .expressions import closure
 
@@ -54,6 +54,8 @@ def _leaders(blocks, labels) -> list[int]:
                 starts.add(b.start)
         elif isinstance(b, Words) and any(k == "M" for k, _ in b.words):
             starts.add(i + 1)
+        elif isinstance(b, Output) or probe_code(b) is not None:
+            starts.add(i + 1)  # it reads and sets variables and state outside the segment's locals
     starts = sorted(s for s in starts if s < n)
     cut = []  # long straight runs (a point list) in pieces: the compiler's time and memory stay linear
     for a, b in zip(starts, starts[1:] + [n]):
@@ -62,6 +64,11 @@ def _leaders(blocks, labels) -> list[int]:
 
 
 def _modal_g(m, g) -> None:
+    if m.probing is not None and f"G{_code(g)}" == m.probing.move:
+        m.probe_pending = round(float(g), 1)  # this block's move probes
+        if m.probing.checks_contact:
+            m.motion = m.probing.move  # G38.2 is a motion mode on LinuxCNC; G31 is one-shot on a Fanuc
+        return
     why = unrun_code("G", g)
     if why is not None:
         raise BlockAlarm("not-run", f"G{_code(g)} {why}, which the simulator does not run")
@@ -104,15 +111,35 @@ def _constant_words(m, run) -> None:
                     values[letter] = v
             if "F" in values:
                 m.feed = values["F"]
-            if m.motion in ("G2", "G3") and any(a in values for a in "XYZ"):
-                _arc()
+            if m.motion not in ("G0", "G1") and m.probe_pending is None and any(a in values for a in "XYZ"):
+                _arc(m)
             m.move(b.line, values)
         except (BlockAlarm, ArithmeticError) as e:
             raise alarm_at(e, b) from None
 
 
-def _arc() -> None:
-    raise BlockAlarm("arc", "arcs are outside what the simulator runs")
+def _run_words(m, b) -> None:
+    """A block of words run through the control's own methods (a probing move: its state lives on the control)."""
+    try:
+        pairs = tuple((letter, e(m)) for letter, e in b.words)
+    except (BlockAlarm, ArithmeticError) as e:
+        raise alarm_at(e, b) from None
+    _constant_words(m, ((b, pairs),))
+
+
+def _send(m, b) -> None:
+    try:
+        m.send(b.action, b.items)
+    except (BlockAlarm, ArithmeticError) as e:
+        raise alarm_at(e, b) from None
+
+
+def _arc(m) -> None:
+    """Refuse a move in a motion mode the simulator does not run: an arc, or a probing mode carried on."""
+    if m.motion in ("G2", "G3"):
+        raise BlockAlarm("arc", "arcs are outside what the simulator runs")
+    raise BlockAlarm("not-run", f"a move in {m.motion} mode without its {m.motion} word: the simulator runs a "
+                                f"probing move only in the block that gives it")
 
 
 def _environment(m, labels) -> dict:
@@ -131,7 +158,8 @@ def _environment(m, labels) -> dict:
     return {"m": m, "V": m.vars, "NM": m.names, "POS": m.pos, "Z": Decimal(0), "ONE": Decimal(1),
             "ZERO": Decimal(0), "P": ctx.plus, "POW": ctx.power, "DIV": m.divide, "MOD": mod, "FUNC": m.func,
             "ATAN2": m.atan2, "GET": m.get, "GETN": m.named, "CHECK": m.check, "CONST": m.const, "JUMP": jump,
-            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc, "WORDS": _constant_words, "STOPS": STOPS,
+            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc,
+            "RUNWORDS": _run_words, "SEND": _send, "WORDS": _constant_words, "STOPS": STOPS,
             "A_LINE": line, "A_RAPID": rapid, "A_X": x, "A_Y": y, "A_Z": z, "A_F": feed}
 
 
@@ -179,6 +207,14 @@ class _Program:
         seg = Segment(self, cached)
         for i in range(start, stop):
             b = self.blocks[i]
+            if isinstance(b, Output) or probe_code(b) is not None:
+                seg.write_back()
+                seg.block = i
+                name = f"b{i}"
+                self.env[name] = b
+                seg.emit(f"{'SEND' if isinstance(b, Output) else 'RUNWORDS'}(m, {name})")
+                seg.emit(f"return {i + 1}")
+                return seg.lines, i
             if isinstance(b, Words) and seg.constant_words(i, b):
                 ms = [v for letter, v in seg.pending[-1][1] if letter == "M"]
                 if ms:

@@ -12,6 +12,7 @@ from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND
 
 from ..controls import Control, control
 from .alarms import BlockAlarm
+from .probing import ProbeCrash
 from .result import SimMoves
 
 __all__ = ["ControlState"]
@@ -38,6 +39,12 @@ class ControlState:
         self.feed = Decimal(0)
         self.absolute = True
         self.moves = SimMoves()
+        self.probing = c.probing
+        self.target = None  # what a probing move touches (lagsym.simulate.probing), when the run has one
+        self.probe_pending: float | None = None  # the probing move of the block being run
+        self.probes = 0
+        self.output: list[str] = []
+        self.output_open = False
 
     def const(self, text: str) -> Decimal:
         value = self.constants.get(text)
@@ -52,6 +59,8 @@ class ControlState:
         return value
 
     def check(self, n: int) -> int:
+        if self.probing is not None and n == self.probing.alarm_variable:
+            raise BlockAlarm(str(n), f"the program raised its own alarm (#{n})")
         if not any(lo <= n <= hi for lo, hi in self.ranges):
             allowed = ", ".join(f"{lo}-{hi}" for lo, hi in self.ranges)
             raise BlockAlarm("115", f"variable {n} is outside the allowed ranges {allowed}")
@@ -64,7 +73,8 @@ class ControlState:
     def get(self, n: int) -> Decimal:
         if n == 0 and self.language.vacant_zero:
             return Decimal(0)  # #0 is always vacant; vacant reads as 0 in arithmetic
-        self.check(n)
+        if self.probing is None or n not in self.probing.result_variables:
+            self.check(n)
         return self.vars.get(n, Decimal(0))
 
     def set(self, n: int, value: Decimal) -> None:
@@ -113,6 +123,10 @@ class ControlState:
         return self.ctx.create_decimal(repr(math.degrees(math.atan2(float(a), float(b))) % 360.0))
 
     def move(self, line: int, words: dict[str, Decimal]) -> None:
+        if self.probe_pending is not None:
+            code, self.probe_pending = self.probe_pending, None
+            self._probe(line, words, code)
+            return
         for axis, letter in enumerate("XYZ"):
             if letter in words:
                 v = words[letter]
@@ -129,3 +143,62 @@ class ControlState:
     def state(self) -> tuple:
         """A copy of the variables, the position and the modes: with the block to run, all a run depends on."""
         return list(self.pos), dict(self.vars), dict(self.names), (self.motion, self.feed, self.absolute)
+
+    # ------------------------------------------------------------------ probing and printed output
+
+    def _probe(self, line: int, words: dict[str, Decimal], code: float) -> None:
+        """A probing move (``G31``, ``G38.2``) toward the target: stop where the tip touches, note where."""
+        name = f"G{code:g}"
+        if self.target is None:
+            raise BlockAlarm("not-run", f"{name} probes, which the simulator runs only against a given surface")
+        if not any(k in words for k in "XYZ"):
+            raise BlockAlarm("probe", f"{name} without an axis word")
+        if self.feed <= 0:
+            raise BlockAlarm("probe", f"{name} with no feed (F)")
+        start = [float(p) for p in self.pos]
+        end = list(self.pos)
+        for axis, letter in enumerate("XYZ"):
+            if letter in words:
+                end[axis] = words[letter] if self.absolute else self.ctx.add(self.pos[axis], words[letter])
+        try:
+            touch = self.target.touch(start, [float(p) for p in end])
+        except ProbeCrash as e:
+            raise BlockAlarm("probe", str(e)) from None
+        if touch is None:
+            if self.probing.checks_contact:
+                raise BlockAlarm("probe", f"{name} move finished without making contact")
+            self.pos = end  # a skip move without the signal ends where it was sent
+        else:
+            self.pos = [self.ctx.create_decimal(repr(float(v))) for v in touch]
+        for n, v in zip(self.probing.result_variables, self.pos):
+            self.vars[n] = v
+        if self.probing.checks_contact:
+            self.vars[5070] = Decimal(int(touch is not None))  # LinuxCNC: 1 after a successful probe
+        self.probes += 1
+        self.moves.append(line, False, float(self.pos[0]), float(self.pos[1]), float(self.pos[2]), float(self.feed))
+
+    def send(self, action: str, items: tuple = ()) -> None:
+        """``POPEN``/``DPRNT``/``PCLOS`` or LinuxCNC's log: open the output, print one line, close it."""
+        if action == "open":
+            self.output_open = True
+        elif action == "close":
+            self.output_open = False
+        elif not self.output_open:
+            if self.language.name == "fanuc":
+                raise BlockAlarm("dprnt", "DPRNT before POPEN: the port is not open")
+            return  # LinuxCNC drops a (LOG,..) while no log file is open
+        else:
+            self.output.append("".join(self._printed(item) for item in items))
+
+    def _printed(self, item) -> str:
+        if item[0] == "text":
+            return item[1]
+        if item[0] == "param":
+            return f"{float(self.get(item[1])):f}"  # LinuxCNC prints a parameter as %f
+        _, n, digits, decimals = item
+        v = self.get(n).quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_UP)
+        whole = len(str(abs(int(v))))
+        if whole > digits:
+            raise BlockAlarm("dprnt", f"#{n} = {v} has more than the {digits} digits before the point DPRNT prints")
+        text = format(abs(v), "f")
+        return ("-" if v < 0 else " ") + text  # the sign's place is a space for a positive value

@@ -23,7 +23,7 @@ MAX_DO = 3  # Fanuc: DO1..DO3
 
 def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
              variable_ranges=None, max_blocks: int = MAX_BLOCKS, max_idle_blocks: int = MAX_IDLE_BLOCKS,
-             progress: Progress | None = None) -> Simulation:
+             progress: Progress | None = None, target=None) -> Simulation:
     """Execute ``text`` as the control would, with ``precision`` significant digits.
 
     Parameters
@@ -48,6 +48,10 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         Blocks executed without a move before the run is stopped as a runaway
         loop.  A run that comes back to a block with every variable and the
         position unchanged is stopped at once (see :mod:`~lagsym.simulate.runaway`).
+    target : ProbeTarget, optional
+        What the probing moves (Fanuc/Haas ``G31``, LinuxCNC ``G38.2``)
+        touch (:func:`~lagsym.simulate.probing.probe_target`); without one a
+        probing move is an alarm, as every code the simulator does not run.
     progress : Progress, optional
         Told the blocks executed, every ``max_blocks`` / 200 (stage ``executing blocks``; the total
         is known only at the end: :mod:`lagsym.progress`).
@@ -72,10 +76,12 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     blocks = _match_loops(read_blocks(text, c))
     labels = _labels(blocks)
     m = ControlState(c, int(precision), variable_ranges or None)
+    m.target = target
     runaway = Runaway(max_blocks, max_idle_blocks, endless_jumps(blocks, labels, c, int(precision)), blocks)
     table, where = compile_program(m, blocks, labels)
     executed = _run(table, where, blocks, m, runaway, Tally(progress, "executing blocks"))
-    return Simulation(dialect=c.name, precision=int(precision), moves=m.moves, blocks=executed)
+    return Simulation(dialect=c.name, precision=int(precision), moves=m.moves, blocks=executed,
+                      output=tuple(m.output), probes=m.probes)
 
 
 def _run(table, where, blocks, m: ControlState, runaway: Runaway, tally: Tally | None = None) -> int:

@@ -305,11 +305,13 @@ def _word_value(letter: str, text: str, increments: bool):
     return expression(t)
 
 
-def word_values(text: str, increments: bool) -> tuple[tuple[str, object], ...]:
+def word_values(text: str, increments: bool, probe: float | None = None) -> tuple[tuple[str, object], ...]:
     """The words of a comment-free block as ``(letter, closure)`` pairs, each value read as the control reads it.
 
     ``increments``: the control reads an axis word without a decimal point in
     least input increments (:attr:`lagsym.controls.MacroLanguage.integer_increments`).
+    ``probe``: the control's probing move (``31.0``, ``38.2``), which passes
+    here; the executor runs it against a given surface, and refuses it without one.
     """
     try:
         split = words(text)
@@ -317,6 +319,8 @@ def word_values(text: str, increments: bool) -> tuple[tuple[str, object], ...]:
         raise BlockAlarm("114", str(e)) from None
     for letter, value in split:  # a call's own words (G65 P9010 A1.) are named by the call, not by its A
         if letter in "GM" and _PLAIN_NUMBER.fullmatch(value.strip()):
+            if letter == "G" and probe is not None and round(float(value), 1) == probe:
+                continue
             why = unrun_code(letter, value)
             if why is not None:
                 code = round(float(value), 1)

@@ -18,7 +18,8 @@ SIM_DIALECTS = names(macros=True)
 
 
 def detect_dialect(text: str) -> str:
-    """Guess the dialect of a program: ``BEGIN PGM`` is Heidenhain, ``o100 while`` LinuxCNC, else Fanuc.
+    """Guess the dialect of a program: ``BEGIN PGM`` is Heidenhain, ``o100 while``, ``#<name>``, a ``G38.2``
+    probe or a ``(LOGOPEN,..)`` LinuxCNC, else Fanuc.
 
     Examples
     --------
@@ -28,6 +29,8 @@ def detect_dialect(text: str) -> str:
     if re.search(r"^\s*\d*\s*BEGIN\s+PGM", text, re.M | re.I):
         return "heidenhain"
     if re.search(r"^[ \t]*o[ \t]*[\d<]\S*[ \t]+(while|if|do|sub|repeat)\b", text, re.M | re.I) or "#<" in text:
+        return "linuxcnc"
+    if re.search(r"\bG\s*38\.[2-5]|\(\s*LOG(OPEN|APPEND)\s*,", text, re.I):
         return "linuxcnc"
     return "fanuc"
 

@@ -132,12 +132,18 @@ class SimMoves(Sequence):
 
 @dataclass(frozen=True)
 class Simulation:
-    """The result of a dry run: the moves in order and how many blocks were executed."""
+    """The result of a dry run: the moves in order, how many blocks were executed, and the text it sent out.
+
+    ``output`` holds the lines a program printed (Fanuc ``DPRNT``, LinuxCNC
+    ``(LOG,..)``), each without its line end; ``probes`` counts its probing moves.
+    """
 
     dialect: str
     precision: int
     moves: SimMoves
     blocks: int
+    output: tuple[str, ...] = ()
+    probes: int = 0
 
     def feed_points(self):
         """The end points of the feed (``G1``) moves as an (N, 3) float array."""

@@ -29,7 +29,7 @@ from decimal import Decimal
 from ..gcode.program import END_M, unrun_code
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
-                     OWhile, Stop, While, Words)
+                     OWhile, Stop, While, Words, probe_code)
 from .control import ControlState
 
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
@@ -132,6 +132,8 @@ def _unchanged(probe: _Probe, cond, blocks, lo: int, hi: int) -> bool:
         return False
     numbers, names = reads
     for c in blocks[lo:hi + 1]:
+        if probe_code(c) is not None:
+            return False  # a probing move sets the result variables
         a = c.then if isinstance(c, IfThen) else c
         if isinstance(a, Assign):
             n = _constant(probe, a.target)
