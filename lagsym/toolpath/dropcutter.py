@@ -221,7 +221,7 @@ def telling_compiles(progress: Progress | None):
     Keep the block to one small drop: the report comes from a timer thread,
     and no other report may be made meanwhile.
     """
-    from .kernel import told_if_compiling
+    from .compiling import told_if_compiling
 
     told = []
 

@@ -19,15 +19,12 @@ derivatives stacked (:func:`.newton.jet_coefficients`).
 
 from __future__ import annotations
 
-import contextlib
 import math
-import threading
 
 import numpy as np
 from numba import njit
-from numba.core import event
 
-__all__ = ["drop_chunk", "newton_starts", "told_if_compiling"]
+__all__ = ["drop_chunk", "newton_starts"]
 
 _HALF = math.sqrt(0.5)
 _STEPS = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0), (0.0, 0.0, 1.0), (0.0, 0.0, -1.0),
@@ -450,40 +447,3 @@ def newton_starts(jc, m, geo, px, py, val, cx, cy, h, done):
     jt = jc.T.copy()
     for k in range(px.size):
         px[k], py[k], val[k], h[k], done[k] = _newton(jt, m, geo, px[k], py[k], val[k], cx[k], cy[k], acc, jet, qjet)
-
-
-class _CompileWatch(event.Listener):
-    """Starts a timer at the first compilation it hears of: Numba's cache held no machine code for the kernel."""
-
-    def __init__(self, tell, after: float):
-        self.tell, self.after, self.timer = tell, after, None
-
-    def on_start(self, _event) -> None:
-        if self.timer is None:
-            self.timer = threading.Timer(self.after, self.tell)
-            self.timer.daemon = True
-            self.timer.start()
-
-    def on_end(self, _event) -> None:
-        pass
-
-
-@contextlib.contextmanager
-def told_if_compiling(tell, after: float = 2.0):
-    """Call ``tell()`` once if, inside the block, Numba compiles and the block has not ended ``after`` seconds later.
-
-    A first run after an install (or after the cache beside this file was
-    removed) compiles the kernel, which takes far longer than loading it: the
-    caller says so rather than seeming to hang.  A load from the cache
-    compiles nothing and tells nothing.  The timer is stopped and joined
-    before the block is left, so no thread outlives it (the planner forks its
-    workers only while no other thread runs).
-    """
-    watch = _CompileWatch(tell, after)
-    try:
-        with event.install_listener("numba:compile", watch):
-            yield
-    finally:
-        if watch.timer is not None:
-            watch.timer.cancel()
-            watch.timer.join()
