@@ -155,6 +155,7 @@ def brute_ball(ref, grid, cx, cy, radius, n=161):
     return np.array(out)
 
 
+@pytest.mark.slow
 def test_drop_cutter_across_borders_against_brute_force():
     g = wavy_grid(20)
     s = piecewise_surface(g)
@@ -173,6 +174,7 @@ def test_drop_cutter_across_borders_against_brute_force():
     assert np.all((z - lower)[inside] < 2e-3)
 
 
+@pytest.mark.slow
 def test_toolpath_is_gouge_free_across_borders():
     g = wavy_grid(20)
     s = piecewise_surface(g)
@@ -189,3 +191,68 @@ def test_toolpath_is_gouge_free_across_borders():
     # every row crosses 19 borders: the path's points lie on both sides of each
     row0 = p[tp.rows == 0]
     assert all(((row0[:, 0] < v) .any() and (row0[:, 0] > v).any()) for v in (float(x) for x in g.x[1:-1]))
+
+
+def test_bspline_patch_is_the_pieces():
+    """The one B-spline, cut at its knots by knot insertion (its own code), gives back every piece exactly."""
+    from lagsym.cad import piecewise_patch
+
+    s = piecewise_surface(wavy_grid(6, 5))
+    p = piecewise_patch(s)
+    assert (p.degree_u, p.degree_v) == (3, 3)
+    assert sorted(set(p.knots_u)) == list(s.grid.x) and p.knots_u.count(s.grid.x[2]) == 2
+    pieces = p.bezier_pieces()
+    assert len(pieces) == 20
+    rng = np.random.default_rng(5)
+    for bp in pieces:
+        x0, x1, y0, y1 = bp.box
+        for a, b in rng.integers(0, 10, (3, 2)):
+            u, v = x0 + (x1 - x0) * Fraction(int(a), 9), y0 + (y1 - y0) * Fraction(int(b), 9)
+            assert bp.point(u, v) == (u, v, s.exact_value(u, v))
+
+
+@pytest.mark.slow
+def test_step_read_back_by_opencascade(tmp_path):
+    pytest.importorskip("OCP")
+    from test_cad_files import bspline_faces, occ_points, read_back
+
+    from lagsym.cad import piecewise_patch
+    from lagsym.export.cad import write_cad
+
+    s = piecewise_surface(wavy_grid(20))
+    path = tmp_path / "s.step"
+    write_cad(path, piecewise_patch(s), units="mm")
+    faces = bspline_faces(read_back(path))
+    assert len(faces) == 1
+    occ = faces[0][1]
+    assert (occ.NbUKnots(), occ.NbVKnots()) == (20, 20) and occ.UMultiplicity(2) == 2
+    us = np.linspace(0, 40, 41)[1:-1] + 0.013
+    got = occ_points(occ, us, us)
+    want = np.array([[float(s.exact_value(Fraction(u), Fraction(v))) for v in us] for u in us])
+    lo, hi = s.grid.z_range()
+    assert np.abs(got[:, :, 2] - want).max() <= 1e-12 * float(hi - lo)
+
+
+def test_command_line(tmp_path):
+    from lagsym.cli import main
+
+    g = wavy_grid(12)
+    src = tmp_path / "g.csv"
+    src.write_text("x,y,z\n" + "".join(f"{x},{y},{g.z[i][k]}\n" if g.z[i][k].denominator == 1 else
+                                       f"{x},{y},{float(g.z[i][k])}\n"
+                                       for i, x in enumerate(map(float, g.x)) for k, y in enumerate(map(float, g.y))))
+    out, err = io.StringIO(), io.StringIO()
+    dst = tmp_path / "s.json"
+    assert main(["piecewise", str(src), "-o", str(dst)], out, err) == 0
+    assert "11 x 11 = 121 exact bicubic pieces through 12 x 12 points, C1" in out.getvalue()
+    s = parse_piecewise_json(dst.read_text())
+    assert s.exact_value(s.grid.x[3], s.grid.y[4]) == Fraction(s.grid.z[3][4])
+    for cmd in (["macro", str(dst)], ["sample", str(dst)], ["check", str(dst)]):
+        out, err = io.StringIO(), io.StringIO()
+        assert main(cmd, out, err) == 2
+        assert len(err.getvalue().strip().splitlines()) == 1 and "piece" in err.getvalue()
+    out, err = io.StringIO(), io.StringIO()
+    nc = tmp_path / "p.nc"
+    assert main(["toolpath", str(dst), "--stepover", "4", "--step", "2", "--tool-diameter", "6", "-o", str(nc)],
+                out, err) == 0
+    assert nc.read_text().startswith("%") and "cutter locations" in err.getvalue()

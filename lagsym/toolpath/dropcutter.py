@@ -90,10 +90,8 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
         Worker processes for this evaluator (:mod:`.workers`) that share the
         positions out in chunks; the values are the same as without.
     feature : float, optional
-        The smallest feature the lattice must resolve (its spacing is at most
-        half of it): by default half the box over the degree, half the
-        nodes' spacing of a polynomial; on a piecewise surface half its
-        narrowest cell, for every piece.
+        The smallest feature the lattice resolves (spacing at most half of it): by default the box over
+        twice the degree; on a piecewise surface, half its narrowest cell.
 
     Returns
     -------
@@ -124,8 +122,7 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     if feature is None:
         deg = max(*ev.shape, 2)
         feature = min(x1 - x0, y1 - y0) / (2 * deg)
-    spacing = min(radius / lattice, feature / 2)
-    spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
+    spacing = max(min(radius / lattice, feature / 2), radius / 40)  # bounded work for a tool far larger than the box
     lattice_ = _lattice(radius, spacing)
     span = _height_scale(ev) + radius + 1.0
     parallel = workers is not None and workers.parallel and workers.evaluator is ev
