@@ -26,9 +26,9 @@ with its knots at the borders (STEP, IGES, exact JSON).  Commands that need
 one polynomial (macro, rough, job, sample, check, equation) refuse it.
 
 examples:
-  lagsym piecewise examples/probe-12x12.csv -o surface.json
-  lagsym toolpath surface.json --tool-diameter 6 --stepover 1 -o part.nc
-  lagsym export surface.json -o surface.step"""
+  lagsym piecewise examples/part-20x20.csv -o pieces.json
+  lagsym toolpath pieces.json --tool-diameter 6 --stepover 2 --step 1 -o pieces.nc
+  lagsym export pieces.json -o pieces.step"""
 
 
 def add_arguments(p) -> None:

@@ -37,6 +37,7 @@ from fractions import Fraction
 from functools import cached_property
 from math import comb
 
+import flint
 import numpy as np
 
 from .._arrays import readonly
@@ -103,15 +104,27 @@ def _apply_cols(table, nodes) -> list[list[Fraction]]:
     return [list(lagrange_slopes(nodes, row)) for row in table]
 
 
-def _matmul(a, b):
-    return [[sum((a[i][k] * b[k][j] for k in range(len(b))), Fraction(0)) for j in range(len(b[0]))]
-            for i in range(len(a))]
+def _fmpq(v) -> flint.fmpq:
+    v = Fraction(v)
+    return flint.fmpq(v.numerator, v.denominator)
 
 
-def _to_power(origin: Fraction, width: Fraction) -> list[list[Fraction]]:
-    """``P[a][k]``: ``((x - origin) / width)**a = sum_k P[a][k] x**k``."""
-    return [[Fraction(comb(a, k)) * (-origin) ** (a - k) / width ** a if k <= a else Fraction(0)
-             for k in range(4)] for a in range(4)]
+def _frac(v: flint.fmpq) -> Fraction:
+    return Fraction(int(v.p), int(v.q))
+
+
+def _rows(mat: flint.fmpq_mat) -> tuple[tuple[Fraction, ...], ...]:
+    return tuple(tuple(_frac(mat[i, j]) for j in range(mat.ncols())) for i in range(mat.nrows()))
+
+
+def _to_power(origin: Fraction, width: Fraction) -> flint.fmpq_mat:
+    """``P[a, k]``: ``((x - origin) / width)**a = sum_k P[a, k] x**k``."""
+    return flint.fmpq_mat([[_fmpq(Fraction(comb(a, k)) * (-origin) ** (a - k) / width ** a) if k <= a else 0
+                            for k in range(4)] for a in range(4)])
+
+
+_M = flint.fmpq_mat([list(r) for r in _HERMITE])
+_THIRDS = flint.fmpq_mat([[flint.fmpq(p ** a, 3 ** a) for a in range(4)] for p in range(4)])  # [p, a] = (p/3)**a
 
 
 @dataclass(frozen=True)
@@ -163,6 +176,19 @@ class PiecewiseSurface:
 
     def local_coefficients(self, i: int, k: int) -> tuple[tuple[Fraction, ...], ...]:
         """``A[a][b]``: piece ``(i, k)`` is ``sum A[a][b] s**a t**b``, ``s, t`` the cell's coordinates on ``[0, 1]``."""
+        return _rows(self._local(i, k))
+
+    def _local(self, i: int, k: int) -> flint.fmpq_mat:
+        found = self._locals.get((i, k))
+        if found is None:
+            found = self._locals[i, k] = self._hermite(i, k)
+        return found
+
+    @cached_property
+    def _locals(self) -> dict:
+        return {}
+
+    def _hermite(self, i: int, k: int) -> flint.fmpq_mat:
         x0, x1, y0, y1 = self.box(i, k)
         hx, hy = x1 - x0, y1 - y0
         z, zx, zy, zxy = self.grid.z, self.zx, self.zy, self.zxy
@@ -170,16 +196,12 @@ class PiecewiseSurface:
         cols = (k, k + 1)
         g = [[z[r][c] for c in cols] + [hy * zy[r][c] for c in cols] for r in rows]
         g += [[hx * zx[r][c] for c in cols] + [hx * hy * zxy[r][c] for c in cols] for r in rows]
-        m = [[Fraction(v) for v in row] for row in _HERMITE]
-        mt = [list(r) for r in zip(*m)]
-        return tuple(tuple(row) for row in _matmul(_matmul(m, g), mt))
+        return _M * flint.fmpq_mat([[_fmpq(v) for v in row] for row in g]) * _M.transpose()
 
     def coefficients(self, i: int, k: int) -> tuple[tuple[Fraction, ...], ...]:
         """``C[a][b]``: piece ``(i, k)`` is ``sum C[a][b] x**a y**b`` (the order of :class:`LagrangeSurface`)."""
         x0, x1, y0, y1 = self.box(i, k)
-        px, py = _to_power(x0, x1 - x0), _to_power(y0, y1 - y0)
-        pxt = [list(r) for r in zip(*px)]
-        return tuple(tuple(row) for row in _matmul(_matmul(pxt, self.local_coefficients(i, k)), py))
+        return _rows(_to_power(x0, x1 - x0).transpose() * self._local(i, k) * _to_power(y0, y1 - y0))
 
     def piece(self, i: int, k: int) -> LagrangeSurface:
         """Piece ``(i, k)`` as the Lagrange surface through its values on a 4 x 4 grid over its cell (itself)."""
@@ -199,8 +221,8 @@ class PiecewiseSurface:
         x0, x1, y0, y1 = self.box(i, k)
         xs = [x0 + (x1 - x0) * Fraction(a, 3) for a in range(4)]
         ys = [y0 + (y1 - y0) * Fraction(b, 3) for b in range(4)]
-        g = grid_from_table(xs, ys, [[horner2(c, x, y) for y in ys] for x in xs],
-                            source=f"{self.grid.source} piece ({i}, {k})", units=self.grid.units)
+        values = _rows(_THIRDS * self._local(i, k) * _THIRDS.transpose())
+        g = grid_from_table(xs, ys, values, source=f"{self.grid.source} piece ({i}, {k})", units=self.grid.units)
         s = LagrangeSurface(g, c)
         self._pieces[(i, k)] = s
         return s
@@ -292,7 +314,7 @@ class PiecewiseEvaluator:
         self.breaks_y = readonly(np.array([float(v) for v in g.y]))
         self.bounds = (float(g.x[0]), float(g.x[-1]), float(g.y[0]), float(g.y[-1]))
         n, m = surface.shape
-        self.local = readonly(np.array([[[[float(v) for v in row] for row in surface.local_coefficients(i, k)]
+        self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
                                          for k in range(m)] for i in range(n)]))
         self._evaluators: dict = {}
 

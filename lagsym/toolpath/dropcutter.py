@@ -167,10 +167,12 @@ def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, 
     reach = radius + eps
     # The pieces' joins are where the surface's nodes are, as a polynomial's features are its nodes' spacing.
     feature = 0.5 * min(np.diff(bx).min(), np.diff(by).min())
+    scale = _piecewise_height_scale(ev)
     out = np.full(cx.shape, -np.inf)
 
     def drop(i, k, idx):
         piece, pev = ev.piece_evaluator(i, k)
+        _HEIGHT_SCALES.setdefault(pev, scale)  # one settling threshold for every piece, the whole surface's
         z = drop_cutter(piece, cx[idx], cy[idx], radius, corner=corner, lattice=lattice, starts=starts,
                         margin=False, evaluator=pev, feature=feature)
         out[idx] = np.maximum(out[idx], z)
@@ -199,7 +201,7 @@ def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, 
             near[near] = top[i, k] - cutter_profile(d2[near], radius, corner) > out[idx[near]]
             if near.any():
                 drop(i, k, idx[near])
-    span = _piecewise_height_scale(ev) + radius + 1.0
+    span = scale + radius + 1.0
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
 
