@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import re
 import math
 from fractions import Fraction
 
@@ -256,3 +257,32 @@ def test_command_line(tmp_path):
     assert main(["toolpath", str(dst), "--stepover", "4", "--step", "2", "--tool-diameter", "6", "-o", str(nc)],
                 out, err) == 0
     assert nc.read_text().startswith("%") and "cutter locations" in err.getvalue()
+
+
+def test_the_measured_data_page_quotes_the_figures(tmp_path, monkeypatch):
+    """docs/measured-data.md's piecewise figures, from the commands and from the formula the example was made from."""
+    from conftest import EXAMPLES, ROOT
+
+    from lagsym.cli import main
+    from lagsym.io import read_points
+
+    page = " ".join((ROOT / "docs" / "measured-data.md").read_text().split())
+    src = EXAMPLES / "part-20x20.csv"
+    out, err = io.StringIO(), io.StringIO()
+    main(["check", str(src)], out, err)
+    amp = re.search(r"surface amplification of data errors: (\S+) ", out.getvalue()).group(1)
+    over = re.search(r"overshoot between nodes: (\S+) \((\S+) of the data range", out.getvalue()).groups()
+    assert f"up to {amp} times" in page and f"overshoots by {over[0]} ({over[1]} of the data range)" in page
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    out, err = io.StringIO(), io.StringIO()
+    assert main(["piecewise", "examples/part-20x20.csv", "-o", "pieces.json"], out, err) == 0
+    assert "$ lagsym piecewise examples/part-20x20.csv -o pieces.json " + out.getvalue().strip() in page
+    # the pieces against the formula, on the float reference surface
+    g = read_points(src)
+    ref = reference_surface(g)
+    t = np.linspace(0, 38, 761)
+    gx, gy = np.meshgrid(t, t, indexing="ij")
+    d = ref.evaluate_grid(t, t) - (10 + 5 * np.sin(gx / 6) * np.cos(gy / 8) + 0.02 * gx * gy)
+    assert f"within {np.abs(d).max():.3f} mm of the formula" in page
+    assert f"(RMS {np.sqrt((d ** 2).mean()):.4f} mm;" in page
