@@ -63,7 +63,7 @@ def test_residuals_figure_draws_both_signs(probe_fit):
 
 
 def test_exaggeration():
-    assert residual_exaggeration([0.02, -0.01], 10.0) == 0.1 * 10.0 / 0.02
+    assert residual_exaggeration([0.02, -0.01], 10.0) == 0.25 * 10.0 / 0.02
     assert residual_exaggeration([0, 0], 10.0) == 1.0
 
 

@@ -5,7 +5,7 @@ The residual of point ``k`` is ``r_k = z_k - p(x_k, y_k)``, exact in the fit
 from the surface at ``(x_k, y_k)`` to the point; residuals of a fit to measured
 points are far smaller than the part, so the stems are drawn
 ``residual_exaggeration`` times their length (by default so that the longest
-is a tenth of the surface's height span), which the title states.  Points
+is a quarter of the surface's height span), which the title states.  Points
 above the surface are red, below it blue (the deviation colour map, centred on
 zero).
 """
@@ -28,15 +28,15 @@ SURFACE_COLOR = "lightgray"
 
 
 def residual_exaggeration(residuals, z_span: float) -> float:
-    """The factor that draws the largest residual a tenth of ``z_span`` long (1 when every residual is 0).
+    """The factor that draws the largest residual a quarter of ``z_span`` long (1 when every residual is 0).
 
     Examples
     --------
     >>> residual_exaggeration([0.02, -0.01], 10.0)
-    50.0
+    125.0
     """
     largest = float(np.abs(np.asarray(residuals, dtype=float)).max(initial=0.0))
-    return 0.1 * z_span / largest if largest > 0 and z_span > 0 else 1.0
+    return 0.25 * z_span / largest if largest > 0 and z_span > 0 else 1.0
 
 
 def residuals_figure(fit_result, *, samples: int = 61, units: str | None = None, title: str | None = None,
