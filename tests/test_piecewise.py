@@ -286,3 +286,42 @@ def test_the_measured_data_page_quotes_the_figures(tmp_path, monkeypatch):
     d = ref.evaluate_grid(t, t) - (10 + 5 * np.sin(gx / 6) * np.cos(gy / 8) + 0.02 * gx * gy)
     assert f"within {np.abs(d).max():.3f} mm of the formula" in page
     assert f"(RMS {np.sqrt((d ** 2).mean()):.4f} mm;" in page
+
+
+def brute_flat(ref, grid, cx, cy, radius, corner=0.0, n=201):
+    """Brute force for a flat end or a bull nose: the highest of the reference surface less the cutter's profile."""
+    x0, x1, y0, y1 = (float(v) for v in grid.bounds)
+    t = np.linspace(-radius, radius, n)
+    gx, gy = np.meshgrid(t, t)
+    d = np.hypot(gx, gy)
+    inside = d <= radius
+    flat = radius - corner
+    prof = np.where(d <= flat, 0.0, corner - np.sqrt(np.maximum(corner**2 - (d - flat) ** 2, 0.0)))[inside]
+    out = []
+    for a, b in zip(cx, cy):
+        px, py = a + gx[inside], b + gy[inside]
+        ok = (px >= x0) & (px <= x1) & (py >= y0) & (py <= y1)
+        out.append((ref.evaluate(px[ok], py[ok]) - prof[ok]).max())
+    return np.array(out)
+
+
+@pytest.mark.parametrize("shape, corner", [("flat", None), ("bull", 1.0)])
+def test_flat_and_bull_cutters_across_borders(shape, corner):
+    g = wavy_grid(12, 10)
+    s = piecewise_surface(g)
+    ref = reference_surface(g)
+    rng = np.random.default_rng(11)
+    cx, cy = rng.uniform(-1, 41, 12), rng.uniform(-1, 41, 12)
+    cx[:3] = [float(g.x[4]), float(g.x[7]), float(g.x[2])]
+    z = drop_cutter(s, cx, cy, 2.5, shape, corner=corner)
+    lower = brute_flat(ref, g, cx, cy, 2.5, 0.0 if corner is None else corner)
+    assert np.all(z >= lower)
+    assert np.all(z - lower < 0.03)
+
+
+def test_a_point_tool_is_the_surface():
+    g = wavy_grid(8, 6)
+    s = piecewise_surface(g)
+    z = drop_cutter(s, [float(g.x[3]), 12.5], [float(g.y[2]), 30.25], 0.0)
+    assert z[0] == float(g.z[3][2])
+    assert abs(z[1] - float(s.exact_value(Fraction(12.5), Fraction(30.25)))) < 1e-12
