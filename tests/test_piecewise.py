@@ -213,7 +213,8 @@ def test_bspline_patch_is_the_pieces():
 
 
 @pytest.mark.slow
-def test_step_read_back_by_opencascade(tmp_path):
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_cad_file_read_back_by_opencascade(tmp_path, suffix):
     pytest.importorskip("OCP")
     from test_cad_files import bspline_faces, occ_points, read_back
 
@@ -221,7 +222,7 @@ def test_step_read_back_by_opencascade(tmp_path):
     from lagsym.export.cad import write_cad
 
     s = piecewise_surface(wavy_grid(20))
-    path = tmp_path / "s.step"
+    path = tmp_path / ("s" + suffix)
     write_cad(path, piecewise_patch(s), units="mm")
     faces = bspline_faces(read_back(path))
     assert len(faces) == 1
