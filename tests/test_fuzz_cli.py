@@ -28,6 +28,7 @@ COMMANDS = {
     "curve": ["--digits"],
     "check": [],
     "fit": ["--degree", "--max-degree", "--threshold"],
+    "piecewise": [],
     "sample": ["--nx", "--ny", "--step", "--x0", "--max-points"],
     "compare": ["--samples", "--degree", "--tolerance"],
     "toolpath": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--spindle", "--safe-z",

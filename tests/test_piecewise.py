@@ -326,3 +326,20 @@ def test_a_point_tool_is_the_surface():
     z = drop_cutter(s, [float(g.x[3]), 12.5], [float(g.y[2]), 30.25], 0.0)
     assert z[0] == float(g.z[3][2])
     assert abs(z[1] - float(s.exact_value(Fraction(12.5), Fraction(30.25)))) < 1e-12
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"x": 3}, '"x" should be a list'),
+    ({"z": [1, 2]}, '"z" should be a list of rows'),
+    ({"y": ["0", "1e999999", "2"]}, "y\\[1\\]: '1e999999' is out of range"),
+    ({"version": 2}, "version 2 is not 1"),
+    ({"units": "furlong"}, "units"),
+])
+def test_bad_files_are_refused_in_one_line(change, message):
+    buf = io.StringIO()
+    write_piecewise_json(buf, piecewise_surface(wavy_grid(4, 3)))
+    doc = __import__("json").loads(buf.getvalue())
+    doc.update(change)
+    with pytest.raises(InputError, match=message) as e:
+        parse_piecewise_json(__import__("json").dumps(doc), "bad.json")
+    assert "\n" not in str(e.value)

@@ -20,12 +20,12 @@ that do not join.
 from __future__ import annotations
 
 import json
-from fractions import Fraction
 from typing import IO
 
 from ..errors import InputError
 from ..grid import grid_from_table
 from ..surfaces.piecewise import CONTINUITY, PiecewiseSurface, piecewise_surface
+from ..values import as_exact
 
 __all__ = ["FORMAT", "piecewise_document", "write_piecewise_json", "parse_piecewise_json"]
 
@@ -81,12 +81,20 @@ def piecewise_from_document(doc, source: str = "<piecewise>") -> PiecewiseSurfac
         raise InputError(f"{source}: not a {FORMAT} file")
     if doc.get("version") != 1:
         raise InputError(f"{source}: {FORMAT} version {doc.get('version')!r} is not 1")
-    try:
-        xs = [Fraction(v) for v in doc["x"]]
-        ys = [Fraction(v) for v in doc["y"]]
-        tables = {k: [[Fraction(v) for v in row] for row in doc[k]] for k in ("z", "zx", "zy", "zxy")}
-    except (KeyError, TypeError, ValueError, ZeroDivisionError) as e:
-        raise InputError(f"{source}: not a valid {FORMAT} file ({type(e).__name__}: {e})") from None
+    def numbers(key):
+        value = doc.get(key)
+        if not isinstance(value, list) or not value:
+            raise InputError(f"{source}: \"{key}\" should be a list, found {type(value).__name__}")
+        return value
+
+    xs = [as_exact(v, f"{source}: x[{i}]") for i, v in enumerate(numbers("x"))]
+    ys = [as_exact(v, f"{source}: y[{i}]") for i, v in enumerate(numbers("y"))]
+    tables = {}
+    for key in ("z", "zx", "zy", "zxy"):
+        rows = numbers(key)
+        if not all(isinstance(r, list) for r in rows):
+            raise InputError(f"{source}: \"{key}\" should be a list of rows of numbers")
+        tables[key] = [[as_exact(v, f"{source}: {key}[{i}][{k}]") for k, v in enumerate(r)] for i, r in enumerate(rows)]
     units = doc.get("units")
     if units is not None and units not in ("mm", "inch"):
         raise InputError(f"{source}: \"units\": {units!r} is not one of mm, inch")
