@@ -149,12 +149,11 @@ def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, 
     The box is the union of the cells, so the maximum over the disc and the
     box is the largest of the maxima over the disc and each cell; each is
     drop-cutter on the piece (a polynomial) restricted to its own cell, with
-    the same search and lattice as on one polynomial.  A piece is searched
-    only where it could rise above the contacts found: each position takes
-    its pieces in order of a bound no contact on them exceeds (the highest of
-    a piece's Bezier control points less the cutter's profile at the nearest
-    point of its cell), highest first, and stops at the first bound no
-    higher than the height found.  The margin is
+    the same search and lattice as on one polynomial.  The piece under the
+    tool axis is dropped on first; another piece is searched only where it
+    could rise above that: where the highest of its Bezier control points
+    less the cutter's profile at the nearest point of its cell (a bound no
+    contact on it exceeds) is above the height found.  The margin is
     :data:`CL_MARGIN` of the largest height scale of any piece, the same at
     every position.
     """
@@ -178,45 +177,30 @@ def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, 
                         margin=False, evaluator=pev, feature=feature)
         out[idx] = np.maximum(out[idx], z)
 
-    # Every piece within reach of each position, with the bound no contact on it exceeds.
+    home_i, home_k, *_ = ev.locate(cx, cy)
+    home = home_i * (len(by) - 1) + home_k
+    order = np.argsort(home, kind="stable")
+    cuts = np.flatnonzero(np.diff(home[order])) + 1
+    for group in np.split(order, cuts):
+        if group.size:
+            drop(int(home_i[group[0]]), int(home_k[group[0]]), group)
     top = ev.upper_heights + eps
-    pos, ids, bound = [], [], []
-    order = np.argsort(cx, kind="stable")  # positions sorted by x: those a column of cells reaches are one slice
+    # Positions sorted by x: the ones a column of cells can reach are one slice.
+    order = np.argsort(cx, kind="stable")
     sx, sy = cx[order], cy[order]
-    m = len(by) - 1
     for i in range(len(bx) - 1):
         a, b = np.searchsorted(sx, bx[i] - reach, "left"), np.searchsorted(sx, bx[i + 1] + reach, "right")
         if a == b:
             continue
         px, py, idx = sx[a:b], sy[a:b], order[a:b]
-        for k in range(m):
+        for k in range(len(by) - 1):
             d2 = (px - np.clip(px, bx[i], bx[i + 1])) ** 2 + (py - np.clip(py, by[k], by[k + 1])) ** 2
-            near = d2 <= reach * reach
+            near = (d2 <= reach * reach) & ((home_i[idx] != i) | (home_k[idx] != k))
+            if not near.any():
+                continue
+            near[near] = top[i, k] - cutter_profile(d2[near], radius, corner) > out[idx[near]]
             if near.any():
-                pos.append(idx[near])
-                ids.append(np.full(int(near.sum()), i * m + k))
-                bound.append(top[i, k] - cutter_profile(d2[near], radius, corner))
-    pos, ids, bound = np.concatenate(pos), np.concatenate(ids), np.concatenate(bound)
-    # Each position's pieces from the highest bound down, one round at a time: a position is done when its
-    # next bound is no higher than the contact found, and every later one is lower still.
-    order = np.lexsort((-bound, pos))
-    pos, ids, bound = pos[order], ids[order], bound[order]
-    first = np.searchsorted(pos, np.arange(cx.size), "left")
-    last = np.searchsorted(pos, np.arange(cx.size), "right")
-    at = first.copy()
-    live = np.flatnonzero(at < last)
-    while live.size:
-        j = at[live]
-        live, j = live[bound[j] > out[live]], j[bound[j] > out[live]]
-        if not live.size:
-            break
-        piece = ids[j]
-        group = np.argsort(piece, kind="stable")
-        cuts = np.flatnonzero(np.diff(piece[group])) + 1
-        for g in np.split(group, cuts):
-            drop(int(piece[g[0]]) // m, int(piece[g[0]]) % m, live[g])
-        at[live] += 1
-        live = live[at[live] < last[live]]
+                drop(i, k, idx[near])
     span = scale + radius + 1.0
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
 
