@@ -229,13 +229,14 @@ def require_conditioning(surface, *, accept: bool = False, limit: float = AMPLIF
     ConditioningError
         Naming the figure, where it is largest and the ways out: a
         least-squares fit (``lagsym fit``), fewer or Chebyshev-spaced nodes,
-        or ``--accept-conditioning``.
+        smooth pieces (``lagsym piecewise``), or ``--accept-conditioning``.
     """
     a = amplification(surface, limit)
     if a.exceeds and not accept:
         g = surface if isinstance(surface, ControlGrid) else surface.grid
         way = ("fit them at lower degrees (lagsym fit POINTS --degree auto)" if a.fitted else
-               f"fit the points instead (lagsym fit {g.source} -o surface.json), use fewer or Chebyshev-spaced nodes")
+               f"fit the points instead (lagsym fit {g.source} -o surface.json), use fewer or Chebyshev-spaced nodes, "
+               f"join exact points by smooth pieces (lagsym piecewise {g.source} -o pieces.json)")
         raise ConditioningError(
             f"{g.source}: {a.text()}, above lagsym's limit of {limit:g}: 0.01 of measurement noise could move "
             f"the surface by {0.01 * a.value:.3g}; {way}, or give --accept-conditioning to use it as it is")
@@ -299,7 +300,7 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
                  f"surface amplification of data errors: {amp.value:.4g} (the product of the two, worst near "
                  f"(x, y) = ({amp.at[0]:.4g}, {amp.at[1]:.4g}))")
                 + (f": above {AMPLIFICATION_LIMIT:g}, so toolpath, rough, job, macro, export and sample refuse it "
-                   f"without --accept-conditioning; for measured points use 'lagsym fit'"
+                   f"without --accept-conditioning; for measured points use 'lagsym fit', for a large grid of exact points 'lagsym piecewise'"
                    if amp.exceeds else f" (limit {AMPLIFICATION_LIMIT:g})"))
     )
     xs = np.linspace(g.x_array[0], g.x_array[-1], dx * samples_per_interval + 1)

@@ -31,6 +31,7 @@ COMMANDS = {
               "--program-number", "--degree", "--nodes", "--box"],
     "read-probe": ["--degree"],
     "fit": ["--degree", "--max-degree", "--threshold"],
+    "piecewise": [],
     "sample": ["--nx", "--ny", "--step", "--x0", "--max-points"],
     "compare": ["--samples", "--degree", "--tolerance"],
     "toolpath": ["--scale", "--step", "--stepover", "--tool-diameter", "--feed", "--spindle", "--safe-z",

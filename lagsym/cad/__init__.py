@@ -6,7 +6,8 @@ volume above a base.  File formats are in :mod:`lagsym.export.step`,
 :mod:`lagsym.export.iges` and :mod:`lagsym.export.patchjson`.
 """
 
-from .convert import KERNEL_MAX_DEGREE, METHODS, bernstein_transform, bezier_patch, cad_patch, double_error_bound
+from .convert import (KERNEL_MAX_DEGREE, METHODS, bernstein_transform, bezier_patch, cad_patch, double_error_bound,
+                      piecewise_patch)
 from .patch import BezierPatch, BSplinePatch, de_casteljau, insert_knot, split_half
 from .solid import HeightBounds, check_base, exact_height, lowest_height, polynomial_volume, volume
 
@@ -25,6 +26,7 @@ __all__ = [
     "exact_height",
     "insert_knot",
     "lowest_height",
+    "piecewise_patch",
     "polynomial_volume",
     "split_half",
     "volume",

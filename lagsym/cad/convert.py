@@ -30,7 +30,8 @@ from ..errors import InputError
 from ..lagrange import LagrangeSurface, lagrange_surface
 from .patch import BezierPatch, BSplinePatch
 
-__all__ = ["METHODS", "KERNEL_MAX_DEGREE", "bernstein_transform", "bezier_patch", "cad_patch", "double_error_bound"]
+__all__ = ["METHODS", "KERNEL_MAX_DEGREE", "bernstein_transform", "bezier_patch", "cad_patch", "double_error_bound",
+           "piecewise_patch"]
 
 METHODS = ("lagrange", "bezier", "bspline")
 KERNEL_MAX_DEGREE = 25  # OpenCascade's Geom_BSplineSurface::MaxDegree(); several CAD kernels stop there too
@@ -145,3 +146,43 @@ def double_error_bound(patch: BSplinePatch, data_range) -> float:
     """
     largest = max(abs(float(p[2])) for row in patch.control_points for p in row)
     return (1 + patch.degree_u + patch.degree_v) * 2.0**-53 * largest / (float(data_range) or 1.0)
+
+
+def piecewise_patch(surface) -> BSplinePatch:
+    """A piecewise surface (:mod:`lagsym.surfaces.piecewise`) as one bicubic B-spline with its knots at the borders.
+
+    Every interior node is a double knot (multiplicity 2 in degree 3: C1, as
+    the pieces join), so one span is one piece and its Bezier net is the
+    piece's: the net holds each piece's inner control points, and the points
+    on a border, which the C1 join puts on the line between their
+    neighbours, are left out, as knot removal leaves them.  The parameters
+    ``(u, v)`` are ``(x, y)``.
+
+    Examples
+    --------
+    >>> from lagsym.grid import grid_from_table
+    >>> from lagsym.surfaces.piecewise import piecewise_surface
+    >>> g = grid_from_table([0, 1, 2, 3], [0, 1, 2], [[x * x + y for y in range(3)] for x in range(4)])
+    >>> p = piecewise_patch(piecewise_surface(g))
+    >>> [str(k) for k in p.knots_u], p.shape
+    (['0', '0', '0', '0', '1', '1', '2', '2', '3', '3', '3', '3'], (8, 6))
+    """
+    g = surface.grid
+    n, m = surface.shape
+    w = [[Fraction(comb(j, a), comb(3, a)) if a <= j else Fraction(0) for a in range(4)] for j in range(4)]
+
+    def spans(count):  # net index -> (piece, Bezier index): b0 of the first, b1 b2 of each, b3 of the last
+        return [(0, 0)] + [(i, j) for i in range(count) for j in (1, 2)] + [(count - 1, 3)]
+
+    nets = {}
+    for i in range(n):
+        for k in range(m):
+            a = surface.local_coefficients(i, k)
+            nets[i, k] = [[sum((w[j][p] * a[p][q] * w[l][q] for p in range(4) for q in range(4)), Fraction(0))
+                           for l in range(4)] for j in range(4)]
+    su, sv = spans(n), spans(m)
+    net = tuple(tuple((g.x[i] + (g.x[i + 1] - g.x[i]) * Fraction(j, 3), g.y[k] + (g.y[k + 1] - g.y[k]) * Fraction(l, 3),
+                       nets[i, k][j][l]) for k, l in sv) for i, j in su)
+    knots_u = (g.x[0],) * 4 + tuple(v for v in g.x[1:-1] for _ in (0, 1)) + (g.x[-1],) * 4
+    knots_v = (g.y[0],) * 4 + tuple(v for v in g.y[1:-1] for _ in (0, 1)) + (g.y[-1],) * 4
+    return BSplinePatch("Piecewise", 3, 3, knots_u, knots_v, net)

@@ -60,6 +60,7 @@ COMMANDS = {
     "probe": "write a probing program: measure the part on the machine at Chebyshev-spaced nodes",
     "read-probe": "read a probing program's results (DPRNT text, LinuxCNC log) into surface points",
     "fit": "fit an exact least-squares polynomial surface to measured points (a grid or scattered) and write it",
+    "piecewise": "build exact C1 bicubic pieces through a grid too large for one polynomial and write them",
     "check": "measure degree, spacing ratio, Lebesgue constants, amplification of data errors and overshoot",
     "sample": "sample the surface densely and write the points (CSV, NumPy) or a mesh (VTK, STL, PLY, OBJ)",
     "export": "write the exact surface as a CAD file: STEP or IGES B-spline surface or solid, exact JSON",

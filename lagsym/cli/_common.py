@@ -61,6 +61,21 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
     return f.points
 
 
+def read_piecewise(path: str):
+    """The surface of ``path`` when it is a ``lagsym-piecewise`` file, else None (a points file)."""
+    from ..io import read_text
+
+    if str(path) == "-":  # standard input is read once, as points
+        return None
+    name, text = read_text(path)
+    head = text.lstrip()[:400]
+    if not head.startswith("{") or '"lagsym-piecewise"' not in head:
+        return None
+    from ..export.piecewisejson import parse_piecewise_json
+
+    return parse_piecewise_json(text, name)
+
+
 ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points more than lagsym's limit "
                             "(see 'lagsym check'); the program header records it")
 

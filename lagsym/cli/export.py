@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
-from ..cad import KERNEL_MAX_DEGREE, METHODS, cad_patch, double_error_bound, exact_height, lowest_height, volume
+from ..cad import (KERNEL_MAX_DEGREE, METHODS, cad_patch, double_error_bound, exact_height, lowest_height,
+                   piecewise_patch, volume)
 from ..conditioning import FLOAT_ERROR_LIMIT
 from ..errors import InputError
 from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ._common import add_conditioning_argument, conditioning_notes, count
+from ._common import add_conditioning_argument, conditioning_notes, count, read_piecewise
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
 control points' box, stored as a clamped single-span B-spline (parameters u, v
 are x, y).  --method bezier or bspline writes a comparison surface instead.
+A piecewise surface ('lagsym piecewise') is written as one bicubic B-spline
+with a double knot at every border between pieces (C1, as the pieces join).
 
 Format by the extension of -o: {', '.join(CAD_FORMATS)}.  STEP (AP214) holds a
 B_SPLINE_SURFACE_WITH_KNOTS face; IGES an entity 128; JSON the exact rational
@@ -36,7 +39,7 @@ examples:
 
 
 def add_arguments(p) -> None:
-    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", required=True,
                    help=f"output file, format by extension: {', '.join(CAD_FORMATS)}")
@@ -58,13 +61,21 @@ def run(args, out, err) -> int:
     if args.degree is not None and args.method != "bspline":
         raise InputError(f"--degree {args.degree} is the degree of --method bspline; the {args.method} surface has "
                          "the degrees of its control points")
-    grid = read_points(args.file)
+    piecewise = read_piecewise(args.file)
+    if piecewise is not None and args.method != "lagrange":
+        raise InputError(f"--method {args.method} builds a surface from points; {args.file} holds a piecewise "
+                         "surface already: leave --method out")
+    grid = read_points(args.file) if piecewise is None else piecewise.grid
     units = grid.units or args.units or "mm"
     if args.units and units != args.units:
         raise InputError(f"{args.file}: the file states \"units\": \"{units}\", not --units {args.units}")
-    if args.method == "lagrange":  # the other methods do not interpolate, so do not amplify the points' errors
-        conditioning_notes(grid, args, err)
-    patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method, degree=args.degree or 3)
+    if piecewise is not None:  # local pieces amplify the points' errors little: no guard rail
+        patch = piecewise_patch(piecewise)
+    else:
+        if args.method == "lagrange":  # the other methods do not interpolate, so do not amplify the points' errors
+            conditioning_notes(grid, args, err)
+        patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method,
+                          degree=args.degree or 3)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
     lo, hi = grid.z_range()
     rel = double_error_bound(patch, hi - lo)

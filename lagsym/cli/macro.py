@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from ..errors import InputError
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
@@ -11,7 +12,7 @@ from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_p
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
 from ..macro.program import MAX_MACRO_POINTS
-from ._common import (add_conditioning_argument, conditioning_notes, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -90,6 +91,12 @@ def settings_from(args, grid) -> tuple[MachineSettings, RasterSpec, Tool]:
 
 
 def run(args, out, err) -> int:
+    piecewise = read_piecewise(args.file)
+    if piecewise is not None:
+        a, b = piecewise.shape
+        raise InputError(f"{args.file}: a macro evaluates one polynomial on the control, and this piecewise surface "
+                         f"has {a * b} pieces, which the control would have to pick between at every point: lagsym "
+                         f"writes no such program; use 'lagsym toolpath {args.file}' (a point list)")
     surface = lagrange_surface(read_points(args.file))
     notes = conditioning_notes(surface.grid, args, err)
     settings, raster, tool = settings_from(args, surface.grid)

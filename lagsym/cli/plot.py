@@ -23,7 +23,10 @@ the degrees 2, 4, ..., 12 (the paper's Figure 11: past degree 6 it grows);
 with --show machined PROGRAM, FILE being a job file (TOML), the block after
 each tool of the job's PROGRAM, simulated as lagsym verify --job does and
 coloured by the material left above the surface (the counterpart of the
-paper's photographs, Figures 13 and 15).
+paper's photographs, Figures 13 and 15); with --show residuals, FILE being
+measured points (a grid or scattered), the least-squares surface 'lagsym fit'
+chooses (automatic degree) and every point on a stem from it, coloured by its
+residual z - p(x, y) (stems drawn longer, as the title says).
 Deviations are d = z_f - z_a everywhere, as lagsym compare prints them.
 A file of [x, y] points draws the curve through them (and, with --show basis,
 its basis polynomials L_i(x)).
@@ -42,9 +45,10 @@ examples:
   lagsym plot examples/paper-example-4.json --show toolpath rough.nc --scale 20 -o toolpath.png
   lagsym plot examples/parabola.json --show growth "1/(1 + ((x-20)**2 + (y-20)**2)/25)" -o growth.png
   lagsym job examples/example-4-job.toml -o job.ngc
-  lagsym plot examples/example-4-job.toml --show machined job.ngc --cell 0.5 -o machined.png"""
+  lagsym plot examples/example-4-job.toml --show machined job.ngc --cell 0.5 -o machined.png
+  lagsym plot --show residuals examples/probe-12x12.csv -o residuals.png"""
 
-SHOW = ("surface", "basis", "compare", "toolpath", "growth", "machined")
+SHOW = ("surface", "basis", "compare", "toolpath", "growth", "machined", "residuals")
 TAKES_A_WORD = {"toolpath": "PROGRAM", "growth": "FORMULA", "machined": "PROGRAM"}
 
 
@@ -59,8 +63,8 @@ def add_arguments(p) -> None:
     # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
-                   help="surface (default), basis, compare, 'toolpath PROGRAM', 'growth FORMULA' or "
-                        "'machined PROGRAM' (FILE a job file)")
+                   help="surface (default), basis, compare, 'toolpath PROGRAM', 'growth FORMULA', "
+                        "'machined PROGRAM' (FILE a job file) or residuals (FILE measured points)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
     p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
@@ -119,6 +123,13 @@ def run(args, out, err) -> int:
         return 0
     if args.cell is not None:
         raise InputError("--cell is the height-map cell of --show machined PROGRAM")
+    if what == "residuals":
+        figure = _residuals_figure(plot, file, args)
+        if args.output:
+            plot.save_figure(figure, args.output)
+        else:
+            figure.show(title=f"lagsym plot {file}")
+        return 0
     points = read_any_points(file)
     _check_options(what, isinstance(points, CurvePoints), args)
     units = args.units or getattr(points, "units", None) or "mm"  # the points file's units unless told
@@ -192,6 +203,25 @@ def _machined_figure(plot, job_file, program, args):
     if args.z_exaggeration is not None:
         opts["z_exaggeration"] = args.z_exaggeration
     return plot.machined_figure(part, **opts)
+
+
+def _residuals_figure(plot, file, args):
+    """The least-squares surface of measured points (automatic degree) and its residuals as coloured stems."""
+    from ..fit import fit_surface
+    from ..io import read_scattered_points
+
+    for option in ("scale", "origin"):
+        if getattr(args, option) is not None:
+            raise InputError(f"--{option} places a program on the machine: it goes with --show toolpath PROGRAM")
+    data = read_scattered_points(file)
+    fitted = fit_surface(data.points, None, source=data.source, units=data.units)
+    opts = dict(units=args.units or data.units or "mm", window_size=args.size,
+                off_screen=True if args.output else None)
+    if args.samples is not None:
+        opts["samples"] = args.samples
+    if args.z_exaggeration is not None:
+        opts["z_exaggeration"] = args.z_exaggeration
+    return plot.residuals_figure(fitted, **opts)
 
 
 def _control_points(grid):

@@ -12,12 +12,14 @@ from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 
-from ._common import (add_conditioning_argument, conditioning_notes, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+from ._common import (add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._progress import progress_bar
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
-FILE and write it as a point-list G-code program.  Cutter locations come from
+FILE and write it as a point-list G-code program.  FILE may also hold a
+piecewise surface ('lagsym piecewise'): the tool is dropped on every piece
+within its reach, so it rests on the pieces across their borders too.  Cutter locations come from
 drop-cutter against the exact surface, so the tool never cuts below it, also
 where the surface is more concave than the tool.  The programmed point is the
 tool tip; the tool stays down between rows.
@@ -34,7 +36,8 @@ POINT_DIALECTS = names(point_lists=True)
 
 
 def add_arguments(p) -> None:
-    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z, a 'lagsym fit' surface or a "
+                                "'lagsym piecewise' surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=POINT_DIALECTS, default="fanuc",
@@ -92,15 +95,20 @@ def settings_from(args, dialect: str, grid) -> MachineSettings:
 def run(args, out, err) -> int:
     from ..toolpath import plan_toolpath
 
-    grid = read_points(args.file)
-    notes = conditioning_notes(grid, args, err)
+    piecewise = read_piecewise(args.file)
+    if piecewise is not None:  # local pieces: each point moves the surface near it only, so no guard rail
+        grid, surface, notes = piecewise.grid, piecewise, ()
+    else:
+        grid = read_points(args.file)
+        notes = conditioning_notes(grid, args, err)
+        surface = lagrange_surface(grid)
     settings = replace(settings_from(args, args.dialect, grid), notes=notes)
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary, args.arcs)
     with progress_bar(err) as progress:
-        tp = plan_toolpath(lagrange_surface(grid), tool, raster, settings.placement, settings.program,
+        tp = plan_toolpath(surface, tool, raster, settings.placement, settings.program,
                            max_points=args.max_points, stock_to_leave_mm=settings.stock_to_leave_mm, progress=progress)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))

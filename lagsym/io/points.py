@@ -79,6 +79,7 @@ def _short(v: Any) -> str:
 
 TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".xyz", ".dat", ".asc")
 SURFACE_FORMAT = "lagsym-surface"
+PIECEWISE_FORMAT = "lagsym-piecewise"  # read by :mod:`lagsym.export.piecewisejson`, refused here
 _INTEGER_RATIO = re.compile(r"^[+-]?\d+(/\d+)?$")
 _SURFACE_DIGITS = 1_000_000  # an exact fit's coefficients run to thousands of digits; a million is no coefficient
 
@@ -237,6 +238,10 @@ def _json_points(name: str, text: str, arity: int | None):
     units = _units(name, data)
     if isinstance(data, dict):
         if "format" in data:
+            if data["format"] == PIECEWISE_FORMAT:
+                raise InputError(f"{name}: a {PIECEWISE_FORMAT} file holds many polynomial pieces; this command needs "
+                                 f"one polynomial (toolpath and export take pieces): give it the points, or a "
+                                 f"'lagsym fit' surface")
             if arity == 2:
                 raise InputError(f"{name}: a {data['format']!r} file holds a surface, not curve points")
             return surface_file(name, data), 3, f"{SURFACE_FORMAT} file", units

@@ -27,6 +27,7 @@ The modules, one concern each:
 - :mod:`~lagsym.plot.compare`: methods side by side, and deviation maps;
 - :mod:`~lagsym.plot.growth`: the deviation against the degree (Figure 11);
 - :mod:`~lagsym.plot.toolpath`: a cutter path over its surface;
+- :mod:`~lagsym.plot.residuals`: a fitted surface and its residuals;
 - :mod:`~lagsym.plot.machined`: the block after each stage of a job, coloured
   by the material left;
 - :mod:`~lagsym.plot.output`: image formats and writing images;
@@ -45,6 +46,7 @@ from .growth import DegreeGrowth, degree_growth, growth_figure
 from .machined import machined_figure
 from .output import IMAGE_FORMATS, deviation_map, image_format, save_figure
 from .style import BASIS_CMAP, DEVIATION_CMAP, FEED_COLOR, NET_COLOR, POINT_COLOR, RAPID_COLOR, SURFACE_CMAP
+from .residuals import residuals_figure
 from .surface import basis_figure, curve_basis_figure, curve_figure, surface_figure
 from .toolpath import toolpath_figure
 
@@ -55,6 +57,7 @@ __all__ = [
     "compare_figure",
     "toolpath_figure",
     "machined_figure",
+    "residuals_figure",
     "deviation_figure",
     "deviation_map",
     "curve_basis_figure",

@@ -39,15 +39,16 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial import chebyshev as C
 
-from ..cutter import corner_radius
+from ..cutter import corner_radius, cutter_profile
 from ..errors import ToolpathError
-from ..progress import COMPILING, Progress
 from ..evaluate import SurfaceEvaluator, surface_evaluator
+from ..progress import COMPILING, Progress
+from ..surfaces.piecewise import PiecewiseEvaluator, PiecewiseSurface
 from ..values import positive
 from .newton import jet_coefficients, kernel_geometry
 from .workers import Workers
 
-__all__ = ["CL_MARGIN", "drop_cutter", "telling_compiles"]
+__all__ = ["CL_MARGIN", "drop_cutter", "evaluator_of", "telling_compiles"]
 
 CL_MARGIN = 1e-7
 """Relative margin (of the surface's height span plus tool radius) added to every drop-cutter value."""
@@ -57,7 +58,7 @@ _CHUNK = 1 << 12  # positions per call of the kernel, and per worker's task
 
 def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corner: float | None = None,
                 lattice: int = 8, starts: int = 3, margin: bool = True, evaluator: SurfaceEvaluator | None = None,
-                workers: Workers | None = None) -> np.ndarray:
+                workers: Workers | None = None, feature: float | None = None) -> np.ndarray:
     """Tool-tip heights of a cutter dropped onto the exact surface at ``(x, y)``.
 
     Parameters
@@ -90,6 +91,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     workers : Workers, optional
         Worker processes for this evaluator (:mod:`.workers`) that share the
         positions out in chunks; the values are the same as without.
+    feature : float, optional
+        The smallest feature the lattice resolves (spacing at most half of it): by default the box over
+        twice the degree; on a piecewise surface, half its narrowest cell.
 
     Returns
     -------
@@ -107,7 +111,9 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     """
     radius = positive(radius, "tool radius", allow_zero=True)
     corner = corner_radius(shape, radius, corner)
-    ev = evaluator or surface_evaluator(surface)
+    ev = evaluator or evaluator_of(surface)
+    if isinstance(ev, PiecewiseEvaluator):
+        return _drop_piecewise(ev, x, y, radius, corner, lattice=lattice, starts=starts, margin=margin)
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
     box = ev.bounds
@@ -115,10 +121,10 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     if radius == 0:
         return ev.fast_points(cx, cy).reshape(shape_out)
     x0, x1, y0, y1 = box
-    deg = max(*ev.shape, 2)
-    feature = min(x1 - x0, y1 - y0) / (2 * deg)
-    spacing = min(radius / lattice, feature / 2)
-    spacing = max(spacing, radius / 40)  # bounded work for a tool far larger than the box
+    if feature is None:
+        deg = max(*ev.shape, 2)
+        feature = min(x1 - x0, y1 - y0) / (2 * deg)
+    spacing = max(min(radius / lattice, feature / 2), radius / 40)  # bounded work for a tool far larger than the box
     lattice_ = _lattice(radius, spacing)
     span = _height_scale(ev) + radius + 1.0
     parallel = workers is not None and workers.parallel and workers.evaluator is ev
@@ -129,6 +135,84 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     parts = workers.map(_drop_chunk, tasks) if parallel else [_drop_chunk(ev, *t) for t in tasks]
     out = np.concatenate(parts) if parts else np.empty(0)
     return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+def evaluator_of(surface):
+    """The numeric evaluator drop-cutter and the planner use: a piecewise surface's own, else the polynomial's."""
+    if isinstance(surface, PiecewiseSurface):
+        return surface.evaluator
+    return surface_evaluator(surface)
+
+
+def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, *, lattice: int, starts: int,
+                    margin: bool) -> np.ndarray:
+    """Drop-cutter on a piecewise surface: the highest of the drops onto every piece within the tool's reach.
+
+    The box is the union of the cells, so the maximum over the disc and the
+    box is the largest of the maxima over the disc and each cell; each is
+    drop-cutter on the piece (a polynomial) restricted to its own cell, with
+    the same search and lattice as on one polynomial.  The piece under the
+    tool axis is dropped on first; another piece is searched only where it
+    could rise above that: where the highest of its Bezier control points
+    less the cutter's profile at the nearest point of its cell (a bound no
+    contact on it exceeds) is above the height found.  The margin is
+    :data:`CL_MARGIN` of the largest height scale of any piece, the same at
+    every position.
+    """
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    shape_out = x.shape
+    cx, cy = _inside_box(x.ravel(), y.ravel(), ev.bounds, radius)
+    if radius == 0:
+        return ev.fast_points(cx, cy).reshape(shape_out)
+    bx, by = ev.breaks_x, ev.breaks_y
+    eps = 1e-9 * max(bx[-1] - bx[0], by[-1] - by[0], radius)
+    reach = radius + eps
+    # The pieces' joins are where the surface's nodes are, as a polynomial's features are its nodes' spacing.
+    feature = 0.5 * min(np.diff(bx).min(), np.diff(by).min())
+    scale = _piecewise_height_scale(ev)
+    out = np.full(cx.shape, -np.inf)
+
+    def drop(i, k, idx):
+        piece, pev = ev.piece_evaluator(i, k)
+        _HEIGHT_SCALES.setdefault(pev, scale)  # one settling threshold for every piece, the whole surface's
+        z = drop_cutter(piece, cx[idx], cy[idx], radius, corner=corner, lattice=lattice, starts=starts,
+                        margin=False, evaluator=pev, feature=feature)
+        out[idx] = np.maximum(out[idx], z)
+
+    home_i, home_k, *_ = ev.locate(cx, cy)
+    home = home_i * (len(by) - 1) + home_k
+    order = np.argsort(home, kind="stable")
+    cuts = np.flatnonzero(np.diff(home[order])) + 1
+    for group in np.split(order, cuts):
+        if group.size:
+            drop(int(home_i[group[0]]), int(home_k[group[0]]), group)
+    top = ev.upper_heights + eps
+    # Positions sorted by x: the ones a column of cells can reach are one slice.
+    order = np.argsort(cx, kind="stable")
+    sx, sy = cx[order], cy[order]
+    for i in range(len(bx) - 1):
+        a, b = np.searchsorted(sx, bx[i] - reach, "left"), np.searchsorted(sx, bx[i + 1] + reach, "right")
+        if a == b:
+            continue
+        px, py, idx = sx[a:b], sy[a:b], order[a:b]
+        for k in range(len(by) - 1):
+            d2 = (px - np.clip(px, bx[i], bx[i + 1])) ** 2 + (py - np.clip(py, by[k], by[k + 1])) ** 2
+            near = (d2 <= reach * reach) & ((home_i[idx] != i) | (home_k[idx] != k))
+            if not near.any():
+                continue
+            near[near] = top[i, k] - cutter_profile(d2[near], radius, corner) > out[idx[near]]
+            if near.any():
+                drop(i, k, idx[near])
+    span = scale + radius + 1.0
+    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+def _piecewise_height_scale(ev: PiecewiseEvaluator) -> float:
+    found = _HEIGHT_SCALES.get(ev)
+    if found is None:
+        # Each piece's power-basis spread on its normalized cell, as for one polynomial.
+        found = _HEIGHT_SCALES[ev] = float(np.ptp(ev.local, axis=(2, 3)).max())
+    return found
 
 
 def _inside_box(cx, cy, box, radius=0.0):
@@ -153,7 +237,7 @@ def _inside_box(cx, cy, box, radius=0.0):
     return nx + (cx - nx) * f, ny + (cy - ny) * f
 
 
-_HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator, float] = weakref.WeakKeyDictionary()
+_HEIGHT_SCALES: weakref.WeakKeyDictionary[SurfaceEvaluator | PiecewiseEvaluator, float] = weakref.WeakKeyDictionary()
 
 
 def _height_scale(ev: SurfaceEvaluator) -> float:

@@ -16,13 +16,14 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ToolpathError
-from ..evaluate import SurfaceEvaluator, surface_evaluator
+from ..evaluate import SurfaceEvaluator
 from ..machine import Placement, ProgramFormat, RasterSpec, Tool
 from ..progress import Progress, Tally
+from ..surfaces.piecewise import PiecewiseEvaluator
 from ..values import positive
 from . import chordal
 from .arcs import Arcs, fit_arcs
-from .dropcutter import drop_cutter, telling_compiles
+from .dropcutter import drop_cutter, evaluator_of, telling_compiles
 from .filter import filter_rows
 from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
                       tool_reach, within_reach)
@@ -113,8 +114,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
 
     Parameters
     ----------
-    surface : LagrangeSurface
-        The exact surface; lengths in its units become mm by ``placement.mm_per_unit``.
+    surface : LagrangeSurface or PiecewiseSurface
+        The exact surface, one polynomial or C1 pieces (:mod:`lagsym.surfaces.piecewise`); lengths in its
+        units become mm by ``placement.mm_per_unit``.
     tool : Cutter
         Cutter shape and diameter (mm).
     raster : RasterSpec
@@ -149,7 +151,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     >>> bool((tp.points_mm[:, 2] == 1.0).all()), tp.rows.tolist()
     (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
     """
-    ev = evaluator or surface_evaluator(surface)
+    ev = evaluator or evaluator_of(surface)
     stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
     mm_per_unit = placement.mm_per_unit
     tol = raster.chordal_tolerance_mm
@@ -167,7 +169,9 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     with telling_compiles(progress):
         cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
     # Worker processes on the other cores, where the plan is large enough to pay for starting them.
-    with Workers(ev, None if len(levels) * len(along) >= MIN_POINTS else 1) as workers:
+    # A piecewise surface's drops run piece by piece in this process (the pieces' evaluators are made as reached).
+    one = isinstance(ev, PiecewiseEvaluator) or len(levels) * len(along) < MIN_POINTS
+    with Workers(ev, 1 if one else None) as workers:
         cl = replace(cl, workers=workers)
         path = _fine_path(cl, levels, along, raster.direction, fine, past=past, progress=progress)
         tp = _checked(ev, cl, path, tol, raster, kappa=kappa, every=every, placement=placement, progress=progress)

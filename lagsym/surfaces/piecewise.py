@@ -1,0 +1,388 @@
+"""Smooth piecewise surfaces for grids too large for one polynomial: exact bicubic Hermite pieces.
+
+One polynomial through an ``n x m`` grid has degree ``(n - 1, m - 1)``; past
+a dozen nodes on even spacing it amplifies errors in the points thousands of
+times (:mod:`lagsym.conditioning`).  A :class:`PiecewiseSurface` is instead one
+bicubic polynomial per cell ``[x_i, x_{i+1}] x [y_k, y_{k+1}]`` of the grid,
+built from the paper's Lagrange idea at a small scale:
+
+* the slopes at each node are those of the local Lagrange parabola, the
+  quadratic through the node and its two neighbours (at the first and last
+  node, through the first or last three), :func:`lagrange_slopes`;
+* the twist ``z_xy`` applies the same rule in both directions;
+* each cell is the bicubic Hermite (Ferguson) patch of its four corners'
+  heights, slopes and twists.
+
+Every number is an exact rational.  **Continuity**: the surface passes
+through every control point and is C1: across every border between pieces
+the value, both first partial derivatives (and the twist ``F_xy``) of the two
+pieces agree exactly, as polynomials along the whole border, because both
+pieces take them from the same node data.  Second derivatives ``F_xx`` and
+``F_yy`` jump in general (it is not C2).  It reproduces every polynomial of
+degree at most 2 in x and 2 in y exactly, since the parabola's slopes are
+exact for those.
+
+The pieces are :class:`~lagsym.lagrange.LagrangeSurface` values (the
+Lagrange surface through a 4 x 4 grid of a piece's own values in its cell is
+the piece itself), so every exact and numeric tool for one polynomial works
+on a piece; :class:`PiecewiseEvaluator` is the numeric evaluator of the whole
+(floats), what drop-cutter and the toolpath planner use.
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_right
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import cached_property
+from math import comb
+
+import flint
+import numpy as np
+
+from .._arrays import readonly
+from ..errors import GridError
+from ..grid import ControlGrid, grid_from_table
+from ..lagrange import LagrangeSurface, horner2
+
+__all__ = ["CONTINUITY", "PiecewiseSurface", "PiecewiseEvaluator", "lagrange_slopes", "piecewise_surface",
+           "piecewise_evaluator", "MAX_PIECES"]
+
+CONTINUITY = "C1"
+"""What the pieces share across every border: value and both first partial derivatives (and the twist)."""
+
+MAX_PIECES = 250_000
+"""Pieces at most (a 501 x 501 grid): beyond it the exact pieces alone would take gigabytes."""
+
+# Hermite data (p0, p1, m0, m1) of a cubic on [0, 1] -> its power coefficients a0..a3.
+_HERMITE = ((1, 0, 0, 0), (0, 0, 1, 0), (-3, 3, -2, -1), (2, -2, 1, 1))
+
+
+def _slope_weights(nodes, i: int) -> tuple[int, tuple[Fraction, Fraction, Fraction]]:
+    """``(lo, w)``: the slope at ``nodes[i]`` of the parabola through ``nodes[lo:lo+3]`` is ``sum w_k f[lo+k]``."""
+    lo = min(max(i - 1, 0), len(nodes) - 3)
+    t = nodes[lo:lo + 3]
+    xi = nodes[i]
+    w = []
+    for k in range(3):
+        others = [t[j] for j in range(3) if j != k]
+        denom = (t[k] - others[0]) * (t[k] - others[1])
+        # d/dx of (x - a)(x - b) at xi
+        w.append(((xi - others[0]) + (xi - others[1])) / denom)
+    return lo, tuple(w)
+
+
+def lagrange_slopes(nodes, values) -> tuple[Fraction, ...]:
+    """The slope at every node of the local Lagrange parabola (3 points), exactly.
+
+    At an inner node the parabola runs through the node and its two
+    neighbours; at an end, through the three nearest nodes.  On even spacing
+    the inner rule is the central difference.
+
+    Examples
+    --------
+    >>> [str(s) for s in lagrange_slopes([0, 1, 3], [0, 1, 9])]  # x**2: exact
+    ['0', '2', '6']
+    """
+    nodes = [Fraction(v) for v in nodes]
+    values = [Fraction(v) for v in values]
+    out = []
+    for i in range(len(nodes)):
+        lo, w = _slope_weights(nodes, i)
+        out.append(sum((w[k] * values[lo + k] for k in range(3)), Fraction(0)))
+    return tuple(out)
+
+
+def _apply_rows(table, nodes) -> list[list[Fraction]]:
+    """:func:`lagrange_slopes` down every column of ``table`` (the x direction: ``table[i][k]``)."""
+    cols = [lagrange_slopes(nodes, [row[k] for row in table]) for k in range(len(table[0]))]
+    return [[cols[k][i] for k in range(len(cols))] for i in range(len(nodes))]
+
+
+def _apply_cols(table, nodes) -> list[list[Fraction]]:
+    """:func:`lagrange_slopes` along every row of ``table`` (the y direction)."""
+    return [list(lagrange_slopes(nodes, row)) for row in table]
+
+
+def _fmpq(v) -> flint.fmpq:
+    v = Fraction(v)
+    return flint.fmpq(v.numerator, v.denominator)
+
+
+def _frac(v: flint.fmpq) -> Fraction:
+    return Fraction(int(v.p), int(v.q))
+
+
+def _rows(mat: flint.fmpq_mat) -> tuple[tuple[Fraction, ...], ...]:
+    return tuple(tuple(_frac(mat[i, j]) for j in range(mat.ncols())) for i in range(mat.nrows()))
+
+
+def _to_power(origin: Fraction, width: Fraction) -> flint.fmpq_mat:
+    """``P[a, k]``: ``((x - origin) / width)**a = sum_k P[a, k] x**k``."""
+    return flint.fmpq_mat([[_fmpq(Fraction(comb(a, k)) * (-origin) ** (a - k) / width ** a) if k <= a else 0
+                            for k in range(4)] for a in range(4)])
+
+
+_M = flint.fmpq_mat([list(r) for r in _HERMITE])
+_THIRDS = flint.fmpq_mat([[flint.fmpq(p ** a, 3 ** a) for a in range(4)] for p in range(4)])  # [p, a] = (p/3)**a
+
+
+@dataclass(frozen=True)
+class PiecewiseSurface:
+    """Exact bicubic pieces over the cells of a control grid, joined C1 (see the module text).
+
+    Attributes
+    ----------
+    grid : ControlGrid
+        The control points; piece ``(i, k)`` covers ``[x[i], x[i+1]] x [y[k], y[k+1]]``.
+    zx, zy, zxy : tuple of tuple of Fraction
+        Slopes and twists at the nodes, ``[i][k]`` as ``grid.z``.
+    """
+
+    grid: ControlGrid
+    zx: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    zy: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    zxy: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+
+    continuity = CONTINUITY
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Pieces along x and along y."""
+        n, m = self.grid.shape
+        return n - 1, m - 1
+
+    @property
+    def bounds(self) -> tuple[Fraction, Fraction, Fraction, Fraction]:
+        """``(x0, x1, y0, y1)``: the control points' box."""
+        return self.grid.bounds
+
+    @property
+    def source(self) -> str:
+        return self.grid.source
+
+    @property
+    def units(self) -> str | None:
+        return self.grid.units
+
+    def __repr__(self) -> str:
+        (n, m), (a, b) = self.grid.shape, self.shape
+        return f"PiecewiseSurface({n}x{m} nodes, {a}x{b} bicubic pieces, {CONTINUITY}, source={self.grid.source!r})"
+
+    def box(self, i: int, k: int) -> tuple[Fraction, Fraction, Fraction, Fraction]:
+        """The cell of piece ``(i, k)``: ``(x[i], x[i+1], y[k], y[k+1])``."""
+        g = self.grid
+        return g.x[i], g.x[i + 1], g.y[k], g.y[k + 1]
+
+    def local_coefficients(self, i: int, k: int) -> tuple[tuple[Fraction, ...], ...]:
+        """``A[a][b]``: piece ``(i, k)`` is ``sum A[a][b] s**a t**b``, ``s, t`` the cell's coordinates on ``[0, 1]``."""
+        return _rows(self._local(i, k))
+
+    def _local(self, i: int, k: int) -> flint.fmpq_mat:
+        found = self._locals.get((i, k))
+        if found is None:
+            found = self._locals[i, k] = self._hermite(i, k)
+        return found
+
+    @cached_property
+    def _locals(self) -> dict:
+        return {}
+
+    def _hermite(self, i: int, k: int) -> flint.fmpq_mat:
+        x0, x1, y0, y1 = self.box(i, k)
+        hx, hy = x1 - x0, y1 - y0
+        z, zx, zy, zxy = self.grid.z, self.zx, self.zy, self.zxy
+        rows = (i, i + 1)
+        cols = (k, k + 1)
+        g = [[z[r][c] for c in cols] + [hy * zy[r][c] for c in cols] for r in rows]
+        g += [[hx * zx[r][c] for c in cols] + [hx * hy * zxy[r][c] for c in cols] for r in rows]
+        return _M * flint.fmpq_mat([[_fmpq(v) for v in row] for row in g]) * _M.transpose()
+
+    def coefficients(self, i: int, k: int) -> tuple[tuple[Fraction, ...], ...]:
+        """``C[a][b]``: piece ``(i, k)`` is ``sum C[a][b] x**a y**b`` (the order of :class:`LagrangeSurface`)."""
+        x0, x1, y0, y1 = self.box(i, k)
+        return _rows(_to_power(x0, x1 - x0).transpose() * self._local(i, k) * _to_power(y0, y1 - y0))
+
+    def piece(self, i: int, k: int) -> LagrangeSurface:
+        """Piece ``(i, k)`` as the Lagrange surface through its values on a 4 x 4 grid over its cell (itself)."""
+        return self._pieces[(i, k)] if (i, k) in self._pieces else self._make_piece(i, k)
+
+    @cached_property
+    def _pieces(self) -> dict:
+        return {}
+
+    @cached_property
+    def evaluator(self) -> PiecewiseEvaluator:
+        """The numeric evaluator of the whole surface (made on first use, kept with it)."""
+        return PiecewiseEvaluator(self)
+
+    def _make_piece(self, i: int, k: int) -> LagrangeSurface:
+        c = self.coefficients(i, k)
+        x0, x1, y0, y1 = self.box(i, k)
+        xs = [x0 + (x1 - x0) * Fraction(a, 3) for a in range(4)]
+        ys = [y0 + (y1 - y0) * Fraction(b, 3) for b in range(4)]
+        values = _rows(_THIRDS * self._local(i, k) * _THIRDS.transpose())
+        g = grid_from_table(xs, ys, values, source=f"{self.grid.source} piece ({i}, {k})", units=self.grid.units)
+        s = LagrangeSurface(g, c)
+        self._pieces[(i, k)] = s
+        return s
+
+    def locate(self, x, y) -> tuple[int, int]:
+        """The piece whose cell holds ``(x, y)`` (a point on a border: the piece above and right of it)."""
+        g = self.grid
+        n, m = self.shape
+        return min(max(bisect_right(g.x, Fraction(x)) - 1, 0), n - 1), min(max(bisect_right(g.y, Fraction(y)) - 1, 0), m - 1)
+
+    def exact_value(self, x, y) -> Fraction:
+        """``F(x, y)`` exactly, from the piece whose cell holds the point."""
+        x, y = Fraction(x), Fraction(y)
+        return horner2(self.coefficients(*self.locate(x, y)), x, y)
+
+    def expr(self, i: int, k: int, x="x", y="y"):
+        """Piece ``(i, k)`` as an exact SymPy expression in ``x, y``."""
+        import sympy
+
+        sx, sy = sympy.Symbol(x) if isinstance(x, str) else x, sympy.Symbol(y) if isinstance(y, str) else y
+        c = self.coefficients(i, k)
+        return sympy.Add(*[sympy.Rational(v.numerator, v.denominator) * sx ** a * sy ** b
+                           for a, row in enumerate(c) for b, v in enumerate(row) if v])
+
+    def piecewise(self, x="x", y="y"):
+        """The whole surface as a SymPy ``Piecewise`` over the cells (a border point: its lower-left piece).
+
+        Outside the box the ``Piecewise`` is ``nan``.
+        """
+        import sympy
+
+        sx, sy = sympy.Symbol(x) if isinstance(x, str) else x, sympy.Symbol(y) if isinstance(y, str) else y
+        branches = []
+        n, m = self.shape
+        for i in range(n):
+            for k in range(m):
+                x0, x1, y0, y1 = (sympy.Rational(v.numerator, v.denominator) for v in self.box(i, k))
+                branches.append((self.expr(i, k, sx, sy), sympy.And(sx >= x0, sx <= x1, sy >= y0, sy <= y1)))
+        branches.append((sympy.nan, True))
+        return sympy.Piecewise(*branches, evaluate=False)
+
+
+def piecewise_surface(grid: ControlGrid) -> PiecewiseSurface:
+    """The C1 piecewise bicubic surface through ``grid`` (at least 3 nodes each way).
+
+    Examples
+    --------
+    >>> g = grid_from_table([0, 1, 2], [0, 1, 2], [[x * x + y for y in range(3)] for x in range(3)])
+    >>> s = piecewise_surface(g)
+    >>> s.shape, s.expr(1, 0)  # x**2 + y is reproduced exactly
+    ((2, 2), x**2 + y)
+    """
+    n, m = grid.shape
+    if n < 3 or m < 3:
+        raise GridError(f"{grid.source}: a piecewise surface needs at least 3 x 3 nodes (the slopes come from "
+                        f"3-point Lagrange parabolas), the grid has {n} x {m}")
+    if (n - 1) * (m - 1) > MAX_PIECES:
+        raise GridError(f"{grid.source}: {n} x {m} nodes make {(n - 1) * (m - 1):,} pieces, more than the limit of "
+                        f"{MAX_PIECES:,}; thin the grid")
+    z = [list(r) for r in grid.z]
+    zx = _apply_rows(z, grid.x)
+    zy = _apply_cols(z, grid.y)
+    zxy = _apply_cols(zx, grid.y)
+    frozen = [tuple(tuple(r) for r in t) for t in (zx, zy, zxy)]
+    return PiecewiseSurface(grid, *frozen)
+
+
+def _local_derivative(a: np.ndarray, d: int) -> np.ndarray:
+    """Coefficients along the last axis of ``a`` differentiated ``d`` times (the same length, zero-padded)."""
+    for _ in range(d):
+        k = np.arange(1, a.shape[-1])
+        a = np.concatenate([a[..., 1:] * k, np.zeros(a.shape[:-1] + (1,))], axis=-1)
+    return a
+
+
+class PiecewiseEvaluator:
+    """The numeric (float64) evaluator of a :class:`PiecewiseSurface`, as the toolpath planner asks one.
+
+    ``bounds``, ``fast_points`` (values and partial derivatives at scattered
+    points) and ``curvature_bound`` answer as
+    :class:`~lagsym.evaluate.SurfaceEvaluator`'s do; ``piece_evaluator(i, k)``
+    is a piece's own evaluator, which drop-cutter searches on.
+    """
+
+    def __init__(self, surface: PiecewiseSurface):
+        self.surface = surface
+        g = surface.grid
+        self.breaks_x = readonly(np.array([float(v) for v in g.x]))
+        self.breaks_y = readonly(np.array([float(v) for v in g.y]))
+        self.bounds = (float(g.x[0]), float(g.x[-1]), float(g.y[0]), float(g.y[-1]))
+        n, m = surface.shape
+        self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
+                                         for k in range(m)] for i in range(n)]))
+        self._evaluators: dict = {}
+
+    @cached_property
+    def upper_heights(self) -> np.ndarray:
+        """``[i, k]``: no point of piece ``(i, k)`` lies above this (its highest Bezier control point, rounded up).
+
+        A Bezier patch lies in the convex hull of its control points; the
+        float rounding of the conversion is covered by a relative ``1e-12``.
+        """
+        w = np.array([[comb(j, a) / comb(3, a) if a <= j else 0.0 for a in range(4)] for j in range(4)])
+        b = np.einsum("ja,ikab,lb->ikjl", w, self.local, w)
+        top = b.max(axis=(2, 3))
+        return readonly(top + 1e-12 * (np.abs(b).max(axis=(2, 3)) + 1.0))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Coefficients of a piece in x and in y."""
+        return 4, 4
+
+    def locate(self, x, y):
+        """Piece indices and cell coordinates ``(i, k, s, t)`` of points (clipped to the box)."""
+        bx, by = self.breaks_x, self.breaks_y
+        i = np.clip(np.searchsorted(bx, x, side="right") - 1, 0, len(bx) - 2)
+        k = np.clip(np.searchsorted(by, y, side="right") - 1, 0, len(by) - 2)
+        hx, hy = bx[i + 1] - bx[i], by[k + 1] - by[k]
+        return i, k, (x - bx[i]) / hx, (y - by[k]) / hy, hx, hy
+
+    def fast_points(self, x, y, dx: int = 0, dy: int = 0) -> np.ndarray:
+        """``F(x, y)`` or a partial derivative at scattered points, each from the piece whose cell holds it."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        shape = x.shape
+        i, k, s, t, hx, hy = self.locate(x.ravel(), y.ravel())
+        a = self.local[i, k]  # (N, 4, 4): a[p, u, v] multiplies s**u t**v
+        a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(a, 1, 2), dx), 1, 2), dy)
+        ps = np.stack([np.ones_like(s), s, s * s, s * s * s], axis=1)
+        pt = np.stack([np.ones_like(t), t, t * t, t * t * t], axis=1)
+        z = np.einsum("pu,puv,pv->p", ps, a, pt) / (hx ** dx * hy ** dy)
+        return z.reshape(shape)
+
+    def curvature_bound(self, samples: int = 5) -> float:
+        """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on ``samples`` x ``samples`` points of every piece.
+
+        Each piece is sampled on its own closed cell, so the values either side of a border (where second
+        derivatives jump) are both seen.
+        """
+        u = np.linspace(0.0, 1.0, samples)
+        powers = np.stack([np.ones_like(u), u, u * u, u * u * u], axis=1)  # (samples, 4)
+        hx, hy = np.diff(self.breaks_x), np.diff(self.breaks_y)
+        worst = 0.0
+        for dx, dy in ((2, 0), (0, 2), (1, 1)):
+            a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(self.local, 2, 3), dx), 2, 3), dy)
+            d = np.einsum("su,ikuv,tv->ikst", powers, a, powers)
+            d = d / (hx[:, None, None, None] ** dx * hy[None, :, None, None] ** dy)
+            worst = max(worst, float(np.abs(d).max()))
+        return worst
+
+    def piece_evaluator(self, i: int, k: int):
+        """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use."""
+        from ..evaluate import surface_evaluator
+
+        found = self._evaluators.get((i, k))
+        if found is None:
+            piece = self.surface.piece(i, k)
+            found = self._evaluators[(i, k)] = (piece, surface_evaluator(piece))
+        return found
+
+
+def piecewise_evaluator(surface: PiecewiseSurface) -> PiecewiseEvaluator:
+    """The evaluator of ``surface``, remembered on it."""
+    return surface.evaluator
