@@ -168,8 +168,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     # Drop-cutter's compiled kernel loaded here (the first time, compiled), before the workers fork: they share it.
     with telling_compiles(progress):
         cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
-    # Worker processes on the other cores, where the plan is large enough to pay for starting them.
-    # A piecewise surface's drops run piece by piece in this process (the pieces' evaluators are made as reached).
+    # Worker processes on the other cores where the plan pays for them; a piecewise surface's run in this process.
     one = isinstance(ev, PiecewiseEvaluator) or len(levels) * len(along) < MIN_POINTS
     with Workers(ev, 1 if one else None) as workers:
         cl = replace(cl, workers=workers)
