@@ -44,11 +44,26 @@ def test_a_cat_holding_the_port_is_named_and_the_send_refused(run_cli, tmp_path)
     assert f"the port is in use by another program (cat, pid {cat.pid})" in err and err.count("\n") == 1
 
 
+def _lock_of(folder, pair) -> Path:
+    return folder / ("LCK.." + os.path.realpath(pair.near)[len("/dev/"):].replace("/", "_"))
+
+
+def _taken_over(pair, lock) -> None:
+    """The lock is taken by this process while the port is open, and removed at close."""
+    port = Port(pair.near, profile("fanuc"), write_timeout=1)
+    try:
+        assert lock.read_text() == f"{os.getpid():>10d}\n"
+    finally:
+        port.close()
+    assert not lock.exists()
+
+
 def test_a_lock_file_of_a_live_program_refuses_and_a_stale_one_is_taken_over(run_cli, tmp_path):
     folder = lock_folder()
     with PtyPair() as pair:
-        lock = folder / ("LCK.." + os.path.realpath(pair.near)[len("/dev/"):].replace("/", "_"))
-        holder = subprocess.Popen(["sleep", "60"])
+        lock = _lock_of(folder, pair)
+        with open(pair.near, "rb") as device:  # the holder has the device open, as minicom would
+            holder = subprocess.Popen(["sleep", "60"], stdin=device)
         try:
             lock.write_text(f"{holder.pid:>10d}\n")
             status, _, err = run_cli("send", write(tmp_path, PROGRAM), "--port", pair.near, "--quiet")
@@ -57,12 +72,22 @@ def test_a_lock_file_of_a_live_program_refuses_and_a_stale_one_is_taken_over(run
             holder.kill()
             holder.wait()
         # Its owner gone, the lock is stale: taken over, held while the port is open, removed at close.
-        port = Port(pair.near, profile("fanuc"), write_timeout=1)
+        _taken_over(pair, lock)
+
+
+def test_a_lock_file_of_a_live_program_without_the_device_open_is_taken_over():
+    # A program that closed the port and never removed its lock, or a pseudo-terminal number given to a new
+    # pair since: its lock claims nothing, though its owner runs on.
+    folder = lock_folder()
+    with PtyPair() as pair:
+        lock = _lock_of(folder, pair)
+        idle = subprocess.Popen(["sleep", "60"])
         try:
-            assert lock.read_text() == f"{os.getpid():>10d}\n"
+            lock.write_text(f"{idle.pid:>10d}\n")
+            _taken_over(pair, lock)
         finally:
-            port.close()
-        assert not lock.exists()
+            idle.kill()
+            idle.wait()
 
 
 def test_the_kernel_refuses_a_second_open_while_lagsym_holds_the_port():

@@ -12,7 +12,9 @@ different kind of other program:
 * A lock file ``LCK..ttyUSB0`` in ``/run/lock`` or ``/var/lock``
   (:func:`take_lock_file`), in the format minicom, picocom, cu and
   ModemManager use: a device another of those holds is refused, and
-  they see lagsym's.  Where no lock folder can be written it is skipped.
+  they see lagsym's.  A lock whose owner has ended, or runs on without the
+  device open (where ``/proc`` shows its files), is stale and taken over.
+  Where no lock folder can be written it is skipped.
 * A look through ``/proc`` for other processes that have the device open
   (:func:`other_openers`): catches a ``cat`` or a terminal that opened the
   device before lagsym, which none of the above can.  It sees only the
@@ -52,6 +54,28 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _holds(pid: int, device: str) -> bool | None:
+    """Whether process ``pid`` has ``device`` open; None where ``/proc`` cannot tell.
+
+    A lock file whose owner still runs but has let the device go (a program that
+    closed the port and never removed its lock, or a pseudo-terminal's number
+    given to a new pair since) claims nothing: other serial tools would wait
+    for that owner to end, which may be never.
+    """
+    real = os.path.realpath(device)
+    try:
+        fds = os.listdir(f"/proc/{pid}/fd")
+    except OSError:
+        return None
+    for fd in fds:
+        try:
+            if os.readlink(f"/proc/{pid}/fd/{fd}") == real:
+                return True
+        except OSError:
+            continue
+    return False
+
+
 def _name_of(pid: int) -> str:
     try:
         return Path(f"/proc/{pid}/comm").read_text().strip() or "?"
@@ -76,9 +100,9 @@ def take_lock_file(device: str) -> tuple[Path | None, str | None]:
                     pid = None
                 if pid == os.getpid():  # this process holds it already: its flock on the device says so
                     return None, None
-                if pid is not None and _alive(pid):
+                if pid is not None and _alive(pid) and _holds(pid, device) is not False:
                     return None, f"{_name_of(pid)}, pid {pid}, lock file {path}"
-                try:  # stale: its owner is gone
+                try:  # stale: its owner is gone, or runs on without the device open
                     path.unlink()
                 except OSError:
                     return None, None
