@@ -22,6 +22,7 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
+import keyword
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -63,14 +64,34 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+MAX_NAME = 64  # characters in a variable's name
+
+
+def check_name(name, what: str = "variable") -> str:
+    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword).
+
+    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
+    writes and the Python text of ``lagsym equation --format python``: a name that is
+    not a plain identifier could be read there as code, so it is refused here, where
+    the value is made.
+    """
+    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
+                                         and name.isidentifier() and not keyword.iskeyword(name)):
+        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
+        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
+                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
+    return name
+
+
 def _variable(value, what: str):
     """A variable as the value keeps it: a plain symbol by its name (no SymPy needed), any other symbol itself."""
     if isinstance(value, str):
-        return value
+        return check_name(value, what)
     import sympy
 
     if not isinstance(value, sympy.Symbol):
         raise InputError(f"{what} = {value!r} is not a SymPy symbol or a name")
+    check_name(value.name, what)
     return value.name if type(value) is sympy.Symbol and value == sympy.Symbol(value.name) else value
 
 
@@ -132,7 +153,7 @@ def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly,
     >>> [p.as_expr() for p in lagrange_basis([1, 2, 3])][1]
     -x**2 + 4*x - 3
     """
-    (symbol,) = _symbols_of((symbol,))
+    (symbol,) = _symbols_of((_variable(symbol, "symbol"),))
     return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes))
 
 
@@ -167,6 +188,9 @@ class LagrangeCurve:
     points: CurvePoints
     coefficients: tuple[Fraction, ...]
     variable: str | sympy.Symbol = "x"
+
+    def __post_init__(self):
+        object.__setattr__(self, "variable", _variable(self.variable, "x"))
 
     @cached_property
     def symbol(self) -> sympy.Symbol:
@@ -234,6 +258,11 @@ class LagrangeSurface:
     grid: ControlGrid
     coefficients: tuple[tuple[Fraction, ...], ...]
     variables: tuple[str | sympy.Symbol, str | sympy.Symbol] = ("x", "y")
+
+    def __post_init__(self):
+        if not isinstance(self.variables, (tuple, list)) or len(self.variables) != 2:
+            raise InputError(f"variables = {self.variables!r} is not a pair of names or symbols")
+        object.__setattr__(self, "variables", (_variable(self.variables[0], "x"), _variable(self.variables[1], "y")))
 
     @cached_property
     def symbols(self) -> tuple[sympy.Symbol, sympy.Symbol]:
