@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import flint
 
 from .errors import InputError
+from .values import as_exact
 
 from .grid import ControlGrid, CurvePoints
 
@@ -129,6 +130,32 @@ def _basis_matrix(nodes: tuple[Fraction, ...]) -> flint.fmpq_mat:
     return flint.fmpq_mat(n, n, rows)
 
 
+def _node(v, i: int) -> Fraction:
+    # Text by the one exact-number policy (which bounds its exponent); a number as its exact value.
+    if isinstance(v, str) or isinstance(v, bool):
+        return as_exact(v, f"node {i}")
+    try:
+        return Fraction(v)
+    except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+        raise InputError(f"node {i} = {v!r:.80} is not a finite number") from None
+
+
+def _distinct_nodes(nodes) -> tuple[Fraction, ...]:
+    """``nodes`` as exact rationals, checked: a basis needs at least one node and no two alike."""
+    try:
+        values = tuple(_node(v, i) for i, v in enumerate(nodes))
+    except TypeError:
+        raise InputError(f"nodes = {nodes!r:.80} is not a sequence of numbers") from None
+    if not values:
+        raise InputError("nodes = () is empty: a basis needs at least one node")
+    seen: dict[Fraction, int] = {}
+    for i, v in enumerate(values):
+        if v in seen:
+            raise InputError(f"nodes {seen[v]} and {i} are both {v}: a Lagrange basis needs distinct nodes")
+        seen[v] = i
+    return values
+
+
 def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     """Power-basis coefficients of the Lagrange basis on ``nodes``.
 
@@ -139,7 +166,7 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     >>> basis_coefficients([1, 2, 3])[0]
     (Fraction(3, 1), Fraction(-5, 2), Fraction(1, 2))
     """
-    nodes = tuple(Fraction(v) for v in nodes)
+    nodes = _distinct_nodes(nodes)
     m = _basis_matrix(nodes)
     n = len(nodes)
     return tuple(tuple(_frac(m[i, a]) for a in range(n)) for i in range(n))

@@ -35,7 +35,7 @@ from .._arrays import freeze_fields
 from ..errors import ProgramError
 from ..machine import mm_per_program_unit
 from .arcs import arc_points
-from .program import END_M, program_blocks, unrun_code
+from .program import END_M, ascii_program, program_blocks, unrun_code
 from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
@@ -156,6 +156,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     >>> m.points_mm.tolist(), m.rapid.tolist()
     ([[1.0, 2.0, 0.0], [1.0, 2.0, -0.5], [3.0, 2.0, -0.5]], [True, False, False])
     """
+    ascii_program(text, source)
     pos = [0.0, 0.0, 0.0]
     start = tuple(pos)
     modal = _Modal()
@@ -245,6 +246,7 @@ def tool_changes(text: str, source: str = "<program>") -> list[tuple[int, int]]:
     >>> tool_changes("T1 M06\\nG00 X0 Y0\\nT2\\nM6\\n")
     [(1, 1), (4, 2)]
     """
+    ascii_program(text, source)
     out, tool = [], None
     for no, raw, block in program_blocks(text):
         try:

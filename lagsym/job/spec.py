@@ -26,6 +26,7 @@ key and (for a choice) the valid values.  Example::
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,7 +35,7 @@ from ..io.files import read_bytes
 from ..controls import VARIABLE_PROFILES, control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
-from ..values import in_range
+from ..values import FrozenMap, in_range
 
 __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "read_job", "parse_job", "KINDS", "COOLANTS"]
 
@@ -78,7 +79,10 @@ class OperationSpec:
     feed_mm_min: float = 600.0
     plunge_feed_mm_min: float = 200.0
     coolant: str = "off"
-    options: dict = field(default_factory=dict)
+    options: Mapping = field(default_factory=FrozenMap)
+
+    def __post_init__(self):
+        object.__setattr__(self, "options", FrozenMap(self.options))
 
 
 @dataclass(frozen=True)
@@ -96,11 +100,18 @@ class JobSpec:
     safe_z_mm: float
     rapid_mm_min: float
     title: str
-    stock: dict
-    tools: dict
+    stock: Mapping
+    tools: Mapping
     operations: tuple
     variables: str = "full"
     notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
+
+    def __post_init__(self):
+        # Read-only all the way down: a value that flows must not change under the code that holds it.
+        object.__setattr__(self, "stock", FrozenMap(self.stock))
+        object.__setattr__(self, "tools", FrozenMap(self.tools))
+        object.__setattr__(self, "operations", tuple(self.operations))
+        object.__setattr__(self, "notes", tuple(self.notes))
 
 
 def read_job(path) -> JobSpec:
