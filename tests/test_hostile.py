@@ -77,3 +77,82 @@ def test_good_names_still_evaluate_as_the_exact_polynomial(in_tmp):
         exec(lagsym.equation.render(s, "python"), ns)  # noqa: S102 - the text under test
         for px, py, pz in GRID:
             assert ns["F"](px, py) == pz
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Writes: always a temporary beside the target and a rename; an output that is an input refused before any work.
+
+from conftest import EXAMPLES  # noqa: E402
+
+from lagsym.errors import OutputError  # noqa: E402
+from lagsym.io import write_text  # noqa: E402
+
+EXAMPLE1 = EXAMPLES / "paper-example-1.json"
+EQUATION = "z = x**2 + 3*y\n"
+
+
+def test_an_output_that_is_an_input_is_refused(run_cli, tmp_path):
+    p = tmp_path / "p.json"
+    p.write_bytes(EXAMPLE1.read_bytes())
+    status, out, err = run_cli("equation", p, "-o", p)
+    assert (status, out) == (2, "") and err == f"lagsym: error: {p}: is also an input; write the result to another file\n"
+    assert p.read_bytes() == EXAMPLE1.read_bytes()
+    nc = tmp_path / "p.nc"
+    nc.write_text("G0 X1.\n")
+    other = tmp_path / "other.nc"
+    os.link(nc, other)  # the same file by another name: same device and inode
+    status, out, err = run_cli("simulate", nc, "-o", other)
+    assert status == 2 and err.count("\n") == 1 and "is also an input" in err
+    assert nc.read_text() == "G0 X1.\n"
+
+
+def test_a_dev_shm_file_is_a_file_not_a_stream(run_cli):
+    # A path under /dev that is a regular file is replaced by a rename: it gets a new inode.
+    folder = "/dev/shm" if os.path.isdir("/dev/shm") else None
+    if folder is None:
+        pytest.skip("no /dev/shm here")
+    import tempfile
+
+    with tempfile.TemporaryDirectory(dir=folder) as d:
+        target = os.path.join(d, "x.csv")
+        with open(target, "w") as fh:
+            fh.write("old\n")
+        before = os.stat(target).st_ino
+        assert run_cli("equation", EXAMPLE1, "-o", target)[0] == 0
+        assert os.stat(target).st_ino != before
+        assert open(target).read() == EQUATION
+        assert os.listdir(d) == ["x.csv"]
+
+
+def test_a_legal_long_name_is_written_and_a_name_over_the_limit_refused(run_cli, tmp_path):
+    name_max = os.pathconf(tmp_path, "PC_NAME_MAX")
+    ok = tmp_path / ("a" * (name_max - 4) + ".txt")
+    assert run_cli("equation", EXAMPLE1, "-o", ok)[0] == 0 and ok.read_text() == EQUATION
+    too_long = tmp_path / ("b" * (name_max + 1))
+    status, out, err = run_cli("equation", EXAMPLE1, "-o", too_long)
+    assert status == 2 and err.count("\n") == 1 and "longer than the system allows" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [ok.name]
+
+
+def test_a_symlink_loop_and_a_newline_in_a_name_are_one_line(run_cli, tmp_path):
+    (tmp_path / "l1").symlink_to(tmp_path / "l2")
+    (tmp_path / "l2").symlink_to(tmp_path / "l1")
+    status, out, err = run_cli("equation", EXAMPLE1, "-o", tmp_path / "l1")
+    assert status == 2 and err.count("\n") == 1 and "symbolic links" in err
+    status, out, err = run_cli("equation", tmp_path / "no\nsuch.json")
+    assert status == 2 and err.count("\n") == 1 and "no\\nsuch.json" in err
+
+
+def test_a_full_disk_message_says_it_once(tmp_path, monkeypatch):
+    import errno
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    target = tmp_path / "out.txt"
+    target.write_text("old\n")
+    monkeypatch.setattr(os, "fsync", full)
+    with pytest.raises(OutputError) as info:
+        write_text(target, "new\n")
+    assert str(info.value) == f"{target}: cannot write (no space left on the device); any earlier file there is untouched"
+    assert target.read_text() == "old\n" and [p.name for p in tmp_path.iterdir()] == ["out.txt"]
