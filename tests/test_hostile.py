@@ -156,3 +156,73 @@ def test_a_full_disk_message_says_it_once(tmp_path, monkeypatch):
         write_text(target, "new\n")
     assert str(info.value) == f"{target}: cannot write (no space left on the device); any earlier file there is untouched"
     assert target.read_text() == "old\n" and [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Wrong answers: nothing reported as ok that is not a number.
+
+def test_nearly_equal_nodes_give_the_true_lebesgue_constant_or_a_refusal(run_cli, tmp_path):
+    import json
+
+    near = tmp_path / "near.csv"
+    near.write_text("x,y,z\n1,0,1\n1,1,2\n1.0000000000000000000001,0,3\n1.0000000000000000000001,1,4\n")
+    status, out, err = run_cli("check", near, "--format", "json")
+    assert status == 0, err
+    # Two distinct nodes: L_0 + L_1 = 1 on their span (the two lines sum to the constant 1), whatever the gap.
+    found = {f["name"]: f["value"] for f in json.loads(out, parse_constant=lambda c: pytest.fail(c))["findings"]}
+    assert found["lebesgue_x"] == pytest.approx(1.0, rel=1e-12) and found["lebesgue_y"] == pytest.approx(1.0)
+    three = tmp_path / "three.csv"
+    three.write_text("x,y,z\n0,0,1\n0,1,2\n1,0,3\n1,1,4\n1.0000000000000000000001,0,3\n1.0000000000000000000001,1,4\n")
+    status, out, err = run_cli("check", three)
+    assert status == 2 and out == "" and err.count("\n") == 1
+    assert "nodes 1 and 1.0000000000000000000001" in err
+
+
+def _job_data(title, dialect="fanuc"):
+    return {"points": "p.csv", "title": title, "dialect": dialect, "stock": {"block": [0, 10, 0, 10], "top": 5},
+            "tools": {"b": {"number": 1, "shape": "ball", "diameter": 6}},
+            "operations": [{"kind": "finish", "tool": "b"}]}
+
+
+def test_a_job_title_must_fit_one_block_of_the_control():
+    from pathlib import Path
+
+    from lagsym.job.spec import parse_job
+
+    # A Fanuc reads 128 characters a block; the header block is "O1000 (" + title + ")".
+    fits = "A" * (128 - len("O1000 ()"))
+    assert parse_job(_job_data(fits), "j.toml", Path(".")).title == fits
+    for title in (fits + "A", "B" * 100_000):
+        with pytest.raises(LagsymError, match=f"title of {len(title):,} characters") as info:
+            parse_job(_job_data(title), "j.toml", Path("."))
+        assert "128" in str(info.value)
+
+
+def _hollerith_strings(text: str) -> list[str]:
+    """The Hollerith strings of an IGES global section, read by their counts (an independent reader)."""
+    out, i = [], 0
+    while i < len(text):
+        j = i
+        while j < len(text) and text[j].isdigit():
+            j += 1
+        if j > i and j < len(text) and text[j] == "H":
+            n = int(text[i:j])
+            out.append(text[j + 1:j + 1 + n])
+            i = j + 1 + n + 1  # past the string and its delimiter
+        else:
+            k = min((p for p in (text.find(",", i), text.find(";", i)) if p >= 0), default=len(text))
+            i = k + 1
+    return out
+
+
+def test_an_iges_file_named_with_accents_stays_ascii_with_true_counts(run_cli, tmp_path):
+    target = tmp_path / "pièce-à-façon.igs"
+    status, out, err = run_cli("export", EXAMPLE1, "-o", target)
+    assert status == 0, err
+    raw = target.read_bytes()
+    assert raw.isascii()
+    lines = raw.decode("ascii").splitlines()
+    assert all(len(line) == 80 for line in lines)
+    glob = "".join(line[:72] for line in lines if line[72] == "G")
+    strings = _hollerith_strings(glob)
+    assert strings[:4] == [",", ";", "piece-a-facon", "piece-a-facon.igs"]

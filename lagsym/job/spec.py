@@ -213,6 +213,8 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
     low, high = control(dialect).program_numbers
     if not low <= program_number <= high:
         raise InputError(f"{source}: program_number = {program_number} must be {low} to {high}")
+    title = data.get("title", Path(data["points"]).stem)
+    _check_title(title, control(dialect), program_number, source)
     return JobSpec(
         source=source, points=base / data["points"],
         dialect=dialect,
@@ -224,8 +226,21 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         program_number=program_number,
         safe_z_mm=_length(data.get("safe_z", 50.0), "safe_z", source),
         rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
-        title=data.get("title", Path(data["points"]).stem),
+        title=title,
         stock=_stock(data["stock"], source), tools=tools, operations=ops, variables=variables)
+
+
+def _check_title(title: str, c, program_number: int, source: str) -> None:
+    """The title goes into one block of the program's header: it must fit the control's block length."""
+    from ..gcode.text import iso_comment
+
+    text = iso_comment(title)
+    f = c.framing
+    block = f.program_word.format(program_number) + f" ({text})" if f.program_word else f.comment(text)
+    if len(block) > c.max_block:
+        raise InputError(f"{source}: title of {len(text):,} characters makes a block of {len(block):,}, more than "
+                         f"the {c.max_block} a {c.name} control reads in one block; shorten it to "
+                         f"{max(len(text) - (len(block) - c.max_block), 0)} characters")
 
 
 def _stock(table: dict, source: str) -> dict:
