@@ -226,3 +226,86 @@ def test_an_iges_file_named_with_accents_stays_ascii_with_true_counts(run_cli, t
     glob = "".join(line[:72] for line in lines if line[72] == "G")
     strings = _hollerith_strings(glob)
     assert strings[:4] == [",", ";", "piece-a-facon", "piece-a-facon.igs"]
+
+
+@pytest.mark.parametrize("dialect, limit", [("fanuc", 128), ("haas", 128), ("linuxcnc", 255)])
+def test_the_title_limits_docs_formats_quotes(dialect, limit):
+    from pathlib import Path
+
+    from lagsym.job.spec import parse_job
+
+    assert f"128 characters on a Fanuc or Haas, 255 on LinuxCNC" in (Path(__file__).parent.parent / "docs" /
+                                                                      "formats.md").read_text()
+    with pytest.raises(LagsymError, match=f"more than the {limit} a {dialect} control"):
+        parse_job(_job_data("T" * limit, dialect), "j.toml", Path("."))
+    assert parse_job(_job_data("T" * (limit - 12), dialect), "j.toml", Path(".")).dialect == dialect
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Internal errors: each of these was exit 70 with a Python error; now one line and exit 0-3.
+
+def _one_line(status, err, statuses=(2,)):
+    assert status in statuses, err
+    assert err.count("\n") <= 1 and "internal error" not in err and "Traceback" not in err, err
+
+
+def test_a_run_of_249_signs_is_read_as_their_parity(run_cli, tmp_path):
+    prog = tmp_path / "signs.ngc"
+    lines = ["#2=3."] + [f"#1={'-' * k}#2\nG1 X#1 F100." for k in (248, 249)] + ["#1=-+-+-#2\nG1 X#1", "M2"]
+    prog.write_text("\n".join(lines) + "\n")
+    status, out, err = run_cli("simulate", prog, "--dialect", "linuxcnc")
+    assert status == 0, err
+    xs = [float(row.split(",")[2]) for row in out.splitlines()[1:]]
+    assert xs == [(-1) ** k * 3.0 for k in (248, 249, 3)]
+
+
+def test_arcs_and_ends_beyond_any_travel_are_one_line(run_cli, tmp_path):
+    head = "G21 G90\nG0 X0. Y0. Z5.\nG1 Z-1. F100.\n"
+    cases = {"huge-ij.nc": "G02 X30. Y30. I1000000000000. J0.\n",
+             "long-end.nc": "G02 X" + "1" * 400 + ". Y30. I10. J0.\n",
+             "long-line.nc": "G01 X" + "1" * 400 + ".\n"}
+    for name, block in cases.items():
+        p = tmp_path / name
+        p.write_text(head + block + "M30\n")
+        status, out, err = run_cli("verify", EXAMPLE1, p, "--cell", "0.1")
+        _one_line(status, err, (0, 1, 2))
+        if name != "huge-ij.nc":
+            assert status == 2 and "beyond any machine's travel" in err
+
+
+def test_toml_nested_deep_and_a_nul_in_the_points_path_are_one_line(run_cli, tmp_path):
+    deep = tmp_path / "deep.toml"
+    deep.write_text("a=" + "[" * 100_000 + "]" * 100_000 + "\n")
+    status, out, err = run_cli("job", deep)
+    _one_line(status, err)
+    assert "nested too deep" in err
+    status, out, err = run_cli("dnc", "serve", deep, "--check")
+    _one_line(status, err)
+    nul = tmp_path / "nul.toml"
+    nul.write_text('points = "a\\u0000b.csv"\ntitle = "T"\n[stock]\ntop = 5\nmargin = 0\n'
+                   '[tools.b]\nnumber = 1\nshape = "ball"\ndiameter = 6\n[[operations]]\nkind = "finish"\ntool = "b"\n')
+    status, out, err = run_cli("job", nul)
+    _one_line(status, err)
+    assert "NUL" in err
+
+
+def test_a_formula_infinite_at_a_node_is_refused_in_the_growth_plot():
+    from lagsym.formula import parse_formula
+    from lagsym.plot.growth import degree_growth
+
+    with pytest.raises(LagsymError, match="division by zero"):
+        degree_growth(parse_formula("1/(x-x)"), (0, 1, 0, 1), degrees=[2], samples=5)
+
+
+def test_ctrl_c_while_the_command_loads_is_one_line(monkeypatch):
+    import io
+
+    import lagsym.cli as cli
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    err = io.StringIO()
+    assert cli.main(["equation", str(EXAMPLE1)], io.StringIO(), err) == 130
+    assert err.getvalue() == "lagsym: interrupted; nothing was written\n"

@@ -134,6 +134,8 @@ def load_config(path: str | Path) -> ServerConfig:
         raise InputError(f"{source}: not UTF-8 text (byte {e.start}); a configuration is a TOML text file") from None
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{source}: not TOML: {e}") from None
+    except RecursionError:
+        raise InputError(f"{source}: not a configuration: arrays or tables nested too deep to read") from None
     for key in data:
         if key != "port":
             raise _bad(source, key, "unknown key; the keys are port")

@@ -27,6 +27,8 @@ reading, not a Fanuc's least-input-increment one).
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -185,6 +187,10 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
                                "which a control never makes")
         if modal.motion is None:
             raise ProgramError(f"{where}: a coordinate before any G00, G01, G02 or G03")
+        if not all(math.isfinite(v) for v in target.values()):
+            bad = next(k for k, v in target.items() if not math.isfinite(v))
+            raise ProgramError(f"{where}: {bad} beyond any machine's travel (a number of over 300 digits) "
+                               f"in {raw.strip()[:60]!r}")
         offset = [target.pop(letter, 0.0) * modal.factor for letter in "IJK"]
         arc = modal.motion in (2, 3)
         if not arc and any(offset):

@@ -121,6 +121,8 @@ def read_job(path) -> JobSpec:
         data = tomllib.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
         raise InputError(f"{path}: not a valid TOML job file: {e}") from None
+    except RecursionError:
+        raise InputError(f"{path}: not a job file: arrays or tables nested too deep to read") from None
     return parse_job(data, str(path), Path(path).parent)
 
 
