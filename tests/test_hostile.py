@@ -309,3 +309,20 @@ def test_ctrl_c_while_the_command_loads_is_one_line(monkeypatch):
     err = io.StringIO()
     assert cli.main(["equation", str(EXAMPLE1)], io.StringIO(), err) == 130
     assert err.getvalue() == "lagsym: interrupted; nothing was written\n"
+
+
+def test_a_dnc_configuration_is_read_only_from_a_regular_file_within_its_limit(run_cli, tmp_path):
+    from lagsym.dnc.config import MAX_CONFIG_BYTES
+
+    status, out, err = run_cli("dnc", "serve", "/dev/zero", "--check")
+    _one_line(status, err)
+    assert "character device" in err
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    status, out, err = run_cli("dnc", "serve", fifo, "--check")  # would wait for a writer for ever
+    _one_line(status, err)
+    big = tmp_path / "big.toml"
+    big.write_text("# " + "x" * MAX_CONFIG_BYTES + "\n")
+    status, out, err = run_cli("dnc", "serve", big, "--check")
+    _one_line(status, err)
+    assert f"at most {MAX_CONFIG_BYTES} bytes" in err
