@@ -326,3 +326,9 @@ def test_a_dnc_configuration_is_read_only_from_a_regular_file_within_its_limit(r
     status, out, err = run_cli("dnc", "serve", big, "--check")
     _one_line(status, err)
     assert f"at most {MAX_CONFIG_BYTES} bytes" in err
+
+
+def test_decimals_too_coarse_for_the_path_name_the_option(run_cli):
+    status, out, err = run_cli("toolpath", EXAMPLE1, "--decimals", "0", "--stepover", "1", "--step", "1")
+    _one_line(status, err)
+    assert "--decimals" in err and "decimals 0 write positions 1 mm apart" in err and out == ""
