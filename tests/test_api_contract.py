@@ -158,3 +158,23 @@ def test_public_functions_answer_hostile_values_with_a_lagsym_error(which, a, b)
         CALLS[which](a, b)
     except LagsymError as e:
         assert "\n" not in str(e)
+
+
+def test_the_limits_the_docs_quote_are_the_ones_in_force():
+    from pathlib import Path
+
+    from lagsym.dnc.config import MAX_CONFIG_BYTES
+    from lagsym.lagrange import MAX_NAME
+    from lagsym.toolpath.pattern import MAX_LEVELS
+
+    docs = Path(__file__).resolve().parent.parent / "docs"
+    assert f"`MAX_LEVELS` ({MAX_LEVELS:,})" in (docs / "api.md").read_text()
+    assert f"at most {MAX_CONFIG_BYTES} bytes, UTF-8 TOML" in (docs / "formats.md").read_text()
+    assert f"at most {MAX_NAME} characters" in (docs / "equations.md").read_text()
+    # And in force: one past each limit is refused.
+    with pytest.raises(LagsymError):
+        lagsym.raster_pattern((0, MAX_LEVELS, 0, 1), "x", 1.0, 1.0)
+    assert len(lagsym.raster_pattern((0, MAX_LEVELS - 2, 0, 1), "x", 1.0, 1.0)[1]) == MAX_LEVELS - 1
+    with pytest.raises(LagsymError):
+        lagsym.lagrange_surface(lagsym.grid_from_points(GRID), x="a" * (MAX_NAME + 1))
+    assert lagsym.lagrange_surface(lagsym.grid_from_points(GRID), x="a" * MAX_NAME).variables[0] == "a" * MAX_NAME
