@@ -178,3 +178,40 @@ def test_the_limits_the_docs_quote_are_the_ones_in_force():
     with pytest.raises(LagsymError):
         lagsym.lagrange_surface(lagsym.grid_from_points(GRID), x="a" * (MAX_NAME + 1))
     assert lagsym.lagrange_surface(lagsym.grid_from_points(GRID), x="a" * MAX_NAME).variables[0] == "a" * MAX_NAME
+
+
+# Generated programs in every dialect and generated job tables: a value or a LagsymError, nothing else.
+GCODE = "GXYZIJKFMNOQ#[]=+-*/.0123456789 \nWHILEDOENDIFGOTO<>LBLFN:CALL\u0661"
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.sampled_from(["fanuc", "haas", "linuxcnc", "heidenhain"]), st.text(alphabet=GCODE, max_size=120))
+def test_generated_programs_in_every_dialect_answer_with_a_lagsym_error(dialect, text):
+    try:
+        lagsym.simulate(text, dialect, max_blocks=2000, max_idle_blocks=1000)
+    except LagsymError as e:
+        assert "\n" not in str(e)
+
+
+_LEAF = st.one_of(st.none(), st.booleans(), st.integers(-10**20, 10**20), st.floats(), st.text(max_size=8))
+_VALUE = st.recursive(_LEAF, lambda c: st.one_of(st.lists(c, max_size=4), st.dictionaries(
+    st.sampled_from(["tool", "kind", "number", "shape", "diameter", "top", "block", "margin", "a"]), c, max_size=4)),
+    max_leaves=10)
+_KEYS = st.sampled_from(["points", "title", "stock", "tools", "operations", "dialect", "units", "scale", "origin",
+                         "work_offset", "program_number", "safe_z", "rapid", "variables"])
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.dictionaries(_KEYS, _VALUE, max_size=4), st.booleans())
+def test_generated_job_tables_answer_with_a_lagsym_error(changes, onto_a_good_job):
+    from pathlib import Path
+
+    from lagsym.job.spec import parse_job
+
+    good = {"points": "p.csv", "stock": {"block": [0, 10, 0, 10], "top": 5},
+            "tools": {"b": {"number": 1, "shape": "ball", "diameter": 6}},
+            "operations": [{"kind": "finish", "tool": "b"}]}
+    try:
+        parse_job({**good, **changes} if onto_a_good_job else changes, "j.toml", Path("."))
+    except LagsymError as e:
+        assert "\n" not in str(e)
