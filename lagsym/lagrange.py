@@ -217,7 +217,7 @@ class LagrangeCurve:
     variable: str | sympy.Symbol = "x"
 
     def __post_init__(self):
-        object.__setattr__(self, "variable", _variable(self.variable, "x"))
+        _variable(self.variable, "x")  # checked; kept as given (a plain symbol stays a symbol)
 
     @cached_property
     def symbol(self) -> sympy.Symbol:
@@ -289,7 +289,8 @@ class LagrangeSurface:
     def __post_init__(self):
         if not isinstance(self.variables, (tuple, list)) or len(self.variables) != 2:
             raise InputError(f"variables = {self.variables!r} is not a pair of names or symbols")
-        object.__setattr__(self, "variables", (_variable(self.variables[0], "x"), _variable(self.variables[1], "y")))
+        _variable(self.variables[0], "x"), _variable(self.variables[1], "y")  # checked; kept as given
+        object.__setattr__(self, "variables", tuple(self.variables))
 
     @cached_property
     def symbols(self) -> tuple[sympy.Symbol, sympy.Symbol]:
