@@ -17,8 +17,9 @@ the rich display of surfaces and curves, their equation and a small figure;
 
 from __future__ import annotations
 
-import importlib
-import sys
+import importlib as _importlib
+import sys as _sys
+import types as _types
 from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
@@ -62,13 +63,33 @@ def __getattr__(name: str):
     module = _WHERE.get(name)
     if module is None:
         raise AttributeError(f"module 'lagsym' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    value = getattr(_importlib.import_module(f".{module}", __name__), name)
     globals()[name] = value  # later look-ups skip this function
     return value
 
 
+_HIDDEN = {"annotations", "TYPE_CHECKING"}  # module-level machinery, not part of the API
+
+
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    return sorted((set(globals()) - _HIDDEN) | set(__all__))
+
+
+class _Package(_types.ModuleType):
+    """The package object: a public name that is also a subpackage's name stays the public value.
+
+    Importing ``lagsym.simulate`` makes Python set the attribute ``simulate`` of
+    the package to the subpackage, which would shadow the function of that
+    name (``from lagsym import *`` gave a module that cannot be called).
+    """
+
+    def __setattr__(self, name, value):
+        if isinstance(value, _types.ModuleType) and _WHERE.get(name) == name and value.__name__ == f"{__name__}.{name}":
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
 
 
 def load_ipython_extension(ipython) -> None:
@@ -90,12 +111,12 @@ def _rich_html(value):
     # Imported on the first display, which pays for pyvista, not the import.  By name, like the
     # exports above: the package facade reaches each layer only on demand, at run time; a static
     # import here would put every module that reads lagsym.__version__ above the plot layer.
-    return importlib.import_module(".plot.inline", __name__).rich_html(value)
+    return _importlib.import_module(".plot.inline", __name__).rich_html(value)
 
 
 def _register_in_running_ipython() -> None:
     """Register the rich display when imported inside an IPython shell; never import IPython here."""
-    ipython = sys.modules.get("IPython")
+    ipython = _sys.modules.get("IPython")
     get_ipython = getattr(ipython, "get_ipython", None)
     shell = get_ipython() if callable(get_ipython) else None
     if getattr(shell, "display_formatter", None) is not None:

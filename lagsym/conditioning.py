@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 
@@ -124,10 +125,20 @@ def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float,
     >>> round(value, 1), 0 < at < 1 or 10 < at < 11
     (51.2, True)
     """
-    raw = np.sort(np.asarray([float(v) for v in nodes]))
+    exact = sorted(Fraction(v) for v in nodes)
+    raw = np.asarray([float(v) for v in exact])
     if len(raw) < 2:
         return 1.0, float(raw[0]) if len(raw) else 0.0
-    s = (raw - raw[0]) / (raw[-1] - raw[0])
+    # The nodes scaled to [0, 1] exactly, then rounded: the constant does not change under scaling, and
+    # nodes that differ far below a float's resolution at their size are still told apart.
+    span = exact[-1] - exact[0]
+    s = np.asarray([float((v - exact[0]) / span) for v in exact]) if span else np.zeros(len(exact))
+    close = np.flatnonzero(np.diff(s) <= 0)
+    if close.size:
+        a, b = exact[close[0]], exact[close[0] + 1]
+        raise ConditioningError(f"nodes {_decimal(a)} and {_decimal(b)} are {'equal' if a == b else 'closer'} "
+                                f"than floating point can tell apart over their span of {_decimal(span)}: the "
+                                f"Lebesgue constant is beyond any limit; space the nodes further apart")
     diff = np.abs(s[:, None] - s[None, :])
     np.fill_diagonal(diff, 1.0)
     logw = -np.log(diff).sum(axis=1)
@@ -147,6 +158,22 @@ def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float,
         lo, hi = np.maximum(centre - step, lo), np.minimum(centre + step, hi)
     i = int(best.argmax())
     return float(np.exp(best[i])), float(raw[0] + where[i] * (raw[-1] - raw[0]))
+
+
+def _decimal(v: Fraction) -> str:
+    """An exact node as the user wrote it: a decimal where it has one (1.0000000000000000000001), else p/q."""
+    d = v.denominator
+    while d % 2 == 0:
+        d //= 2
+    while d % 5 == 0:
+        d //= 5
+    if d != 1 or v.denominator > 10**60:
+        return str(v)
+    from decimal import Decimal, localcontext
+
+    with localcontext() as ctx:
+        ctx.prec = 80
+        return format(Decimal(v.numerator) / Decimal(v.denominator), "f")
 
 
 @dataclass(frozen=True)

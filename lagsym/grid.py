@@ -16,6 +16,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 from .errors import GridError, InputError
+from .values import choice
 
 if TYPE_CHECKING:
     import numpy as np
@@ -78,6 +79,9 @@ class ControlGrid:
     units: str | None = field(default=None, compare=False)
     amplification: float | None = field(default=None, compare=False)
 
+    def __post_init__(self):
+        _check_units(self.units)
+
     @property
     def shape(self) -> tuple[int, int]:
         """``(n, m)``: the number of nodes in x and in y."""
@@ -122,6 +126,14 @@ class ControlGrid:
         return grid_from_table(self.x, self.y, z, source=self.source, units=self.units)
 
 
+POINT_UNITS = ("mm", "inch")  # the units a points file may name (None: it names none)
+
+
+def _check_units(units) -> None:
+    if units is not None:
+        choice(units, POINT_UNITS, "units")
+
+
 @dataclass(frozen=True)
 class CurvePoints:
     """Nodes ``x[0] < ... < x[n-1]`` and values ``y[i]`` of a 1-D curve, exact (``units`` as for a grid)."""
@@ -130,6 +142,9 @@ class CurvePoints:
     y: tuple[Fraction, ...]
     source: str = field(default="<points>", compare=False)
     units: str | None = field(default=None, compare=False)
+
+    def __post_init__(self):
+        _check_units(self.units)
 
     @property
     def degree(self) -> int:

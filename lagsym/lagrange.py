@@ -22,6 +22,7 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
+import keyword
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -31,6 +32,7 @@ from typing import TYPE_CHECKING
 import flint
 
 from .errors import InputError
+from .values import as_exact
 
 from .grid import ControlGrid, CurvePoints
 
@@ -63,14 +65,34 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+MAX_NAME = 64  # characters in a variable's name
+
+
+def check_name(name, what: str = "variable") -> str:
+    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword).
+
+    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
+    writes and the Python text of ``lagsym equation --format python``: a name that is
+    not a plain identifier could be read there as code, so it is refused here, where
+    the value is made.
+    """
+    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
+                                         and name.isidentifier() and not keyword.iskeyword(name)):
+        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
+        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
+                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
+    return name
+
+
 def _variable(value, what: str):
     """A variable as the value keeps it: a plain symbol by its name (no SymPy needed), any other symbol itself."""
     if isinstance(value, str):
-        return value
+        return check_name(value, what)
     import sympy
 
     if not isinstance(value, sympy.Symbol):
         raise InputError(f"{what} = {value!r} is not a SymPy symbol or a name")
+    check_name(value.name, what)
     return value.name if type(value) is sympy.Symbol and value == sympy.Symbol(value.name) else value
 
 
@@ -108,6 +130,32 @@ def _basis_matrix(nodes: tuple[Fraction, ...]) -> flint.fmpq_mat:
     return flint.fmpq_mat(n, n, rows)
 
 
+def _node(v, i: int) -> Fraction:
+    # Text by the one exact-number policy (which bounds its exponent); a number as its exact value.
+    if isinstance(v, str) or isinstance(v, bool):
+        return as_exact(v, f"node {i}")
+    try:
+        return Fraction(v)
+    except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+        raise InputError(f"node {i} = {v!r:.80} is not a finite number") from None
+
+
+def _distinct_nodes(nodes) -> tuple[Fraction, ...]:
+    """``nodes`` as exact rationals, checked: a basis needs at least one node and no two alike."""
+    try:
+        values = tuple(_node(v, i) for i, v in enumerate(nodes))
+    except TypeError:
+        raise InputError(f"nodes = {nodes!r:.80} is not a sequence of numbers") from None
+    if not values:
+        raise InputError("nodes = () is empty: a basis needs at least one node")
+    seen: dict[Fraction, int] = {}
+    for i, v in enumerate(values):
+        if v in seen:
+            raise InputError(f"nodes {seen[v]} and {i} are both {v}: a Lagrange basis needs distinct nodes")
+        seen[v] = i
+    return values
+
+
 def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     """Power-basis coefficients of the Lagrange basis on ``nodes``.
 
@@ -118,7 +166,7 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     >>> basis_coefficients([1, 2, 3])[0]
     (Fraction(3, 1), Fraction(-5, 2), Fraction(1, 2))
     """
-    nodes = tuple(Fraction(v) for v in nodes)
+    nodes = _distinct_nodes(nodes)
     m = _basis_matrix(nodes)
     n = len(nodes)
     return tuple(tuple(_frac(m[i, a]) for a in range(n)) for i in range(n))
@@ -132,7 +180,7 @@ def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly,
     >>> [p.as_expr() for p in lagrange_basis([1, 2, 3])][1]
     -x**2 + 4*x - 3
     """
-    (symbol,) = _symbols_of((symbol,))
+    (symbol,) = _symbols_of((_variable(symbol, "symbol"),))
     return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes))
 
 
@@ -167,6 +215,9 @@ class LagrangeCurve:
     points: CurvePoints
     coefficients: tuple[Fraction, ...]
     variable: str | sympy.Symbol = "x"
+
+    def __post_init__(self):
+        _variable(self.variable, "x")  # checked; kept as given (a plain symbol stays a symbol)
 
     @cached_property
     def symbol(self) -> sympy.Symbol:
@@ -234,6 +285,12 @@ class LagrangeSurface:
     grid: ControlGrid
     coefficients: tuple[tuple[Fraction, ...], ...]
     variables: tuple[str | sympy.Symbol, str | sympy.Symbol] = ("x", "y")
+
+    def __post_init__(self):
+        if not isinstance(self.variables, (tuple, list)) or len(self.variables) != 2:
+            raise InputError(f"variables = {self.variables!r} is not a pair of names or symbols")
+        _variable(self.variables[0], "x"), _variable(self.variables[1], "y")  # checked; kept as given
+        object.__setattr__(self, "variables", tuple(self.variables))
 
     @cached_property
     def symbols(self) -> tuple[sympy.Symbol, sympy.Symbol]:

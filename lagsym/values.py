@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from decimal import Decimal, InvalidOperation
 from fractions import Fraction
 
 from .errors import InputError
 
-__all__ = ["as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
+__all__ = ["FrozenMap", "frozen", "as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
            "NotANumber", "MAX_EXPONENT"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
@@ -218,4 +218,60 @@ def choice(value, options: Iterable, what: str):
     options = tuple(options)
     if value not in options:
         raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
+    return value
+
+
+class FrozenMap(Mapping):
+    """A read-only mapping for the tables a frozen value holds (a job's stock, tools, an operation's options).
+
+    Made from a mapping, whose dicts become frozen maps and lists tuples, all the way down, so the value that
+    holds it cannot be changed through it.  Equal to any mapping with the same items; pickles (for worker
+    processes) and hashes where its values do.
+
+    Examples
+    --------
+    >>> m = FrozenMap({"block": [0, 1], "top": 5})
+    >>> m["block"], m == {"block": (0, 1), "top": 5}
+    ((0, 1), True)
+    >>> m["top"] = 6
+    Traceback (most recent call last):
+    ...
+    TypeError: 'FrozenMap' object does not support item assignment
+    """
+
+    __slots__ = ("_items",)
+
+    def __init__(self, items=()):
+        object.__setattr__(self, "_items", {key: frozen(value) for key, value in dict(items).items()})
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"a {type(self).__name__} is read-only")
+
+    def __getitem__(self, key):
+        return self._items[key]
+
+    def __iter__(self):
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __hash__(self) -> int:
+        return hash(frozenset(self._items.items()))
+
+    def __repr__(self) -> str:
+        return f"FrozenMap({self._items!r})"
+
+    def __reduce__(self):
+        return (FrozenMap, (self._items,))
+
+
+def frozen(value):
+    """``value`` with every dict made a :class:`FrozenMap` and every list or tuple a tuple, all the way down."""
+    if isinstance(value, FrozenMap):
+        return value
+    if isinstance(value, Mapping):
+        return FrozenMap(value)
+    if type(value) in (list, tuple):  # a named tuple is a value of its own, kept as it is
+        return tuple(frozen(v) for v in value)
     return value

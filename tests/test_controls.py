@@ -168,7 +168,7 @@ def test_a_haas_macro_runs_in_the_simulator_at_haas_precision_as_the_fanuc_macro
 def test_the_simulator_keeps_to_the_haas_variables():
     program = "#700=1.\nG1 X#700 Y0. Z0. F100.\nM30\n"
     assert len(simulate(program, "fanuc").moves) == 1  # a Fanuc's #700 is a common variable
-    with pytest.raises(lagsym.simulate.ControlAlarm, match="variable 700 is outside"):
+    with pytest.raises(lagsym.ControlAlarm, match="variable 700 is outside"):
         simulate(program, "haas")  # a Haas keeps #700-#799 for itself
 
 

@@ -123,31 +123,55 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None
     return parser
 
 
+MAX_MESSAGE = 2_000  # characters of one error line; a longer message (a quoted field of a file) is cut in the middle
+
+
+def one_line(message: str) -> str:
+    """``message`` as one printable line: a newline or other control character in a name is escaped, a long one cut.
+
+    Examples
+    --------
+    >>> one_line("bad\\nname.csv: no such file")
+    'bad\\\\nname.csv: no such file'
+    """
+    text = message if message.isprintable() else "".join(
+        c if c.isprintable() else repr(c)[1:-1] for c in message)
+    if len(text) <= MAX_MESSAGE:
+        return text
+    half = MAX_MESSAGE // 2  # the head names the value, the tail says what is wrong with it
+    return f"{text[:half]}...[{len(text) - 2 * half:,} characters]...{text[-half:]}"
+
+
 def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stderr: IO[str] | None = None) -> int:
     """Run the ``lagsym`` command line and return its exit status."""
     out = stdout if stdout is not None else sys.stdout
     err = stderr if stderr is not None else sys.stderr
     argv = list(sys.argv[1:] if argv is None else argv)
-    chosen = _chosen(argv)
-    parser = build_parser(out, err, load=() if chosen is None else (chosen,))
-    try:
-        args = parser.parse_args(argv)
-    except _ParserExit as e:
-        return int(e.status)
+    try:  # Ctrl-C while the command's modules load: one line, as later
+        chosen = _chosen(argv)
+        parser = build_parser(out, err, load=() if chosen is None else (chosen,))
+        try:
+            args = parser.parse_args(argv)
+        except _ParserExit as e:
+            return int(e.status)
+    except KeyboardInterrupt:
+        err.write("lagsym: interrupted; nothing was written\n")
+        return ExitStatus.INTERRUPTED
     if not getattr(args, "_run", None):
         parser.print_help(out)
         return ExitStatus.BAD_INPUT
     keep_freed_memory()  # large temporaries reused rather than faulted in afresh (lagsym.allocator)
     try:
-        from ._common import in_program_units
+        from ._common import check_paths, in_program_units
 
         in_program_units(args)
-        with _signals_as_interrupts():
+        check_paths(args)
+        with _signals_as_interrupts(), _notices(err):
             return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
-        err.write(f"lagsym: error: {e}\n")
+        err.write(f"lagsym: error: {one_line(str(e))}\n")
         return int(e.exit_status)
     except Terminated as e:
         err.write(f"lagsym: stopped by {signal.Signals(e.signum).name}; no partial output file is left\n")
@@ -161,8 +185,30 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
         else:
-            err.write(f"lagsym: internal error: {type(e).__name__}: {e} (run again with --traceback and report it)\n")
+            err.write(f"lagsym: internal error: {type(e).__name__}: {one_line(str(e))} "
+                      f"(run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+@contextlib.contextmanager
+def _notices(err: IO[str]):
+    """An :class:`~lagsym.io.OutputNotice` from the library as one line on ``err``; other warnings as before."""
+    import warnings
+
+    from ..io import OutputNotice
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", OutputNotice)
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, OutputNotice):
+                err.write(f"lagsym: note: {one_line(str(message))}\n")
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        yield
 
 
 @contextlib.contextmanager
@@ -186,4 +232,9 @@ def _signals_as_interrupts():
 
 def run_console() -> None:
     """Entry point of the installed ``lagsym`` script."""
-    sys.exit(main())
+    try:
+        status = main()
+    except KeyboardInterrupt:  # between main's own handlers (a second Ctrl-C)
+        sys.stderr.write("lagsym: interrupted\n")
+        status = ExitStatus.INTERRUPTED
+    sys.exit(status)

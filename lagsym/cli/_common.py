@@ -13,6 +13,24 @@ from ..controls import CONTROLS, work_offset
 from ..values import as_exact, finite, in_range, whole
 
 
+def check_paths(args) -> None:
+    """Before any work: ``-o`` must be a path that can be written, and not one of the command's input files."""
+    from ..io import check_not_input, check_output
+
+    output = getattr(args, "output", None)
+    if not output or output == "-" or not isinstance(output, str):
+        return
+    check_output(output)
+    inputs = []
+    for name, value in vars(args).items():
+        if name in ("output", "log"):
+            continue
+        for v in value if isinstance(value, (list, tuple)) else (value,):
+            if isinstance(v, str) and v and v != "-" and "\x00" not in v:
+                inputs.append(v)
+    check_not_input(output, inputs)
+
+
 def emit(text: str, output: str | None, out: IO[str]) -> None:
     """Write ``text`` (plus a final newline) to the file ``output``, atomically, or to ``out``."""
     if not text.endswith("\n"):

@@ -11,9 +11,12 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import InputError, LagsymError
+from ..io.files import read_bytes
 from .settings import LineSettings, check_port, profile
 
-__all__ = ["PortConfig", "ServerConfig", "load_config"]
+__all__ = ["PortConfig", "ServerConfig", "load_config", "MAX_CONFIG_BYTES"]
+
+MAX_CONFIG_BYTES = 1024 * 1024  # a configuration of many ports is a few kilobytes
 
 _LINE_KEYS = {f.name for f in fields(LineSettings)}
 
@@ -126,14 +129,15 @@ def load_config(path: str | Path) -> ServerConfig:
         TOML, holds an unknown key or a bad value.
     """
     source = str(path)
+    raw = read_bytes(path, "a DNC configuration", MAX_CONFIG_BYTES)  # a regular file, within a limit: never /dev/zero
     try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as e:
-        raise InputError(f"{source}: cannot read the configuration ({e.strerror or e})") from None
+        data = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError as e:
         raise InputError(f"{source}: not UTF-8 text (byte {e.start}); a configuration is a TOML text file") from None
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{source}: not TOML: {e}") from None
+    except RecursionError:
+        raise InputError(f"{source}: not a configuration: arrays or tables nested too deep to read") from None
     for key in data:
         if key != "port":
             raise _bad(source, key, "unknown key; the keys are port")

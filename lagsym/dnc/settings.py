@@ -127,12 +127,15 @@ class LineSettings:
             raise InputError(f"baud rate {self.baud!r} must be a whole number from 50 to 4000000")
         choice(self.bytesize, (5, 6, 7, 8), "data bits")
         choice(self.parity, tuple(PARITIES), "parity")
-        object.__setattr__(self, "stopbits", float(self.stopbits))
+        if isinstance(self.stopbits, (int, float)) and not isinstance(self.stopbits, bool):
+            object.__setattr__(self, "stopbits", float(self.stopbits))
         choice(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
         choice(self.flow, FLOW_CONTROLS, "flow control")
         choice(self.line_ending, tuple(LINE_ENDINGS), "end of block")
         for name in ("leader", "trailer"):
             text = getattr(self, name)
+            if not isinstance(text, str):
+                raise InputError(f"{name} {text!r:.80} must be text")
             if any(ord(c) in (DC1, DC2, DC3, DC4) or ord(c) > 127 for c in text):
                 raise InputError(f"{name} {text!r} holds a character the line cannot carry or that steers it")
         choice(self.carrier, CARRIERS, "carrier signal")

@@ -8,6 +8,7 @@ import flint
 import numpy as np
 
 from .._arrays import readonly as _readonly
+from .arguments import coordinates, of_type
 from .cache import ObjectCache
 from .chebyshev import chebyshev_basis, chebyshev_transform, data_range, fmpq, fraction
 
@@ -50,4 +51,6 @@ _CURVES: ObjectCache[CurveEvaluator] = ObjectCache(_make_evaluator)
 
 def evaluate_curve(curve, x) -> np.ndarray:
     """Evaluate a :class:`~lagsym.lagrange.LagrangeCurve` at ``x`` (any shape)."""
-    return curve_evaluator(curve)(x)
+    from ..lagrange import LagrangeCurve
+
+    return curve_evaluator(of_type(curve, LagrangeCurve, "curve"))(coordinates(x, "x"))

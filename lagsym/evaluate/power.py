@@ -72,9 +72,9 @@ def lambdify_surface(surface):
     """
     import sympy
 
-    from ..lagrange import X, Y
-
-    raw = sympy.lambdify((X, Y), surface.expr, modules="numpy")
+    # The surface's own symbols, whose names its construction checked: a name is written into the code
+    # lambdify generates, and an expression in symbols the arguments do not name would fail or worse.
+    raw = sympy.lambdify(surface.symbols, surface.expr, modules="numpy")
 
     def f(x, y):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
+from .arguments import a_surface, broadcast_pair, coordinates
 from .bounds import chebyshev_error_bound
 from .cache import ObjectCache
 from .engine import COMPILED_POINTS, Engine, current_engine
@@ -438,9 +439,9 @@ _SURFACES: ObjectCache[SurfaceEvaluator] = ObjectCache(_make_evaluator)
 
 def evaluate_points(surface, x, y) -> np.ndarray:
     """Evaluate a surface at scattered points; ``x`` and ``y`` broadcast together."""
-    return surface_evaluator(surface).points(x, y)
+    return surface_evaluator(a_surface(surface)).points(*broadcast_pair(x, y))
 
 
 def evaluate_grid(surface, xs, ys) -> np.ndarray:
     """Evaluate a surface on the grid ``xs`` x ``ys``; result ``Z[i, j] = F(xs[i], ys[j])``."""
-    return surface_evaluator(surface).grid(xs, ys)
+    return surface_evaluator(a_surface(surface)).grid(coordinates(xs, "xs"), coordinates(ys, "ys"))

@@ -16,6 +16,7 @@ directory (D, two lines per entity), parameter data (P) and terminate (T).
 from __future__ import annotations
 
 import time
+import unicodedata
 from fractions import Fraction
 from typing import IO
 
@@ -23,13 +24,28 @@ from ..cad.patch import BSplinePatch
 from ..cad.solid import check_base
 from .cadtext import check_units, real
 
-__all__ = ["write_iges", "closing_patches"]
+__all__ = ["write_iges", "closing_patches", "ascii_name"]
 
 _UNIT_FLAGS = {"mm": (2, "MM"), "inch": (1, "INCH")}
 
 
 def _hollerith(text: str) -> str:
+    # IGES counts a Hollerith string in characters of its ASCII file: the text must be ASCII, so bytes are characters.
+    if not text.isascii():
+        raise ValueError(f"Hollerith text {text!r} is not ASCII")
     return f"{len(text)}H{text}"
+
+
+def ascii_name(name: str) -> str:
+    """The product name as an IGES file can hold it: ASCII (accents dropped: ``pièce`` is ``piece``), no delimiters.
+
+    Examples
+    --------
+    >>> ascii_name("pièce-à-façon"), ascii_name("Ø6;,"), ascii_name("日本")
+    ('piece-a-facon', '6', 'surface')
+    """
+    plain = unicodedata.normalize("NFKD", name).encode("ascii", "ignore").decode("ascii")
+    return "".join(c for c in plain if c.isprintable() and c not in ",;") or "surface"
 
 
 def _records(tokens: list[str], width: int) -> list[str]:
@@ -108,7 +124,7 @@ def write_iges(stream: IO[str], patch: BSplinePatch, *, base_z: Fraction | None 
     check_units(units)
     if base_z is not None:
         base_z = check_base(patch, base_z, source)
-    name = "".join(c for c in name if c.isprintable() and c not in ",;") or "surface"
+    name = ascii_name(name)
     surfaces = [patch] + (closing_patches(patch, base_z) if base_z is not None else [])
     stamp = timestamp or time.strftime("%Y%m%d.%H%M%S", time.gmtime())
     largest = max(abs(float(c)) for s in surfaces for row in s.control_points for p in row for c in p)

@@ -58,6 +58,8 @@ def arc_points(start, end, offset, plane: int, ccw: bool, where: str = "<program
     u0, v0 = s[a] - c[a], s[b] - c[b]
     u1, v1 = e[a] - c[a], e[b] - c[b]
     r0, r1 = math.hypot(u0, v0), math.hypot(u1, v1)
+    if not all(math.isfinite(v) for v in (*s, *e, *c, r0, r1)):
+        raise ProgramError(f"{where}: an arc beyond any machine's travel (centre {c[a]:g}, {c[b]:g})")
     if r0 == 0.0 or r1 == 0.0:
         raise ProgramError(f"{where}: an arc whose centre is on its start or end")
     t0, t1 = math.atan2(v0, u0), math.atan2(v1, u1)
@@ -65,7 +67,9 @@ def arc_points(start, end, offset, plane: int, ccw: bool, where: str = "<program
     if abs(sweep) < 1e-12 and math.hypot(u1 - u0, v1 - v0) < 1e-9:
         sweep = 2 * math.pi if ccw else -2 * math.pi  # end on the start: a full circle
     r = max(r0, r1)
-    per = 2.0 * math.acos(max(-1.0, 1.0 - ARC_SAG_MM / r)) if r > ARC_SAG_MM else math.pi / 2
+    # The angle of a chord that sags ARC_SAG_MM, 2 acos(1 - sag/r), written so that it stays above 0 for any
+    # radius: 1 - sag/r rounds to 1 above r = 1e11 mm, and the arc would need 1/0 pieces.
+    per = 4.0 * math.asin(math.sqrt(ARC_SAG_MM / (2.0 * r))) if r > ARC_SAG_MM else math.pi / 2
     pieces = max(1, int(math.ceil(abs(sweep) / per)))
     if pieces > MAX_PIECES:
         raise ProgramError(f"{where}: an arc of radius {r:g} mm turning {abs(sweep):g} rad would take {pieces} "

@@ -27,6 +27,8 @@ reading, not a Fanuc's least-input-increment one).
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +37,7 @@ from .._arrays import freeze_fields
 from ..errors import ProgramError
 from ..machine import mm_per_program_unit
 from .arcs import arc_points
-from .program import END_M, program_blocks, unrun_code
+from .program import END_M, ascii_program, program_blocks, unrun_code
 from .words import WordError, numeric_words, plain_move
 
 __all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
@@ -156,6 +158,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
     >>> m.points_mm.tolist(), m.rapid.tolist()
     ([[1.0, 2.0, 0.0], [1.0, 2.0, -0.5], [3.0, 2.0, -0.5]], [True, False, False])
     """
+    ascii_program(text, source)
     pos = [0.0, 0.0, 0.0]
     start = tuple(pos)
     modal = _Modal()
@@ -184,6 +187,10 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
                                "which a control never makes")
         if modal.motion is None:
             raise ProgramError(f"{where}: a coordinate before any G00, G01, G02 or G03")
+        if not all(math.isfinite(v) for v in target.values()):
+            bad = next(k for k, v in target.items() if not math.isfinite(v))
+            raise ProgramError(f"{where}: {bad} beyond any machine's travel (a number of over 300 digits) "
+                               f"in {raw.strip()[:60]!r}")
         offset = [target.pop(letter, 0.0) * modal.factor for letter in "IJK"]
         arc = modal.motion in (2, 3)
         if not arc and any(offset):
@@ -245,6 +252,7 @@ def tool_changes(text: str, source: str = "<program>") -> list[tuple[int, int]]:
     >>> tool_changes("T1 M06\\nG00 X0 Y0\\nT2\\nM6\\n")
     [(1, 1), (4, 2)]
     """
+    ascii_program(text, source)
     out, tool = [], None
     for no, raw, block in program_blocks(text):
         try:

@@ -22,10 +22,11 @@ from __future__ import annotations
 
 import re
 
+from ..errors import ProgramError
 from ..values import choice
 from .words import WordError, numeric_words, strip_comments, words
 
-__all__ = ["MACRO_USES", "PASSED_G", "PLAIN_M", "END_M", "unrun_code", "program_blocks", "program_units", "macro_uses", "is_macro", "first_line_with"]
+__all__ = ["ascii_program", "MACRO_USES", "PASSED_G", "PLAIN_M", "END_M", "unrun_code", "program_blocks", "program_units", "macro_uses", "is_macro", "first_line_with"]
 
 MACRO_USES = ("variable", "expression", "loop", "jump", "condition", "call", "return")
 """What :func:`macro_uses` names: ``#`` variables; ``[..]`` expressions; loops (``WHILE .. DO``, ``END``,
@@ -107,6 +108,22 @@ _SPACE = f"[^\\S{_EOL}]*"  # space within a line, as numeric_words allows betwee
 _HINT = re.compile(f"[#\\[OoWwIiEe]|[Mm]{_SPACE}\\+?0*9[89]|[Gg]{_SPACE}\\+?0*6[56]")
 _UNITS_HINT = re.compile(f"[Gg]{_SPACE}\\+?0*2[01]")
 _PERCENT = re.compile(f"(?:^|(?<=[{_EOL}]))[^\\S{_EOL}]*%")
+
+
+def ascii_program(text, source: str = "<program>") -> str:
+    """``text`` if it is a program's text in ASCII; else a ProgramError naming the line and the character.
+
+    A control reads ASCII: a digit of another script (Arabic-Indic, full width), which Python's
+    ``\\d`` and ``float`` would take as a digit, is refused rather than read as a number.
+    """
+    if not isinstance(text, str):
+        raise ProgramError(f"{source}: {type(text).__name__} {text!r:.60} is not a program's text (a str)")
+    if text.isascii():
+        return text
+    at = next(i for i, c in enumerate(text) if ord(c) > 127)
+    line = text.count("\n", 0, at) + 1
+    raise ProgramError(f"{source}, line {line}: character {text[at]!r} (U+{ord(text[at]):04X}) is not ASCII; "
+                       f"a control reads ASCII programs")
 
 
 def program_blocks(text: str):

@@ -26,7 +26,7 @@ from .points import (
     read_scattered_points,
     surface_file,
 )
-from .write import atomic_path, atomic_write, check_output, write_text
+from .write import OutputNotice, atomic_path, atomic_write, check_not_input, check_output, write_text
 
 __all__ = [
     "read_points",
@@ -50,6 +50,8 @@ __all__ = [
     "atomic_write",
     "write_text",
     "check_output",
+    "check_not_input",
+    "OutputNotice",
     "MAX_BYTES",
     "STDIN_SILENCE_S",
     "TABLE_SUFFIXES",

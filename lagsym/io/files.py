@@ -37,6 +37,8 @@ def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> by
     name = str(path)
     if name in STDIN_NAMES:
         return _read_stdin(what, limit)
+    if "\x00" in name:
+        raise InputError(f"{name!r}: a file name cannot hold a NUL character")
     try:
         fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
     except FileNotFoundError:

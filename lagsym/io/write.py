@@ -1,8 +1,12 @@
 """Writing results: a file appears complete or not at all, and what is at the path is respected.
 
-A regular file is replaced in one rename (keeping its permissions, and its
-hard links by rewriting in place), a symbolic link is followed, and a device,
-pipe or ``/dev/stdout`` is written through once the content is complete.
+A regular file, or a new name, is always replaced in one rename of a
+temporary file written beside it (keeping an existing file's permissions; a
+file with other hard links becomes a new file, and :class:`OutputNotice` says
+the other links keep the old content); a symbolic link is followed; a device,
+pipe or socket, told by what it is (``stat``), not by its name, is written
+through once the content is complete.  An output that is one of the inputs is
+refused before any work (:func:`check_not_input`).
 """
 
 from __future__ import annotations
@@ -10,51 +14,141 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import secrets
 import shutil
 import stat
 import tempfile
-from collections.abc import Iterator
+import warnings
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
 from ..errors import InputError, OutputError
 
-__all__ = ["atomic_path", "atomic_write", "write_text", "check_output"]
+__all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "OutputNotice",
+           "temporary_name"]
+
+SUFFIX_KEPT = 16  # characters of the target's extension the temporary keeps (meshio and VTK choose a format by it)
 
 
-def _write_error(path, e: OSError) -> OutputError:
-    reason = (e.strerror or str(e)).lower()
-    if e.errno == errno.ENOSPC:
-        reason = "no space left on the device"
-    return OutputError(f"{path}: cannot write ({reason}); any earlier file there is untouched")
+class OutputNotice(UserWarning):
+    """Something about a finished write the user should know (the command line prints it as one line)."""
 
 
-def _is_stream(given: Path, real: Path) -> bool:
-    """A target written through rather than replaced: a device, pipe or socket, or a /dev or /proc name."""
-    if str(given).startswith(("/dev/", "/proc/")):
-        return True
+def _reason(e: OSError) -> str:
+    return "no space left on the device" if e.errno == errno.ENOSPC else (e.strerror or str(e)).lower()
+
+
+def _write_error(path, e: OSError, stream: bool = False) -> OutputError:
+    if isinstance(e, OutputError):  # already one line that names the path: never wrapped twice
+        return e
+    tail = "" if stream else "; any earlier file there is untouched"
+    return OutputError(f"{path}: cannot write ({_reason(e)}){tail}")
+
+
+def _path_error(path, e: OSError) -> InputError:
+    if e.errno == errno.ELOOP:
+        return InputError(f"{path}: too many levels of symbolic links (a loop?)")
+    if e.errno == errno.ENAMETOOLONG:
+        return InputError(f"{path}: the name or path is longer than the system allows")
+    return InputError(f"{path}: cannot use this path ({_reason(e)})")
+
+
+def _target(path) -> tuple[Path, os.stat_result | None]:
+    """What ``path`` names: the real path, and its status (None for a new name); an InputError for a bad path."""
+    name = os.fspath(path) if isinstance(path, os.PathLike) else path
+    if not isinstance(name, str) or not name:
+        raise InputError(f"output path {path!r:.80} is not a file name")
+    if "\x00" in name:
+        raise InputError(f"{name!r}: a file name cannot hold a NUL character")
     try:
-        return not stat.S_ISREG(real.stat().st_mode)
+        info = os.stat(name)  # follows a symbolic link, as the write will
     except (FileNotFoundError, NotADirectoryError):  # a new name; its folder is checked next
-        return False
+        info = None
+    except OSError as e:
+        raise _path_error(path, e) from None
+    try:
+        real = Path(os.path.realpath(name, strict=False))
+    except OSError as e:
+        raise _path_error(path, e) from None
+    return real, info
 
 
 def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
     """Whether ``path`` can be written, before any work: ``(real path, written through, folder of the temporary)``.
 
     Raises :class:`InputError` for a folder, a name under something that is
-    not a folder, or a missing folder.
+    not a folder, a missing folder, a symbolic-link loop, or a name or path
+    over the system's limits.
     """
-    given = Path(path)
-    real = Path(os.path.realpath(given))
-    if real.is_dir():
+    real, info = _target(path)
+    if info is not None and stat.S_ISDIR(info.st_mode):
         raise InputError(f"{path}: is a directory")
-    stream = _is_stream(given, real)
+    stream = info is not None and not stat.S_ISREG(info.st_mode)
     directory = Path(tempfile.gettempdir()) if stream else real.parent
     if not directory.is_dir():
         what = f"{directory} is not a folder" if directory.exists() else f"the folder {directory} does not exist"
         raise InputError(f"{path}: {what}")
+    if not stream:
+        limit = _name_max(directory)
+        if len(os.fsencode(real.name)) > limit:
+            raise InputError(f"{path}: the name is {len(os.fsencode(real.name))} bytes, more than the "
+                             f"{limit} the file system allows")
     return real, stream, directory
+
+
+def check_not_input(output, inputs: Iterable) -> None:
+    """Refuse an ``output`` that is one of ``inputs`` (the same device and inode), before any work is done."""
+    try:
+        out = os.stat(output)
+    except (OSError, ValueError, TypeError):
+        return  # a new name, or one check_output refuses
+    if not stat.S_ISREG(out.st_mode):
+        return
+    for given in inputs:
+        try:
+            info = os.stat(given)
+        except (OSError, ValueError, TypeError):
+            continue
+        if (info.st_dev, info.st_ino) == (out.st_dev, out.st_ino):
+            same = "" if os.fspath(given) == os.fspath(output) else f" ({given})"
+            raise InputError(f"{output}: is also an input{same}; write the result to another file")
+
+
+def _name_max(directory: Path) -> int:
+    try:
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (OSError, ValueError):
+        return 255
+
+
+def temporary_name(target: Path, name_max: int = 255) -> str:
+    """The name of the temporary beside ``target``: hidden, random, with its extension, within ``name_max`` bytes.
+
+    Examples
+    --------
+    >>> t = temporary_name(Path("/w/part.vtk"))
+    >>> t.startswith(".part.vtk.") and t.endswith(".part.vtk"), len(temporary_name(Path("a" * 251 + ".csv")))
+    (True, 255)
+    """
+    suffix = target.suffix if len(target.suffix) <= SUFFIX_KEPT and target.suffix.isascii() else ""
+    tail = f".{secrets.token_hex(4)}.part{suffix}"
+    room = name_max - 1 - len(tail.encode())
+    stem = os.fsencode(target.name)[:room].decode("utf-8", "ignore")
+    return f".{stem}{tail}"
+
+
+def _new_temporary(directory: Path, target: Path) -> str:
+    limit = _name_max(directory)
+    for _ in range(100):
+        tmp = str(directory / temporary_name(target, limit))
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except FileExistsError:
+            continue
+        os.close(fd)
+        return tmp
+    raise FileExistsError(errno.EEXIST, "no free temporary name")
 
 
 @contextlib.contextmanager
@@ -66,8 +160,9 @@ def atomic_path(path: str | os.PathLike) -> Iterator[str]:
 
     - a regular file, or a new name: the temporary file sits beside it and
       replaces it in one rename, keeping an existing file's permissions (a new
-      file gets ``0o666`` less the umask); a file with other hard links is
-      rewritten in place instead, so the links stay one file;
+      file gets ``0o666`` less the umask).  A file with other hard links is
+      replaced too: the name becomes a new file, the other links keep the old
+      content, and an :class:`OutputNotice` warning says so;
     - a symbolic link: the same, for the file it points to (the link stays);
     - a device, pipe or socket (``/dev/null``, ``/dev/stdout``, a FIFO): written
       through, after the content is complete.
@@ -78,18 +173,17 @@ def atomic_path(path: str | os.PathLike) -> Iterator[str]:
     given = Path(path)
     real, stream, directory = check_output(path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".part" + real.suffix, dir=directory)
+        tmp = _new_temporary(directory, real)
     except OSError as e:
-        raise _write_error(path, e) from None
-    os.close(fd)
+        raise _write_error(path, e, stream) from None
     try:
         yield tmp
         if stream:
             _copy_into(tmp, given)
         else:
-            _commit(tmp, real)
+            _commit(tmp, real, path)
     except OSError as e:
-        raise _write_error(path, e) from None
+        raise _write_error(path, e, stream) from None
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -100,7 +194,7 @@ def _copy_into(tmp: str, target: Path) -> None:
         shutil.copyfileobj(src, dst, 1 << 20)
 
 
-def _commit(tmp: str, target: Path) -> None:
+def _commit(tmp: str, target: Path, given) -> None:
     try:
         old = target.stat()
     except FileNotFoundError:
@@ -109,15 +203,13 @@ def _commit(tmp: str, target: Path) -> None:
         os.chmod(tmp, 0o666 & ~mask)
         os.replace(tmp, target)
         return
-    if old.st_nlink > 1:
-        with open(tmp, "rb") as src, open(target, "r+b") as dst:
-            shutil.copyfileobj(src, dst, 1 << 20)
-            dst.truncate()
-            dst.flush()
-            os.fsync(dst.fileno())
-        return
     os.chmod(tmp, stat.S_IMODE(old.st_mode))
     os.replace(tmp, target)
+    if old.st_nlink > 1:
+        others = old.st_nlink - 1
+        warnings.warn(OutputNotice(f"{given}: written as a new file; its {others} other hard "
+                                   f"link{'s' if others > 1 else ''} keep{'' if others > 1 else 's'} "
+                                   f"the old content"), stacklevel=2)
 
 
 @contextlib.contextmanager
@@ -130,6 +222,8 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", newline: str | None =
                 yield fh
                 fh.flush()
                 os.fsync(fh.fileno())
+        except OutputError:
+            raise
         except OSError as e:
             raise _write_error(path, e) from None
 

@@ -26,6 +26,7 @@ key and (for a choice) the valid values.  Example::
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,7 +35,7 @@ from ..io.files import read_bytes
 from ..controls import VARIABLE_PROFILES, control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
-from ..values import in_range
+from ..values import FrozenMap, in_range
 
 __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "ProbeStage", "read_job", "parse_job", "KINDS", "COOLANTS"]
 
@@ -81,7 +82,10 @@ class OperationSpec:
     feed_mm_min: float = 600.0
     plunge_feed_mm_min: float = 200.0
     coolant: str = "off"
-    options: dict = field(default_factory=dict)
+    options: Mapping = field(default_factory=FrozenMap)
+
+    def __post_init__(self):
+        object.__setattr__(self, "options", FrozenMap(self.options))
 
 
 @dataclass(frozen=True)
@@ -113,13 +117,20 @@ class JobSpec:
     safe_z_mm: float
     rapid_mm_min: float
     title: str
-    stock: dict
-    tools: dict
+    stock: Mapping
+    tools: Mapping
     operations: tuple
     variables: str = "full"
     notes: tuple[str, ...] = ()  # header comments about the surface, such as an accepted conditioning
     probe: ProbeStage | None = None
     grid: object = None  # the surface's grid when it does not come from the points file (a fitted measurement)
+
+    def __post_init__(self):
+        # Read-only all the way down: a value that flows must not change under the code that holds it.
+        object.__setattr__(self, "stock", FrozenMap(self.stock))
+        object.__setattr__(self, "tools", FrozenMap(self.tools))
+        object.__setattr__(self, "operations", tuple(self.operations))
+        object.__setattr__(self, "notes", tuple(self.notes))
 
 
 def read_job(path) -> JobSpec:
@@ -129,6 +140,8 @@ def read_job(path) -> JobSpec:
         data = tomllib.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
         raise InputError(f"{path}: not a valid TOML job file: {e}") from None
+    except RecursionError:
+        raise InputError(f"{path}: not a job file: arrays or tables nested too deep to read") from None
     return parse_job(data, str(path), Path(path).parent)
 
 
@@ -225,6 +238,8 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
     if not low <= program_number <= high:
         raise InputError(f"{source}: program_number = {program_number} must be {low} to {high}")
     probe = _probe(data["probe"], dialect, source) if "probe" in data else None
+    title = data.get("title", Path(data["points"]).stem if "points" in data else "probed")
+    _check_title(title, control(dialect), program_number, source)
     return JobSpec(
         source=source, points=base / data["points"] if "points" in data else None, probe=probe,
         dialect=dialect,
@@ -236,7 +251,7 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         program_number=program_number,
         safe_z_mm=_length(data.get("safe_z", 50.0), "safe_z", source),
         rapid_mm_min=_positive(data.get("rapid", 5000.0), "rapid", source),
-        title=data.get("title", Path(data["points"]).stem if "points" in data else "probed"),
+        title=title,
         stock=_stock(data["stock"], source), tools=tools, operations=ops, variables=variables)
 
 
@@ -269,6 +284,19 @@ def _probe(table: dict, dialect: str, source: str) -> ProbeStage:
     except InputError as e:
         raise InputError(f"{source}: probe: {e}") from None
     return ProbeStage(plan, settings, fit_degree)
+
+
+def _check_title(title: str, c, program_number: int, source: str) -> None:
+    """The title goes into one block of the program's header: it must fit the control's block length."""
+    from ..gcode.text import iso_comment
+
+    text = iso_comment(title)
+    f = c.framing
+    block = f.program_word.format(program_number) + f" ({text})" if f.program_word else f.comment(text)
+    if len(block) > c.max_block:
+        raise InputError(f"{source}: title of {len(text):,} characters makes a block of {len(block):,}, more than "
+                         f"the {c.max_block} a {c.name} control reads in one block; shorten it to "
+                         f"{max(len(text) - (len(block) - c.max_block), 0)} characters")
 
 
 def _stock(table: dict, source: str) -> dict:

@@ -10,6 +10,7 @@ paper's limitation 4: "more than 6th order").
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
@@ -58,9 +59,18 @@ def _net(formula, bounds, n: int):
     ys = [y0 + (y1 - y0) * k / (n - 1) for k in range(n)]
     try:
         z = [[formula.exact_value(a, b) for b in ys] for a in xs]
-    except FormulaError:  # sin, pi, ...: the float value, read exactly
-        z = [[Fraction(float(formula(float(a), float(b)))) for b in ys] for a in xs]
+    except FormulaError as exact_error:  # sin, pi, ...: the float value, read exactly
+        z = [[_finite(formula, a, b, exact_error) for b in ys] for a in xs]
     return grid_from_table(xs, ys, z)
+
+
+def _finite(formula, a: Fraction, b: Fraction, exact_error: FormulaError) -> Fraction:
+    """The formula's float value at a node, exactly; where it is not finite (1/(x-x)), the exact reading's error."""
+    with np.errstate(all="ignore"):
+        v = float(formula(float(a), float(b)))
+    if not math.isfinite(v):
+        raise FormulaError(f"{exact_error}; its value at (x, y) = ({float(a):g}, {float(b):g}) is {v}") from None
+    return Fraction(v)
 
 
 def degree_growth(formula, bounds: Sequence[float], degrees: Sequence[int] = range(2, 13, 2), *, samples: int = 81,

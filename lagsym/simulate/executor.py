@@ -7,6 +7,8 @@ from decimal import localcontext
 
 from ..errors import ProgramError
 from ..controls import control
+from ..gcode.program import ascii_program
+from ..values import whole
 from ..progress import MOST_CALLS, Progress, Tally
 from .alarms import BlockAlarm, ControlAlarm, alarm_at
 from .blocks import Block, End, Label, OElse, OElseIf, OEndIf, OEndWhile, OIf, OWhile, While
@@ -70,9 +72,13 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     >>> [(m.x, m.z) for m in sim.moves]
     [(0.0, 0.0), (1.0, 1.0), (2.0, 4.0)]
     """
+    ascii_program(text)
     c = control(dialect or detect_dialect(text), "dialect", SIM_DIALECTS)
-    if int(precision) < 1 or int(precision) > 34:
-        raise ProgramError(f"precision {precision} must be 1 to 34 significant digits")
+    if isinstance(precision, float) and precision.is_integer():
+        precision = int(precision)
+    precision = whole(precision, "precision (significant digits)", 1, 34)
+    max_blocks = whole(max_blocks, "max_blocks", 1, 1 << 62)
+    max_idle_blocks = whole(max_idle_blocks, "max_idle_blocks", 1, 1 << 62)
     blocks = _match_loops(read_blocks(text, c))
     labels = _labels(blocks)
     m = ControlState(c, int(precision), variable_ranges or None)

@@ -116,13 +116,12 @@ class _Parser:
         return f
 
     def unary(self):
-        if self.peek()[1] == "-":
-            self.take()
-            return ("neg", self.unary())
-        if self.peek()[1] == "+":
-            self.take()
-            return self.unary()
-        return self.primary()
+        # A run of signs read in a loop and folded to at most one negation: 250 of them would otherwise nest
+        # 250 deep here and in the generated code, past what Python compiles.
+        negative = False
+        while self.peek()[1] in ("-", "+"):
+            negative ^= self.take()[1] == "-"
+        return ("neg", self.primary()) if negative else self.primary()
 
     def primary(self):
         kind, val = self.take()

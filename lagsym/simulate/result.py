@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from array import array
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import FrozenInstanceError, dataclass
 
 __all__ = ["SimMove", "SimMoves", "Simulation", "moves_csv", "BYTES_PER_MOVE"]
 
@@ -37,14 +37,24 @@ class SimMoves(Sequence):
     in a :class:`Simulation` is not changed again.
     """
 
-    __slots__ = ("_line", "_rapid", "_x", "_y", "_z", "_feed")
+    __slots__ = ("_line", "_rapid", "_x", "_y", "_z", "_feed", "_sealed")
 
     def __init__(self):
         self._line, self._rapid = array("i"), array("b")
         self._x, self._y, self._z, self._feed = array("d"), array("d"), array("d"), array("d")
+        self._sealed = False
+
+    def seal(self) -> None:
+        """End the run: from now on the table is read-only (a :class:`Simulation` seals its moves)."""
+        self._sealed = True
+
+    def _check_open(self) -> None:
+        if self._sealed:
+            raise FrozenInstanceError("the moves of a finished run are read-only")
 
     def append(self, line: int, rapid: bool, x: float, y: float, z: float, feed: float) -> None:
         """Add one move (the executor's use only)."""
+        self._check_open()
         self._line.append(line)
         self._rapid.append(rapid)
         self._x.append(x)
@@ -54,6 +64,7 @@ class SimMoves(Sequence):
 
     def appenders(self) -> tuple:
         """The ``append`` of each column, in the order of :meth:`append` (the executor's use only)."""
+        self._check_open()
         return (self._line.append, self._rapid.append, self._x.append, self._y.append, self._z.append,
                 self._feed.append)
 
@@ -144,6 +155,9 @@ class Simulation:
     blocks: int
     output: tuple[str, ...] = ()
     probes: int = 0
+
+    def __post_init__(self):
+        self.moves.seal()
 
     def feed_points(self):
         """The end points of the feed (``G1``) moves as an (N, 3) float array."""

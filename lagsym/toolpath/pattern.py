@@ -16,7 +16,9 @@ from ..machine import BOUNDARIES, DIRECTIONS
 from ..values import choice, finite, positive
 
 __all__ = ["raster_pattern", "levels", "scallop_stepover", "tool_reach", "within_reach", "past_reach", "reach_levels",
-           "fixed_step_samples", "every_step"]
+           "fixed_step_samples", "every_step", "MAX_LEVELS"]
+
+MAX_LEVELS = 10_000_000  # rows, or positions along a row, of one raster: 80 MB of floats each
 
 
 def scallop_stepover(radius_mm: float, scallop_mm: float) -> float:
@@ -45,7 +47,11 @@ def levels(lo: float, hi: float, step: float) -> np.ndarray:
     >>> levels(0.0, 1.0, 0.4).tolist()
     [0.0, 0.3333333333333333, 0.6666666666666666, 1.0]
     """
-    count = max(int(math.ceil((hi - lo) / step - 1e-9)), 1)
+    span = (hi - lo) / step
+    if not math.isfinite(span) or span + 1 > MAX_LEVELS:
+        raise ToolpathError(f"{lo:g} to {hi:g} in steps of {step:g} is {span + 1:.4g} positions, more than the "
+                            f"limit of {MAX_LEVELS:,} in one direction: give a larger step")
+    count = max(int(math.ceil(span - 1e-9)), 1)
     return np.linspace(lo, hi, count + 1)
 
 
@@ -64,10 +70,24 @@ def raster_pattern(bounds, direction: str, stepover: float, step: float):
     """
     choice(direction, DIRECTIONS, "raster direction")
     stepover, step = positive(stepover, "side step"), positive(step, "forward step")
-    x0, x1, y0, y1 = (float(v) for v in bounds)
+    x0, x1, y0, y1 = _box(bounds)
     if direction == "x":
         return levels(y0, y1, stepover), levels(x0, x1, step)
     return levels(x0, x1, stepover), levels(y0, y1, step)
+
+
+def _box(bounds) -> tuple[float, float, float, float]:
+    """``(x0, x1, y0, y1)`` as finite floats with ``x0 <= x1`` and ``y0 <= y1``; the message names a bad one."""
+    try:
+        values = tuple(bounds)
+    except TypeError:
+        raise ToolpathError(f"bounds {bounds!r:.80} is not (x0, x1, y0, y1)") from None
+    if len(values) != 4:
+        raise ToolpathError(f"bounds {values!r:.80} is not (x0, x1, y0, y1)")
+    x0, x1, y0, y1 = (finite(v, f"bounds {name}") for v, name in zip(values, ("x0", "x1", "y0", "y1")))
+    if x1 < x0 or y1 < y0:
+        raise ToolpathError(f"bounds {values!r:.80} is not a box: x0 <= x1 and y0 <= y1 are needed")
+    return x0, x1, y0, y1
 
 
 def tool_reach(bounds, radius: float, boundary: str, past: float | None = None):

@@ -161,6 +161,10 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         if raster.boundary == "past" else None
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
     step, fine = _forward_steps(raster, ev, mm_per_unit)
+    if program.resolution_mm > fine:  # samples closer than the written positions would fall on one another
+        raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, coarser "
+                            f"than the sampling step of {fine:.3g} mm: give more decimals (--decimals), or a "
+                            f"larger --step and --tolerance")
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step=step, fine=fine, max_points=max_points)
     if scallop is None and tool.is_ball and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)

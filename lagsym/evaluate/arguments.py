@@ -1,0 +1,41 @@
+"""The checks of the public evaluation functions' arguments: what they are given, as one InputError naming it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["coordinates", "broadcast_pair", "of_type", "a_surface"]
+
+
+def coordinates(value, what: str) -> np.ndarray:
+    """``value`` as a float array, or an InputError that names it."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{what} = {value!r:.80} is not an array of numbers") from None
+
+
+def broadcast_pair(x, y) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` and ``y`` as float arrays that broadcast together, or an InputError that gives their shapes."""
+    x, y = coordinates(x, "x"), coordinates(y, "y")
+    try:
+        np.broadcast_shapes(x.shape, y.shape)
+    except ValueError:
+        raise InputError(f"x of shape {x.shape} and y of shape {y.shape} do not broadcast together") from None
+    return x, y
+
+
+def of_type(value, cls: type, what: str):
+    """``value`` if it is a ``cls``, else an InputError that names it."""
+    if not isinstance(value, cls):
+        raise InputError(f"{what} = {value!r:.80} is not a {cls.__name__}")
+    return value
+
+
+def a_surface(value):
+    """``value`` if it is a :class:`~lagsym.lagrange.LagrangeSurface`, else an InputError that names it."""
+    from ..lagrange import LagrangeSurface
+
+    return of_type(value, LagrangeSurface, "surface")
