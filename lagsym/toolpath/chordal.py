@@ -43,9 +43,10 @@ import math
 
 import numpy as np
 
+from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator
 
-__all__ = ["tolerance_step", "bends", "semi_convex_sag", "move_sags", "move_rises", "crosses_box_edge",
+__all__ = ["tolerance_step", "forward_steps", "bends", "semi_convex_sag", "move_sags", "move_rises", "crosses_box_edge",
            "bent_moves", "check_moves", "lift"]
 
 _CHECK_SAMPLES = 6  # interior samples of a checked move, at least
@@ -290,3 +291,22 @@ def lift(sag: np.ndarray) -> np.ndarray:
         out[:-1] = sag
         out[1:] = np.maximum(out[1:], sag)
     return out
+
+
+def forward_steps(ev: SurfaceEvaluator, tolerance_mm: float, step_mm: float | None, mm_per_unit: float,
+                  program) -> tuple[float, float]:
+    """A raster's longest move (mm) and the finer sampling step the filter chooses points from (mm).
+
+    The sampling step is one whose own chordal error on the surface is a
+    quarter of the tolerance, and with a fixed step at most half of it.  A
+    program (:class:`~lagsym.machine.ProgramFormat`) that writes positions
+    further apart than the sampling step is refused: its samples would fall
+    on one another.
+    """
+    fine = tolerance_step(ev, tolerance_mm, mm_per_unit)
+    step, fine = (fine, fine) if step_mm is None else (step_mm, min(step_mm / 2.0, fine))
+    if program.resolution_mm > fine:
+        raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, coarser "
+                            f"than the sampling step of {fine:.3g} mm: give more decimals (--decimals), or a "
+                            f"larger --step and --tolerance")
+    return step, fine

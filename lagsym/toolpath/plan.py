@@ -160,11 +160,7 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
         if raster.boundary == "past" else None
     reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
-    step, fine = _forward_steps(raster, ev, mm_per_unit)
-    if program.resolution_mm > fine:  # samples closer than the written positions would fall on one another
-        raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, coarser "
-                            f"than the sampling step of {fine:.3g} mm: give more decimals (--decimals), or a "
-                            f"larger --step and --tolerance")
+    step, fine = chordal.forward_steps(ev, raster.chordal_tolerance_mm, raster.step_mm, mm_per_unit, program)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step=step, fine=fine, max_points=max_points)
     if scallop is None and tool.is_ball and tool.radius_mm > 0:  # the cusps a fixed side step leaves
         scallop = row_cusps(ev, raster.direction, levels, tool.radius_mm, mm_per_unit, raster.stepover_mm)
@@ -294,18 +290,6 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
     if not tool.is_ball:
         raise ToolpathError("a scallop height (--scallop) needs a ball-end cutter; give --stepover for a flat end")
     return scallop_stepover(tool.radius_mm, raster.scallop_mm)
-
-
-def _forward_steps(raster: RasterSpec, ev: SurfaceEvaluator, mm_per_unit: float) -> tuple[float, float]:
-    """The longest move (mm) and the finer sampling step the filter chooses points from (mm).
-
-    The sampling step is one whose own chordal error on the surface is a
-    quarter of the tolerance, and with a fixed step at most half of it.
-    """
-    fine = chordal.tolerance_step(ev, raster.chordal_tolerance_mm, mm_per_unit)
-    if raster.step_mm is None:
-        return fine, fine
-    return raster.step_mm, min(raster.step_mm / 2.0, fine)
 
 
 @dataclass(frozen=True)
