@@ -74,6 +74,14 @@ class Toolpath:
         The share of the box (of the prediction's samples) in hollows
         tighter than the ball, whose bottom it cannot reach: there the cusp
         prediction does not hold.
+    note : str or None
+        What the program header says of the strategy (waterline and
+        steep-and-shallow, :mod:`lagsym.toolpath.waterline`); None for a raster.
+    threshold_deg : float or None
+        The slope from which contours finish the part, degrees (the
+        threshold of steep-and-shallow, less its band); None for a raster.
+    levels : int or None
+        How many contour heights; None for a raster.
     arcs : Arcs or None
         With ``raster.arcs``, the circular moves that replace runs of the
         points (:mod:`lagsym.toolpath.arcs`); None without.
@@ -92,6 +100,9 @@ class Toolpath:
     cusp_at_mm: tuple[float, float] | None = None
     arcs: Arcs | None = None
     hollow_share: float | None = None
+    note: str | None = None
+    threshold_deg: float | None = None
+    levels: int | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))
