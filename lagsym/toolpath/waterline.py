@@ -144,6 +144,8 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     if not tool.is_ball or tool.radius_mm <= 0:
         raise ToolpathError(f"the {strategy} strategy spaces its passes from a ball's cusp: it needs a ball-end "
                             f"cutter with a diameter (--tool-shape ball), not {tool.label}")
+    if raster.arcs:
+        raise ToolpathError(f"arcs (--arcs) are fitted along a raster's rows, not in the {strategy} strategy")
     if raster.scallop_mm is None:
         raise ToolpathError(f"the {strategy} strategy spaces its passes from a cusp height: give --scallop "
                             f"instead of --stepover {raster.stepover_mm:g}")
@@ -181,6 +183,7 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         with Tally(progress, "contours") as t:
             contours, dzs = _contour_passes(drop, f, steep, d0, tol, kappa, mpu, milling, counter=t)
         passes += contours
+        passes = _lifted(drop, passes, kappa, mpu)
         if not passes:
             raise ToolpathError(f"no pass to plan: the surface has no part steeper than {theta - BAND_DEG:.1f} "
                                 f"degrees for the {strategy} strategy")
@@ -363,7 +366,7 @@ def _contour_passes(drop: _Drop, f: _Field, steep: np.ndarray, d0: float, tol: f
             keep = _thinned(pts[:, :2], tol / mpu, closed)
             passes.append((pts[keep], closed, ("contour", li)))
     steps = [-d for d in np.diff(levels)] if len(levels) > 1 else [0.0]
-    return _lifted(drop, passes, kappa, mpu), steps
+    return passes, steps
 
 
 def _chains(above: np.ndarray, steep: np.ndarray, nx: int, ny: int, li: int, where: dict):
@@ -447,11 +450,13 @@ def _thinned(xy: np.ndarray, tol: float, closed: bool) -> np.ndarray:
 
 
 def _lifted(drop: _Drop, passes, kappa: float, mpu: float):
-    """The passes with both ends of each move raised by the most the cutter path rises above it."""
+    """The passes on the program's resolution, both ends of each move raised by the most the cutter path rises above it."""
     if not passes:
         return []
     spacing = 0.25 * GRID_MM / mpu
     pts = np.vstack([p for p, _, _ in passes])
+    # On the program's resolution first: the moves checked are the moves written.
+    pts[:, 0], pts[:, 1] = drop.cl.snap(pts[:, 0], pts[:, 1])
     pts[:, 2] = np.maximum(pts[:, 2], drop(pts[:, 0], pts[:, 1]))
     ends = np.cumsum([len(p) for p, _, _ in passes])
     starts = ends - np.array([len(p) for p, _, _ in passes])
