@@ -66,7 +66,7 @@ def test_contours_run_climb_or_conventional_around_a_boss():
     surf = _dome()
     areas = {}
     for milling in ("climb", "conventional"):
-        tp = plan_strategy(surf, Tool("ball", 1.0), RasterSpec("x", None, None, 0.01, TOL), Placement(10.0),
+        tp = plan_strategy(surf, Tool("ball", 1.0), RasterSpec("x", None, None, 0.02, TOL), Placement(3.0),
                            strategy="waterline", milling=milling)
         signs = []
         for r in np.unique(tp.rows):
