@@ -149,6 +149,7 @@ def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_tha
         found[strategy] = (len(tp), float(left[reach].max()), float(left.min()))
         lines[strategy] = left
     (n_ss, left_ss, low_ss), (n_r, left_r, low_r) = found["steep-shallow"], found["raster"]
+    print("measured (cutter locations, most left normal, least left):", found)
     assert left_r <= 0.015 and left_ss <= 0.015, found
     assert low_ss >= -1e-4 and low_r >= -1e-4, found
     assert n_ss < n_r, found
