@@ -91,9 +91,10 @@ def test_steep_shallow_program_passes_rs274_and_states_its_threshold(run_cli, rs
                              "--tolerance", TOL, "--safe-z", 60, "--dialect", "linuxcnc", "-o", out)
     assert status == 0, err
     text = out.read_text()
-    theta = int(re.search(r"THRESHOLD (\d+) DEG", text).group(1))
+    theta = int(re.search(r"\(STEEP-SHALLOW THRESHOLD (\d+) DEG\)", text).group(1))
     over = int(re.search(r"contours on slopes over (\d+) degrees", err).group(1))
-    assert over == theta - 5 and f"ON SLOPES ACROSS ROWS OVER {over} DEG" in text
+    assert over == theta - 5 and f"(WATERLINE OVER {over} DEG ACROSS ROWS)" in text
+    assert f"(RASTER UNDER {theta + 5} DEG ACROSS ROWS)" in text
     feeds, _ = interpret(rs274, text)
     tp = plan_strategy(surf, Tool("ball", 4.0), RasterSpec("x", None, None, 0.02, TOL), Placement(1.0),
                        strategy="steep-shallow")

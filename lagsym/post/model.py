@@ -81,7 +81,7 @@ def point_program(toolpath, settings: MachineSettings, title: str = "") -> Point
         if getattr(toolpath, "hollow_share", None):
             tool += " OUTSIDE HOLLOWS TIGHTER THAN THE TOOL"
     if getattr(toolpath, "note", None):  # waterline or steep-and-shallow: the strategy and its threshold
-        settings = replace(settings, notes=(*settings.notes, toolpath.note))
+        settings = replace(settings, notes=(*settings.notes, *toolpath.note.split("; ")))
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool,
                         arcs=getattr(toolpath, "arcs", None))
 

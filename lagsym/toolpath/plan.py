@@ -76,7 +76,8 @@ class Toolpath:
         prediction does not hold.
     note : str or None
         What the program header says of the strategy (waterline and
-        steep-and-shallow, :mod:`lagsym.toolpath.waterline`); None for a raster.
+        steep-and-shallow, :mod:`lagsym.toolpath.waterline`), a comment line
+        each part between ``"; "``; None for a raster.
     threshold_deg : float or None
         The slope from which contours finish the part, degrees (the
         threshold of steep-and-shallow, less its band); None for a raster.

@@ -194,12 +194,11 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     x_mm, y_mm, z_mm = _place(placement, sx, sy, z)
     bx, by, _ = _place(placement, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     keep = np.concatenate([[True], np.any(np.diff(np.stack([x_mm, y_mm, z_mm], axis=1), axis=0) != 0, axis=1)])
-    across = "ACROSS ROWS " if strategy == "steep-shallow" else ""
-    what = "WATERLINE" if strategy == "waterline" else "STEEP-SHALLOW: WATERLINE"
-    note = (f"{what} ON SLOPES {across}OVER {theta - BAND_DEG:.0f} DEG"
-            + (f", RASTER UNDER {theta + BAND_DEG:.0f} DEG (THRESHOLD {theta:.0f} DEG)"
-               if strategy == "steep-shallow" else "")
-            + f", {len(dzs)} LEVELS, {milling.upper()}")
+    if strategy == "waterline":
+        note = f"WATERLINE ON SLOPES OVER {theta - BAND_DEG:.0f} DEG; {len(dzs)} LEVELS {milling.upper()}"
+    else:  # short lines: some controls cut a comment short
+        note = (f"STEEP-SHALLOW THRESHOLD {theta:.0f} DEG; WATERLINE OVER {theta - BAND_DEG:.0f} DEG ACROSS ROWS; "
+                f"RASTER UNDER {theta + BAND_DEG:.0f} DEG ACROSS ROWS; {len(dzs)} LEVELS {milling.upper()}")
     return Toolpath(points_mm=np.stack([x_mm, y_mm, z_mm], axis=1)[keep], rows=rows[keep],
                     exact_mm=_place(placement, sx, sy, exact)[2][keep], tool=tool, raster=raster,
                     stepover_mm=float(max(dzs)) if dzs else 0.0, step_mm=GRID_MM,
