@@ -30,8 +30,8 @@ examples:
       --stepover 0.4 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
   lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 --safe-z 400 \\
       --dialect linuxcnc -o part.ngc
-  lagsym toolpath examples/paper-example-4.json --scale 20 --strategy steep-shallow --scallop 0.01 \\
-      --tolerance 0.005 --safe-z 100 --dialect linuxcnc -o part.ngc"""
+  lagsym toolpath examples/paper-example-4.json --scale 20 --strategy steep-shallow --scallop 0.05 \\
+      --tolerance 0.01 --safe-z 100 --dialect linuxcnc -o steep.ngc"""
 
 POINT_DIALECTS = names(point_lists=True)
 
