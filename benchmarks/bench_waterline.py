@@ -69,8 +69,8 @@ def main(argv=None) -> int:
                     task=f"steep-and-shallow finishing of Example 4 at scale {SCALE:g} (ball D{DIAMETER:g} mm, cusp "
                     f"{CUSP:g} mm, {len(s):,} cutter locations)",
                     peer=f"lagsym's scallop raster for the same cusp ({len(r):,} cutter locations)",
-                    ratio=ratio, detail=f"wall medians of {args.runs}: {statistics.median(times['steep-shallow']):.2f} s "
-                    f"against {statistics.median(times['raster']):.2f} s", argv=argv, path=args.results)
+                    ratio=ratio, detail=f"wall medians of {args.runs}: "
+                    f"{statistics.median(times['steep-shallow']):.2f} s against {statistics.median(times['raster']):.2f} s", argv=argv, path=args.results)
     return 0
 
 

@@ -154,3 +154,12 @@ def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_tha
     assert left_r <= 0.015 and left_ss <= 0.015, found
     assert low_ss >= -1e-4 and low_r >= -1e-4, found
     assert n_ss < n_r, found
+    # The figures docs/toolpaths.md quotes: the counts exact, the material left rounded up to the micrometre.
+    doc = " ".join((EXAMPLES.parent / "docs" / "toolpaths.md").read_text().split())
+    m = re.search(r"leaves at most ([\d.]+) mm normal to the surface outside hollows tighter than the ball with "
+                  r"steep-and-shallow \(([\d,]+) cutter locations\), and at most ([\d.]+) mm with the scallop raster "
+                  r"\(([\d,]+) cutter locations\)", doc)
+    assert m, "docs/toolpaths.md no longer states the measured figures"
+    assert int(m.group(2).replace(",", "")) == n_ss and int(m.group(4).replace(",", "")) == n_r
+    for quoted, measured in ((float(m.group(1)), left_ss), (float(m.group(3)), left_r)):
+        assert measured <= quoted < measured + 0.001, (quoted, measured)

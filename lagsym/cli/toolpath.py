@@ -125,7 +125,8 @@ def run(args, out, err) -> int:
         if tp.note is not None:
             err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} passes, "
                       f"{tp.levels} levels, contours on slopes over {tp.threshold_deg - BAND_DEG:.0f} degrees, "
-                      f"moves within {raster.chordal_tolerance_mm:g} mm of the cutter path and never below it, passes spaced for a cusp of at most {tp.cusp_mm:g} mm "
+                      f"moves within {raster.chordal_tolerance_mm:g} mm of the cutter path and never below it, "
+                      f"passes spaced for a cusp of at most {tp.cusp_mm:g} mm "
                       f"normal to the surface outside hollows tighter than the ball "
                       f"({100 * tp.hollow_share:.1f} % of the grid)\n")
             return 0

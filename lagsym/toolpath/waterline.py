@@ -117,7 +117,7 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
                   program: ProgramFormat = ProgramFormat(), *, strategy: str = "raster", milling: str = "climb",
                   evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS,
                   stock_to_leave_mm: float = 0.0, progress: Progress | None = None) -> Toolpath:
-    """Plan a finishing pass by ``strategy``: ``"raster"`` (:func:`.plan.plan_toolpath`), ``"waterline"`` or ``"steep-shallow"``.
+    """Plan a finishing pass: ``"raster"`` (:func:`.plan.plan_toolpath`), ``"waterline"`` or ``"steep-shallow"``.
 
     Parameters
     ----------
@@ -380,7 +380,7 @@ def _chains(above: np.ndarray, steep: np.ndarray, nx: int, ny: int, li: int, whe
     link: dict[int, list[int]] = {}
     for i, j in zip(*np.nonzero(mixed)):
         # The cell's edges: bottom (x, j), top (x, j+1), left (y, i), right (y, i+1).
-        sides = [nx * 0 + i * ny + j, i * ny + j + 1, nx * ny + i * ny + j, nx * ny + (i + 1) * ny + j]
+        sides = [i * ny + j, i * ny + j + 1, nx * ny + i * ny + j, nx * ny + (i + 1) * ny + j]
         crossed = [where[(li, s)] for s in sides if (li, s) in where]
         if len(crossed) == 2:
             pairs = [tuple(crossed)]
@@ -449,7 +449,7 @@ def _thinned(xy: np.ndarray, tol: float, closed: bool) -> np.ndarray:
 
 
 def _lifted(drop: _Drop, passes, kappa: float, mpu: float):
-    """The passes on the program's resolution, both ends of each move raised by the most the cutter path rises above it."""
+    """The passes on the program's resolution, each move's ends raised by the most the cutter path rises above it."""
     if not passes:
         return []
     spacing = 0.25 * GRID_MM / mpu
