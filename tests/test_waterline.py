@@ -47,8 +47,10 @@ def _dome():
 def test_waterline_on_a_steep_flank_leaves_the_cusp_and_tolerance_at_most_and_never_gouges():
     """On the 67-76 degree flank, contours spaced for a 0.02 mm cusp leave at most that plus the chordal tolerance."""
     surf, _ = steep_flank()
+    told = []
     tp = plan_strategy(surf, Tool("ball", 4.0), RasterSpec("x", None, None, 0.02, TOL), Placement(1.0),
-                       strategy="waterline")
+                       strategy="waterline", progress=lambda done, total, stage: told.append(stage))
+    assert {"dropping the tool on the grid", "contours"} <= set(told)
     assert isinstance(tp, Toolpath) and tp.levels > 10 and "WATERLINE ON SLOPES OVER" in tp.note
     assert not tp.points_mm.flags.writeable
     assert (tp.points_mm[:, 2] >= tp.exact_mm).all()
