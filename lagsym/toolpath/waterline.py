@@ -75,7 +75,8 @@ from .resolution import ResolutionGrid
 from .scallop import _TIGHT, _allowed_d
 from .workers import MIN_POINTS, Workers
 
-__all__ = ["STRATEGIES", "plan_strategy", "BAND_DEG", "GRID_MM", "LINK_CLEARANCE_MM", "NEAR_RADII", "BISECTIONS"]
+__all__ = ["STRATEGIES", "plan_strategy", "BAND_DEG", "GRID_MM", "LINK_CLEARANCE_MM", "NEAR_RADII", "BISECTIONS",
+           "EDGE_DENSER"]
 
 STRATEGIES = ("raster", "waterline", "steep-shallow")
 """The finishing strategies: the zig-zag raster, contours at constant heights, or both split by slope."""
@@ -91,6 +92,9 @@ BISECTIONS = 10
 
 LINK_CLEARANCE_MM = 1.0
 """How far above the highest cutter location under it a link between distant passes runs."""
+
+EDGE_DENSER = 32
+"""How many times closer a move with the tool axis beyond the box is checked."""
 
 NEAR_RADII = 4.0
 """A next pass within this many tool radii is joined by a straight move where one stays above the cutter path."""
@@ -228,16 +232,28 @@ class _Drop:
         """The most each straight move ``a[k] -> b[k]`` (x, y surface units, z mm) lies below the cutter path.
 
         Checked at points ``spacing`` (surface units) apart inside each move,
-        plus the sag a path bending no faster than the surface can hide
-        between them; 0 or less where the move stays above.
+        :data:`EDGE_DENSER` times closer where a move has an end with the
+        tool axis beyond the box (where the tool rolls onto the box's edge its
+        height rises like a square root, faster than any bound on the
+        surface's bending), plus at each point a quarter of its downward
+        second difference (:func:`.chordal.bends`: what the path may bend
+        below the points between them); 0 or less where the move stays above.
         """
-        n = np.maximum(np.ceil(np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]) / spacing), 1).astype(int)
+        x0, x1, y0, y1 = self.cl.ev.bounds
+        beyond = ((a[:, 0] < x0) | (a[:, 0] > x1) | (a[:, 1] < y0) | (a[:, 1] > y1)
+                  | (b[:, 0] < x0) | (b[:, 0] > x1) | (b[:, 1] < y0) | (b[:, 1] > y1))
+        step = np.where(beyond, spacing / EDGE_DENSER, spacing)
+        n = np.maximum(np.ceil(np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]) / step), 2).astype(int)
         k = np.repeat(np.arange(len(a)), n + 1)
         t = (np.arange(k.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)) / np.repeat(n, n + 1)
         p = a[k] + t[:, None] * (b[k] - a[k])
-        below = self(p[:, 0], p[:, 1]) - p[:, 2]
+        z = self(p[:, 0], p[:, 1])
+        below = z - p[:, 2]
+        bend = np.zeros(len(z))
+        inner = np.flatnonzero(k[:-2] == k[2:]) + 1  # points with both neighbours on their move
+        bend[inner] = np.maximum(0.0, -(z[inner - 1] - 2.0 * z[inner] + z[inner + 1])) / 4.0
         out = np.full(len(a), -np.inf)
-        np.maximum.at(out, k, below)
+        np.maximum.at(out, k, below + bend)
         return out
 
 
