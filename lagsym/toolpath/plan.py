@@ -74,18 +74,8 @@ class Toolpath:
         The share of the box (of the prediction's samples) in hollows
         tighter than the ball, whose bottom it cannot reach: there the cusp
         prediction does not hold.
-    note : str or None
-        What the program header says of the strategy (waterline and
-        steep-and-shallow, :mod:`lagsym.toolpath.waterline`), a comment line
-        each part between ``"; "``; None for a raster.
-    threshold_deg : float or None
-        The slope from which contours finish the part, degrees (the
-        threshold of steep-and-shallow, less its band); None for a raster.
-    levels : int or None
-        How many contour heights; None for a raster.
-    arcs : Arcs or None
-        With ``raster.arcs``, the circular moves that replace runs of the
-        points (:mod:`lagsym.toolpath.arcs`); None without.
+    note, threshold_deg, levels : str, float, int or None
+        Of waterline finishing (:mod:`.waterline`): header note, slope of the contours, levels.
     """
 
     points_mm: np.ndarray

@@ -124,19 +124,11 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     Parameters
     ----------
     surface, tool, raster, placement, program, evaluator, max_points, stock_to_leave_mm, progress
-        As :func:`.plan.plan_toolpath`.  Waterline and steep-and-shallow need
-        a ball end and ``raster.scallop_mm`` (the cusp, normal to the
-        surface, their passes keep); the raster's ``direction`` and
-        ``boundary`` and the chordal tolerance hold for them too.
+        As :func:`.plan.plan_toolpath`; waterline and steep-and-shallow need a ball end and
+        ``raster.scallop_mm`` (the cusp normal to the surface their passes keep).
     strategy : {"raster", "waterline", "steep-shallow"}
     milling : {"climb", "conventional"}
         The contours' direction with the spindle turning clockwise.
-
-    Returns
-    -------
-    Toolpath
-        With ``rows`` the pass of each point and ``note`` the strategy and
-        threshold slope for the program header.
     """
     choice(strategy, STRATEGIES, "strategy")
     choice(milling, _DIRECTIONS, "milling direction")
@@ -196,17 +188,21 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     x_mm, y_mm, z_mm = _place(placement, sx, sy, z)
     bx, by, _ = _place(placement, np.array(ev.bounds[:2]), np.array(ev.bounds[2:]), 0.0)
     keep = np.concatenate([[True], np.any(np.diff(np.stack([x_mm, y_mm, z_mm], axis=1), axis=0) != 0, axis=1)])
-    if strategy == "waterline":
-        note = f"WATERLINE ON SLOPES OVER {theta - BAND_DEG:.0f} DEG; {len(dzs)} LEVELS {milling.upper()}"
-    else:  # short lines: some controls cut a comment short
-        note = (f"STEEP-SHALLOW THRESHOLD {theta:.0f} DEG; WATERLINE OVER {theta - BAND_DEG:.0f} DEG ACROSS ROWS; "
-                f"RASTER UNDER {theta + BAND_DEG:.0f} DEG ACROSS ROWS; {len(dzs)} LEVELS {milling.upper()}")
     return Toolpath(points_mm=np.stack([x_mm, y_mm, z_mm], axis=1)[keep], rows=rows[keep],
                     exact_mm=_place(placement, sx, sy, exact)[2][keep], tool=tool, raster=raster,
                     stepover_mm=float(max(dzs)) if dzs else 0.0, step_mm=GRID_MM,
                     bounds_mm=(float(bx[0]), float(bx[1]), float(by[0]), float(by[1])), fine_points=nx * ny,
-                    cusp_mm=float(raster.scallop_mm), hollow_share=float(f.tight.mean()), note=note,
+                    cusp_mm=float(raster.scallop_mm), hollow_share=float(f.tight.mean()),
+                    note=_note(strategy, theta, len(dzs), milling),
                     threshold_deg=float(theta), levels=len(dzs))
+
+
+def _note(strategy: str, theta: float, levels: int, milling: str) -> str:
+    """The header's lines (between ``"; "``), short: some controls cut a comment short."""
+    if strategy == "waterline":
+        return f"WATERLINE ON SLOPES OVER {theta - BAND_DEG:.0f} DEG; {levels} LEVELS {milling.upper()}"
+    return (f"STEEP-SHALLOW THRESHOLD {theta:.0f} DEG; WATERLINE OVER {theta - BAND_DEG:.0f} DEG ACROSS ROWS; "
+            f"RASTER UNDER {theta + BAND_DEG:.0f} DEG ACROSS ROWS; {levels} LEVELS {milling.upper()}")
 
 
 @dataclass(frozen=True)
