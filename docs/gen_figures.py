@@ -42,6 +42,20 @@ def export_figure(path: Path) -> None:
     save_figure(p, path)
 
 
+def steep_shallow_figure(path: Path) -> int:
+    """docs/toolpaths.md: steep-and-shallow on Example 4, a coarse cusp so that the passes show apart."""
+    from lagsym.cli import main as lagsym
+
+    with tempfile.TemporaryDirectory() as d:
+        program = str(Path(d) / "steep.nc")
+        if lagsym(["toolpath", "examples/paper-example-4.json", "--scale", "20", "--tool-diameter", "6",
+                   "--strategy", "steep-shallow", "--scallop", "0.3", "--tolerance", "0.02", "--safe-z", "80",
+                   "-o", program]) != 0:
+            return 1
+        return lagsym(["plot", "examples/paper-example-4.json", "--show", "toolpath", program, "--scale", "20",
+                       "-o", str(path)])
+
+
 def main(names: list[str] | None = None) -> int:
     from lagsym.cli import main as lagsym
 
@@ -50,10 +64,14 @@ def main(names: list[str] | None = None) -> int:
         for name in names:
             if name == "export-net.png":
                 export_figure(HERE / "images" / name)
+            elif name == "steep-shallow.png" and steep_shallow_figure(HERE / "images" / name):
+                return 1
             elif name in FIGURES and lagsym([*FIGURES[name], *size, "-o", str(HERE / "images" / name)]):
                 return 1
         return 0
     export_figure(HERE / "images" / "export-net.png")
+    if steep_shallow_figure(HERE / "images" / "steep-shallow.png"):
+        return 1
     for name, argv in FIGURES.items():
         if lagsym([*argv, *size, "-o", str(HERE / "images" / name)]) != 0:
             return 1

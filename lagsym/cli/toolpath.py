@@ -11,6 +11,7 @@ from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES
                        Tool)
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
+from ..toolpath.waterline import BAND_DEG, STRATEGIES
 
 from ._common import (add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
@@ -30,7 +31,9 @@ examples:
   lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 \\
       --stepover 0.4 --step 0.2 --feed 600 --safe-z 80 --dialect fanuc -o O1000.nc
   lagsym toolpath examples/paper-example-1.json --scale 10 --scallop 0.01 --tolerance 0.005 --safe-z 400 \\
-      --dialect linuxcnc -o part.ngc"""
+      --dialect linuxcnc -o part.ngc
+  lagsym toolpath examples/paper-example-4.json --scale 20 --strategy steep-shallow --scallop 0.05 \\
+      --tolerance 0.01 --safe-z 100 --dialect linuxcnc -o steep.ngc"""
 
 POINT_DIALECTS = names(point_lists=True)
 
@@ -43,6 +46,13 @@ def add_arguments(p) -> None:
     p.add_argument("--dialect", choices=POINT_DIALECTS, default="fanuc",
                    help=f"the control: {dialect_help(POINT_DIALECTS)}")
     g = p.add_argument_group("raster")
+    g.add_argument("--strategy", choices=STRATEGIES, default="raster",
+                   help="raster (default: the zig-zag), waterline (contours at constant heights on the slopes "
+                        "steeper than a threshold, spaced from the local slope) or steep-shallow (raster where the "
+                        "slope across the rows is below the threshold, contours above it, overlapping); "
+                        "waterline and steep-shallow need --scallop and a ball end")
+    g.add_argument("--milling", choices=("climb", "conventional"), default="climb",
+                   help="direction of the contours with the spindle clockwise (default climb)")
     g.add_argument("--direction", choices=DIRECTIONS, default="x", help="rows along x (default) or y")
     g.add_argument("--stepover", type=STEP_MM, metavar="MM", help="side step between rows (default 0.5)")
     g.add_argument("--step", type=STEP_MM, metavar="MM",
@@ -93,7 +103,7 @@ def settings_from(args, dialect: str, grid) -> MachineSettings:
 
 
 def run(args, out, err) -> int:
-    from ..toolpath import plan_toolpath
+    from ..toolpath import plan_strategy, plan_toolpath
 
     piecewise = read_piecewise(args.file)
     if piecewise is not None:  # local pieces: each point moves the surface near it only, so no guard rail
@@ -108,12 +118,26 @@ def run(args, out, err) -> int:
     step = args.step if args.step is not None else (None if args.tolerance is not None else 0.2)
     raster = RasterSpec(args.direction, stepover, step, args.scallop, args.tolerance, args.boundary, args.arcs)
     with progress_bar(err) as progress:
-        tp = plan_toolpath(surface, tool, raster, settings.placement, settings.program,
-                           max_points=args.max_points, stock_to_leave_mm=settings.stock_to_leave_mm, progress=progress)
+        if args.strategy == "raster":
+            tp = plan_toolpath(surface, tool, raster, settings.placement, settings.program,
+                               max_points=args.max_points, stock_to_leave_mm=settings.stock_to_leave_mm,
+                               progress=progress)
+        else:
+            tp = plan_strategy(surface, tool, raster, settings.placement, settings.program,
+                               strategy=args.strategy, milling=args.milling, max_points=args.max_points,
+                               stock_to_leave_mm=settings.stock_to_leave_mm, progress=progress)
     title = args.title if args.title is not None else str(grid.source).rsplit("/", 1)[-1]
     text = write_program(point_program(tp, settings, title=title))
     if args.output and args.output != "-":
         write_text(args.output, text, newline="")
+        if tp.note is not None:
+            err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} passes, "
+                      f"{tp.levels} levels, contours on slopes over {tp.threshold_deg - BAND_DEG:.0f} degrees, "
+                      f"moves within {raster.chordal_tolerance_mm:g} mm of the cutter path and never below it, "
+                      f"passes spaced for a cusp of at most {tp.cusp_mm:g} mm "
+                      f"normal to the surface outside hollows tighter than the ball "
+                      f"({100 * tp.hollow_share:.1f} % of the grid)\n")
+            return 0
         err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
                   f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
                   f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"

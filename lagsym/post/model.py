@@ -12,7 +12,7 @@ decimal point there.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -80,6 +80,8 @@ def point_program(toolpath, settings: MachineSettings, title: str = "") -> Point
         tool += f" CUSP AT MOST {toolpath.cusp_mm:.4f} MM NORMAL TO SURFACE"
         if getattr(toolpath, "hollow_share", None):
             tool += " OUTSIDE HOLLOWS TIGHTER THAN THE TOOL"
+    if getattr(toolpath, "note", None):  # waterline or steep-and-shallow: the strategy and its threshold
+        settings = replace(settings, notes=(*settings.notes, *toolpath.note.split("; ")))
     return PointProgram(points_mm=toolpath.points_mm, settings=settings, title=title, tool_comment=tool,
                         arcs=getattr(toolpath, "arcs", None))
 

@@ -14,7 +14,9 @@ The pipeline follows OpenCAMLib's four steps, each its own module:
    path rises above each move, and the moves are lifted by it;
 4. the program text, in :mod:`lagsym.post`.
 
-:mod:`.plan` puts the steps together (:func:`plan_toolpath`, :class:`Toolpath`).
+:mod:`.plan` puts the steps together (:func:`plan_toolpath`, :class:`Toolpath`);
+:mod:`.waterline` plans contours at constant heights instead, or both split
+by slope (:func:`plan_strategy`).
 
 Terms are used as in CAM: the *cutter location* (CL) is the programmed point,
 here the tool tip; the *cutter contact* (CC) point is where the tool touches
@@ -27,6 +29,7 @@ from .dropcutter import CL_MARGIN, drop_cutter
 from .filter import filter_rows
 from .pattern import raster_pattern, scallop_stepover
 from .plan import Toolpath, plan_toolpath
+from .waterline import STRATEGIES, plan_strategy
 
 __all__ = [
     "Toolpath",
@@ -35,5 +38,7 @@ __all__ = [
     "filter_rows",
     "scallop_stepover",
     "plan_toolpath",
+    "plan_strategy",
+    "STRATEGIES",
     "CL_MARGIN",
 ]

@@ -75,9 +75,8 @@ class Toolpath:
         The share of the box (of the prediction's samples) in hollows
         tighter than the ball, whose bottom it cannot reach: there the cusp
         prediction does not hold.
-    arcs : Arcs or None
-        With ``raster.arcs``, the circular moves that replace runs of the
-        points (:mod:`lagsym.toolpath.arcs`); None without.
+    note, threshold_deg, levels : str, float, int or None
+        Of waterline finishing (:mod:`.waterline`): header note, slope of the contours, levels.
     """
 
     points_mm: np.ndarray
@@ -93,6 +92,9 @@ class Toolpath:
     cusp_at_mm: tuple[float, float] | None = None
     arcs: Arcs | None = None
     hollow_share: float | None = None
+    note: str | None = None
+    threshold_deg: float | None = None
+    levels: int | None = None
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "rows", "exact_mm"))

@@ -1,0 +1,93 @@
+"""An independent check of the material a ball leaves, along lines across its passes, on the exact polynomial.
+
+Written for the tests apart from lagsym: the surface is the polynomial's
+rational coefficients in the power basis evaluated by NumPy
+(:func:`swept_check.polynomial_heights`), its slope and curvature by central
+differences of that; the swept ball's lowest point over a query point along
+each straight move is found by golden sections (it is convex along the
+move), for every move that passes within the ball's radius of the point.  A
+line of points a few micrometres apart crosses the cusps between passes, so
+their peaks are seen; the material left is the height of the swept ball's
+lower surface above the surface, times the cosine of the slope (normal to
+the surface).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from swept_check import GOLDEN, polynomial_heights
+
+
+def swept_lowest(points_mm, radius, qx, qy, iterations=48):
+    """The lowest height a ball's lower surface reaches over each ``(qx[i], qy[i])`` following ``points_mm``.
+
+    ``inf`` where no move passes within the radius.
+    """
+    p = np.asarray(points_mm, dtype=float)
+    a, b = p[:-1], p[1:]
+    qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
+    out = np.full(qx.shape, np.inf)
+    lo_x, hi_x = qx.min() - radius, qx.max() + radius
+    lo_y, hi_y = qy.min() - radius, qy.max() + radius
+    near = ((np.maximum(a[:, 0], b[:, 0]) >= lo_x) & (np.minimum(a[:, 0], b[:, 0]) <= hi_x)
+            & (np.maximum(a[:, 1], b[:, 1]) >= lo_y) & (np.minimum(a[:, 1], b[:, 1]) <= hi_y))
+    a, b = a[near], b[near]
+    for s in range(0, len(a), 64):
+        ma, mb = a[s:s + 64], b[s:s + 64]
+        d = mb[:, :2] - ma[:, :2]
+        dd = np.maximum((d * d).sum(axis=1), 1e-300)
+        # Pairs of move and point within the radius of the move's plan line.
+        rx, ry = qx[None, :] - ma[:, 0:1], qy[None, :] - ma[:, 1:2]
+        t0 = np.clip((rx * d[:, 0:1] + ry * d[:, 1:2]) / dd[:, None], 0.0, 1.0)
+        ex, ey = rx - t0 * d[:, 0:1], ry - t0 * d[:, 1:2]
+        mi, qi = np.nonzero(ex * ex + ey * ey <= radius * radius)
+        if not mi.size:
+            continue
+        A, B = ma[mi], mb[mi]
+        px, py = qx[qi], qy[qi]
+
+        def height(t):
+            cx, cy, cz = (A[:, k] + t * (B[:, k] - A[:, k]) for k in range(3))
+            d2 = (px - cx) ** 2 + (py - cy) ** 2
+            return np.where(d2 <= radius * radius, cz + radius - np.sqrt(np.maximum(radius * radius - d2, 0.0)),
+                            cz + radius + (np.sqrt(d2) - radius) * 1e6)
+
+        lo, hi = np.zeros(len(mi)), np.ones(len(mi))
+        for _ in range(iterations):
+            m1, m2 = hi - GOLDEN * (hi - lo), lo + GOLDEN * (hi - lo)
+            left = height(m1) <= height(m2)
+            hi, lo = np.where(left, m2, hi), np.where(left, lo, m1)
+        best = np.minimum.reduce([height(lo), height(hi), height(np.zeros(len(mi))), height(np.ones(len(mi)))])
+        best = np.where(best < np.inf, best, np.inf)
+        np.minimum.at(out, qi, best)
+    return out
+
+
+def surface_frame(surface, mm_per_unit, qx, qy, h=1e-3):
+    """Height, slope factor ``sqrt(1 + |grad|**2)`` and the larger principal curvature (1/mm, + a hollow) at points."""
+    def f(x, y):
+        return polynomial_heights(surface, mm_per_unit, x, y)
+
+    z = f(qx, qy)
+    fx = (f(qx + h, qy) - f(qx - h, qy)) / (2 * h)
+    fy = (f(qx, qy + h) - f(qx, qy - h)) / (2 * h)
+    fxx = (f(qx + h, qy) - 2 * z + f(qx - h, qy)) / (h * h)
+    fyy = (f(qx, qy + h) - 2 * z + f(qx, qy - h)) / (h * h)
+    fxy = (f(qx + h, qy + h) - f(qx + h, qy - h) - f(qx - h, qy + h) + f(qx - h, qy - h)) / (4 * h * h)
+    w = np.sqrt(1 + fx * fx + fy * fy)
+    # Shape operator of a graph: II / I; its larger eigenvalue.
+    E, F, G = 1 + fx * fx, fx * fy, 1 + fy * fy
+    L, M, N = fxx / w, fxy / w, fyy / w
+    det = E * G - F * F
+    H = (E * N - 2 * F * M + G * L) / (2 * det)
+    K = (L * N - M * M) / det
+    k1 = H + np.sqrt(np.maximum(H * H - K, 0.0))
+    return z, w, k1
+
+
+def left_normal(surface, mm_per_unit, points_mm, radius, qx, qy):
+    """Material left normal to the surface at each query point (mm; negative: a gouge), and the hollow curvature."""
+    cut = swept_lowest(points_mm, radius, qx, qy)
+    z, w, k1 = surface_frame(surface, mm_per_unit, qx, qy)
+    return (cut - z) / w, k1
