@@ -130,6 +130,16 @@ def test_strategies_are_checked_against_their_list():
 
 
 @pytest.mark.slow
+def test_a_piecewise_surface_is_refused_with_the_way_out():
+    from lagsym.errors import ToolpathError
+    from lagsym.surfaces.piecewise import piecewise_surface
+
+    surface = piecewise_surface(read_points(EXAMPLES / "paper-example-4.json"))
+    with pytest.raises(ToolpathError, match="finish a piecewise surface by raster"):
+        plan_strategy(surface, Tool("ball", 6.0), RasterSpec("x", None, 0.2, 0.01), Placement(20.0),
+                      strategy="steep-shallow")
+
+
 def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_than_a_raster_that_does():
     """Example 4 at scale 20, 6 mm ball, cusp 0.01 mm: what steep-and-shallow and the scallop raster leave normal to
     the surface outside hollows tighter than the ball (as docs/toolpaths.md states), no gouge, and fewer cutter

@@ -33,8 +33,7 @@ one program:
   ``κ h² / 8`` (the sag a path bending no faster than the surface's
   curvature bound ``κ`` can hide between samples ``h`` apart), so no move
   cuts below the exact cutter path;
-* **direction**: climb milling with the spindle clockwise (``M03``) keeps the
-  material, uphill, on the right of the travel; conventional on the left;
+* **direction**: climb (spindle ``M03``): material, uphill, on the right; conventional on the left;
 * **links**: from the end of one pass to the start of the next, a straight
   move where the next is within :data:`NEAR_RADII` tool radii and the straight
   move stays above the cutter path; else up to :data:`LINK_CLEARANCE_MM` above
@@ -44,13 +43,11 @@ one program:
 over the nodes whose slope is at most ``θ_t`` plus :data:`BAND_DEG` (and
 wherever the tool axis is beyond the box), waterline where it is at least
 ``θ_t`` less the band, so the two overlap by a band of slopes and leave no
-seam.  The raster's rows are walked across the box like the scallop raster's
-(the gap after a row the smallest allowed over its shallow nodes), cut into
-pieces where they cross the steep parts.  ``θ_t`` is chosen from the
+seam.  The raster's rows are walked as the scallop raster's (the gap after a row the smallest allowed over its
+shallow nodes), cut where they cross the steep parts.  ``θ_t`` is chosen from the
 requested cusp: the slope, between 10 and 80 degrees, that gives the shortest
-estimated path, the raster's length over its region at the rows' spacing
-``d(0) cos(θ_t + band)`` plus the contours' at the level step
-``d(0) sin(θ_t - band)``.  The waterline strategy alone plans the contours of
+estimated path, the raster's length over its region at the rows' spacing ``d(0) cos(θ_t + band)`` plus the
+contours' at the level step ``d(0) sin(θ_t - band)``.  The waterline strategy alone plans the contours of
 the same steep region (the shallow parts are another program's); the program
 header states the threshold.
 """
@@ -71,6 +68,7 @@ from ..values import choice, positive
 from . import chordal
 from .filter import filter_rows
 from .pattern import past_reach, tool_reach, within_reach
+from .dropcutter import telling_compiles
 from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, plan_toolpath
 from .resolution import ResolutionGrid
 from .contours import BISECTIONS, contour_passes
@@ -116,6 +114,20 @@ class _Field:
     cross_deg: np.ndarray  # the slope across a raster's rows: arccos(sqrt(1 + fp**2) / sqrt(1 + |grad|**2))
 
 
+def _check_request(surface, tool: Tool, raster: RasterSpec, strategy: str) -> None:
+    """Refuse what the waterline and steep-and-shallow strategies cannot plan, naming the way out."""
+    if isinstance(surface, PiecewiseSurface):
+        raise ToolpathError(f"the {strategy} strategy takes one polynomial: finish a piecewise surface by raster")
+    if not tool.is_ball or tool.radius_mm <= 0:
+        raise ToolpathError(f"the {strategy} strategy spaces its passes from a ball's cusp: it needs a ball-end "
+                            f"cutter with a diameter (--tool-shape ball), not {tool.label}")
+    if raster.arcs:
+        raise ToolpathError(f"arcs (--arcs) are fitted along a raster's rows, not in the {strategy} strategy")
+    if raster.scallop_mm is None:
+        raise ToolpathError(f"the {strategy} strategy spaces its passes from a cusp height: give --scallop "
+                            f"instead of --stepover {raster.stepover_mm:g}")
+
+
 def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement = Placement(),
                   program: ProgramFormat = ProgramFormat(), *, strategy: str = "raster", milling: str = "climb",
                   evaluator: SurfaceEvaluator | None = None, max_points: int | None = MAX_PLAN_POINTS,
@@ -125,28 +137,17 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     Parameters
     ----------
     surface, tool, raster, placement, program, evaluator, max_points, stock_to_leave_mm, progress
-        As :func:`.plan.plan_toolpath`; waterline and steep-and-shallow need a ball end and
-        ``raster.scallop_mm`` (the cusp normal to the surface their passes keep).
+        As :func:`.plan.plan_toolpath`; waterline and steep-and-shallow need one polynomial (not a piecewise
+        surface), a ball end and ``raster.scallop_mm`` (the cusp normal to the surface their passes keep).
     strategy : {"raster", "waterline", "steep-shallow"}
     milling : {"climb", "conventional"}
         The contours' direction with the spindle turning clockwise.
     """
-    choice(strategy, STRATEGIES, "strategy")
-    choice(milling, _DIRECTIONS, "milling direction")
+    choice(strategy, STRATEGIES, "strategy"), choice(milling, _DIRECTIONS, "milling direction")
     if strategy == "raster":
         return plan_toolpath(surface, tool, raster, placement, program, evaluator=evaluator, max_points=max_points,
                              stock_to_leave_mm=stock_to_leave_mm, progress=progress)
-    if isinstance(surface, PiecewiseSurface):
-        raise ToolpathError(f"the {strategy} strategy follows one polynomial's drop-cutter field; a piecewise surface "
-                            "is finished with the raster strategy (--strategy raster)")
-    if not tool.is_ball or tool.radius_mm <= 0:
-        raise ToolpathError(f"the {strategy} strategy spaces its passes from a ball's cusp: it needs a ball-end "
-                            f"cutter with a diameter (--tool-shape ball), not {tool.label}")
-    if raster.arcs:
-        raise ToolpathError(f"arcs (--arcs) are fitted along a raster's rows, not in the {strategy} strategy")
-    if raster.scallop_mm is None:
-        raise ToolpathError(f"the {strategy} strategy spaces its passes from a cusp height: give --scallop "
-                            f"instead of --stepover {raster.stepover_mm:g}")
+    _check_request(surface, tool, raster, strategy)
     ev = evaluator or surface_evaluator(surface)
     stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
     mpu = placement.mm_per_unit
@@ -162,7 +163,8 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     radius_mm = cl.radius * mpu
     d0 = float(_allowed_d(0.0, radius_mm, raster.scallop_mm))
     kappa = ev.curvature_bound() / mpu
-    cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))  # the compiled kernel loaded before the workers fork
+    with telling_compiles(progress):  # the compiled kernel loaded before the workers fork
+        cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
     with Workers(ev, None if nx * ny >= MIN_POINTS else 1) as workers:
         drop = _Drop(replace(cl, workers=workers), past)
         with Tally(progress, "dropping the tool on the grid", nx * ny) as t:
