@@ -128,7 +128,8 @@ def test_verify_of_a_move_far_away_is_estimated_not_allocated(run_cli, flat, tmp
 # 6. Work is estimated first and refused with the figure and the option that lifts it.
 
 def test_toolpath_refuses_a_plan_beyond_max_points(run_cli):
-    status, out, err = run_cli("toolpath", EX4, "--scale", "20", "--step", "0.0001", "--safe-z", "100")
+    status, out, err = run_cli("toolpath", EX4, "--scale", "20", "--step", "0.0001", "--decimals", "5",
+                               "--safe-z", "100")
     one_line_error(status, out, err, "--max-points")
     assert "201 rows" not in err and "drop-cutter points" in err
 

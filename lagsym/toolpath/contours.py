@@ -39,7 +39,7 @@ def _levels(f, steep: np.ndarray, d0: float) -> list[float]:
         start = level
 
 
-def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: float, mpu: float,
+def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: float, *, mpu: float,
                     milling: str, counter=None):
     """The contours of the steep region at every level, as passes ``(points (n, 3), closed)``; and the levels."""
     levels = _levels(f, steep, d0)

@@ -168,7 +168,7 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     with Workers(ev, None if nx * ny >= MIN_POINTS else 1) as workers:
         drop = _Drop(replace(cl, workers=workers), past)
         with Tally(progress, "dropping the tool on the grid", nx * ny) as t:
-            f = _field(drop, reach, nx, ny, radius_mm, raster.scallop_mm, raster.direction, mpu)
+            f = _field(drop, reach, nx, ny, radius_mm, raster.scallop_mm, direction=raster.direction, mpu=mpu)
             t.add(nx * ny)
         # Steep and shallow split by the slope across the rows: a flank the rows run up and down leaves the
         # raster's cusp as on the flat.
@@ -179,9 +179,9 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         if strategy == "steep-shallow":
             shallow = (slope <= theta + BAND_DEG) | ~f.inside
             with Tally(progress, "raster rows") as t:
-                passes += _raster_passes(drop, f, shallow, raster.direction, d0, tol, kappa, mpu, counter=t)
+                passes += _raster_passes(drop, f, shallow, raster.direction, d0, tol, kappa=kappa, mpu=mpu, counter=t)
         with Tally(progress, "contours") as t:
-            contours, dzs = contour_passes(drop, f, steep, d0, tol, kappa, mpu, milling, counter=t)
+            contours, dzs = contour_passes(drop, f, steep, d0, tol, kappa, mpu=mpu, milling=milling, counter=t)
         passes += contours
         passes = _lifted(drop, passes, kappa, mpu)
         if not passes:
@@ -257,7 +257,7 @@ class _Drop:
         return out
 
 
-def _field(drop: _Drop, reach, nx: int, ny: int, radius_mm: float, scallop_mm: float, direction: str,
+def _field(drop: _Drop, reach, nx: int, ny: int, radius_mm: float, scallop_mm: float, *, direction: str,
            mpu: float) -> _Field:
     """The grid of cutter locations over the reach, its slopes and the steps allowed at each node."""
     xs, ys = np.linspace(reach[0], reach[1], nx), np.linspace(reach[2], reach[3], ny)
@@ -338,7 +338,7 @@ def _lifted(drop: _Drop, passes, kappa: float, mpu: float):
     return out
 
 
-def _raster_passes(drop: _Drop, f: _Field, shallow: np.ndarray, direction: str, d0: float, tol: float,
+def _raster_passes(drop: _Drop, f: _Field, shallow: np.ndarray, direction: str, d0: float, tol: float, *,
                    kappa: float, mpu: float, counter=None):
     """Raster rows over the shallow region, walked across like the scallop raster's, cut where they leave it."""
     xs, ys = f.xs, f.ys
@@ -422,7 +422,7 @@ def _linked(drop: _Drop, passes, radius_mm: float, kappa: float, mpu: float):
             cur = pts[-1]
     p = np.array([q[-1] for q in ordered[:-1]]).reshape(-1, 3)
     q = np.array([q[0] for q in ordered[1:]]).reshape(-1, 3)
-    links = _links(drop, p, q, radius_mm, spacing, kappa, mpu)
+    links = _links(drop, p, q, radius_mm, spacing, kappa, mpu=mpu)
     out, rows = [ordered[0]], [np.zeros(len(ordered[0]), dtype=int)]
     for k, pts in enumerate(ordered[1:], start=1):
         out += [links[k - 1], pts]
@@ -430,7 +430,7 @@ def _linked(drop: _Drop, passes, radius_mm: float, kappa: float, mpu: float):
     return np.vstack(out), np.concatenate(rows)
 
 
-def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing: float, kappa: float, mpu: float):
+def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing: float, kappa: float, *, mpu: float):
     """The points between the end ``p[k]`` of each pass and the start ``q[k]`` of the next (both left out).
 
     None where the next pass is near and the straight move to it stays above
