@@ -434,3 +434,13 @@ G0 Z25.
 M30
 %
 """
+
+
+def wait_until(check, timeout: float = 30.0) -> bool:
+    """Whether ``check()`` came true within ``timeout`` seconds, asked every 50 ms."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if check():
+            return True
+        time.sleep(0.05)
+    return False

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 import signal
@@ -16,6 +17,7 @@ import pytest
 from lagsym.dnc import profile
 from lagsym.dnc.config import load_config
 from lagsym.dnc.server import serve
+import simcontrol
 from simcontrol import PtyPair, SimControl, punch
 
 pytestmark = pytest.mark.socat
@@ -23,13 +25,7 @@ ROOT = Path(__file__).resolve().parent.parent
 BAUD = 38400
 
 
-def wait_until(check, timeout=60.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.05)
-    return False
+wait_until = functools.partial(simcontrol.wait_until, timeout=60.0)  # a busy server takes its time
 
 
 def config_text(devices, received="received", extra=""):

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from lagsym.dnc import parse_program, profile, transfer_segments
-from simcontrol import PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import PtyPair, SimControl, chars_per_s, program_text, punch, wait_until
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
@@ -25,15 +25,6 @@ def docs_config() -> str:
     block = re.search(r"```toml\n(.*?)```", text, re.DOTALL).group(1)
     assert block == (ROOT / "examples" / "dnc.toml").read_text()
     return block
-
-
-def wait_until(check, timeout=30.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.05)
-    return False
 
 
 def test_the_server_end_to_end_on_two_ports(tmp_path):

@@ -16,7 +16,7 @@ from lagsym.probe import ProbeSettings, node_plan, probe_program
 from lagsym.simulate import simulate
 from lagsym.simulate.probing import probe_target
 
-from simcontrol import PtyPair, punch
+from simcontrol import PtyPair, punch, wait_until
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
@@ -87,14 +87,6 @@ def test_the_dnc_server_keeps_probe_results_and_refuses_a_missing_node(tmp_path)
                             stderr=subprocess.PIPE, text=True)
     received = tmp_path / "dnc" / "received" / "mill1"
     log = tmp_path / "dnc" / "mill1.log"
-
-    def wait_until(check, timeout=30.0):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if check():
-                return True
-            time.sleep(0.05)
-        return False
 
     try:
         assert wait_until(lambda: log.exists() and "listening" in proc.stdout.readline())
