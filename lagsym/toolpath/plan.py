@@ -154,14 +154,10 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     (True, [0, 0, 0, 1, 1, 1, 2, 2, 2])
     """
     ev = evaluator or evaluator_of(surface)
-    stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
     mm_per_unit = placement.mm_per_unit
     tol = raster.chordal_tolerance_mm
-    cl = _Cutter.of(surface, ev, tool, stock, ResolutionGrid.of(placement, program, ev.bounds))
-    # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
-    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
-        if raster.boundary == "past" else None
-    reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
+    cl, past, reach = cutter_and_reach(surface, ev, tool, raster, placement, program,
+                                       stock_to_leave_mm=stock_to_leave_mm)
     step, fine = chordal.forward_steps(ev, raster.chordal_tolerance_mm, raster.step_mm, mm_per_unit, program)
     scallop, levels, along, every = _pattern(ev, tool, raster, cl, reach, step=step, fine=fine, max_points=max_points)
     if scallop is None and tool.is_ball and tool.radius_mm > 0:  # the cusps a fixed side step leaves
@@ -292,6 +288,18 @@ def _side_step(tool: Tool, raster: RasterSpec) -> float:
     if not tool.is_ball:
         raise ToolpathError("a scallop height (--scallop) needs a ball-end cutter; give --stepover for a flat end")
     return scallop_stepover(tool.radius_mm, raster.scallop_mm)
+
+
+def cutter_and_reach(surface, ev: SurfaceEvaluator, tool: Tool, raster: RasterSpec, placement: Placement,
+                     program: ProgramFormat, *, stock_to_leave_mm: float):
+    """The planner's cutter on the program's grid, how far past the box it may go (None: not past) and the reach
+    of its positions (surface units): what every finishing strategy starts from."""
+    stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
+    cl = _Cutter.of(surface, ev, tool, stock, ResolutionGrid.of(placement, program, ev.bounds))
+    # Two units of the program's last decimal short of the radius: moved to the grid, a position stays within it.
+    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
+        if raster.boundary == "past" else None
+    return cl, past, tool_reach(ev.bounds, cl.radius, raster.boundary, past)
 
 
 @dataclass(frozen=True)

@@ -64,13 +64,12 @@ from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..machine import Placement, ProgramFormat, RasterSpec, Tool
 from ..progress import Progress, Tally
 from ..surfaces.piecewise import PiecewiseSurface
-from ..values import choice, positive
+from ..values import choice
 from . import chordal
 from .filter import filter_rows
-from .pattern import past_reach, tool_reach, within_reach
+from .pattern import within_reach
 from .dropcutter import telling_compiles
-from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, plan_toolpath
-from .resolution import ResolutionGrid
+from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, cutter_and_reach, plan_toolpath
 from .contours import BISECTIONS, contour_passes
 from .scallop import _TIGHT, _allowed_d
 from .workers import MIN_POINTS, Workers
@@ -149,13 +148,10 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
                              stock_to_leave_mm=stock_to_leave_mm, progress=progress)
     _check_request(surface, tool, raster, strategy)
     ev = evaluator or surface_evaluator(surface)
-    stock = positive(stock_to_leave_mm, "stock to leave", allow_zero=True)
     mpu = placement.mm_per_unit
     tol = raster.chordal_tolerance_mm
-    cl = _Cutter.of(surface, ev, tool, stock, ResolutionGrid.of(placement, program, ev.bounds))
-    past = max(0.0, min(past_reach(ev, cl.radius, cl.corner), cl.radius - 2 * cl.unit)) \
-        if raster.boundary == "past" else None
-    reach = tool_reach(ev.bounds, cl.radius, raster.boundary, past)
+    cl, past, reach = cutter_and_reach(surface, ev, tool, raster, placement, program,
+                                       stock_to_leave_mm=stock_to_leave_mm)
     nx, ny = (math.ceil((reach[k + 1] - reach[k]) * mpu / GRID_MM) + 1 for k in (0, 2))
     if max_points is not None and nx * ny > max_points:
         raise ToolpathError(f"a grid of {nx} x {ny} cutter locations ({nx * ny:.3g}) is more than the limit of "
