@@ -98,14 +98,17 @@ def test_a_forked_process_starts_helpers_of_its_own():
     assert out.stdout.split() == ["2", "0"]
 
 
-def test_the_hand_over_benchmark_runs_and_prints_its_table():
+def test_the_hand_over_benchmark_runs_and_prints_its_table(tmp_path):
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    done = subprocess.run([sys.executable, os.path.join(root, "benchmarks", "bench_threads.py"), "--runs", "3"],
+    results = tmp_path / "results.json"  # never the tracked results file
+    done = subprocess.run([sys.executable, os.path.join(root, "benchmarks", "bench_threads.py"), "--runs", "3",
+                           "--results", str(results)],
                           cwd=root, capture_output=True, text=True, timeout=120, check=False)
     assert done.returncode == 0, done.stderr
     rows = [ln for ln in done.stdout.splitlines() if ln.startswith("| ") and "us)" not in ln]
     assert len(rows) == 4 and all(len(r.split("|")) == 6 for r in rows)
     assert "the caller held: the peer" in done.stdout
+    assert "threads" in results.read_text()
 
 
 def test_nothing_of_a_call_is_kept_by_the_helpers_once_it_returns():
