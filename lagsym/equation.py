@@ -21,7 +21,7 @@ import flint
 
 from . import polytext
 from .errors import InputError
-from .lagrange import LagrangeCurve, LagrangeSurface, horner2
+from .lagrange import LagrangeCurve, LagrangeSurface
 
 if TYPE_CHECKING:
     import sympy

@@ -8,11 +8,10 @@ import pkgutil
 import re
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import lagsym
-from lagsym.controls import CONTROLS, Control, control, names, work_offset
+from lagsym.controls import CONTROLS, control, names, work_offset
 from lagsym.errors import InputError, ProgramError, ToolpathError
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface

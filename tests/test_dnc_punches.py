@@ -14,11 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from lagsym.dnc import profile
 from lagsym.dnc.config import load_config
 from lagsym.dnc.server import serve
 import simcontrol
-from simcontrol import PtyPair, SimControl, punch
+from simcontrol import PtyPair, punch
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent

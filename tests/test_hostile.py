@@ -234,7 +234,7 @@ def test_the_title_limits_docs_formats_quotes(dialect, limit):
 
     from lagsym.job.spec import parse_job
 
-    assert f"128 characters on a Fanuc or Haas, 255 on LinuxCNC" in (Path(__file__).parent.parent / "docs" /
+    assert "128 characters on a Fanuc or Haas, 255 on LinuxCNC" in (Path(__file__).parent.parent / "docs" /
                                                                       "formats.md").read_text()
     with pytest.raises(LagsymError, match=f"more than the {limit} a {dialect} control"):
         parse_job(_job_data("T" * limit, dialect), "j.toml", Path("."))
@@ -332,3 +332,10 @@ def test_decimals_too_coarse_for_the_path_name_the_option(run_cli):
     status, out, err = run_cli("toolpath", EXAMPLE1, "--decimals", "0", "--stepover", "1", "--step", "1")
     _one_line(status, err)
     assert "--decimals" in err and "decimals 0 write positions 1 mm apart" in err and out == ""
+
+
+def test_a_sampling_step_equal_to_the_written_resolution_is_refused_not_warned(run_cli):
+    # --step 0.002 samples every 0.001 mm, which 3 decimals write as ties that round onto one position
+    status, out, err = run_cli("toolpath", EXAMPLE1, "--stepover", "2", "--step", "0.002")
+    _one_line(status, err)
+    assert "decimals 3 write positions 0.001 mm apart" in err and "RuntimeWarning" not in err and out == ""

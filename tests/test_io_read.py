@@ -82,6 +82,6 @@ def test_points_in_memory_are_sent_to_the_function_for_them(reader, maker):
     with pytest.raises(lagsym.InputError) as e:
         getattr(lagsym, reader)(points)
     assert "no such file" not in str(e.value)
-    assert f"not list [[0, 0, 1]" in str(e.value) and f"use lagsym.{maker}(points)" in str(e.value)
+    assert "not list [[0, 0, 1]" in str(e.value) and f"use lagsym.{maker}(points)" in str(e.value)
     # and the function it names takes them
     assert lagsym.grid_from_points(points).z_array.shape == (2, 2)

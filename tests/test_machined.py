@@ -18,7 +18,6 @@ from lagsym.lagrange import lagrange_surface
 from lagsym.machine import Tool
 from lagsym.machined import LEFT_BINS_MM, machine_part
 
-from conftest import EXAMPLES
 
 FLAT = lagrange_surface(grid_from_table([0, 10], [0, 10], [[0, 0], [0, 0]]))
 BLOCK = (0.0, 10.0, 0.0, 10.0, 5.0)

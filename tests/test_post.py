@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lagsym.errors import InputError, ProgramError, ToolpathError
+from lagsym.errors import InputError, ProgramError
 from lagsym.grid import grid_from_table
 from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface

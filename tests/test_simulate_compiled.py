@@ -63,7 +63,7 @@ def compiled(text: str, dialect: str, precision: int):
     return _state(m)
 
 
-def _state(m: Control):
+def _state(m):
     moves = [(mv.line, mv.x, mv.y, mv.z, math.copysign(1, mv.x)) for mv in m.moves]
     return ({n: str(v) for n, v in m.vars.items()}, {k: str(v) for k, v in m.names.items()}, moves)
 

@@ -14,7 +14,7 @@ from ..probe import is_probe_results, read_results, surface_points
 from ..values import exact_number, NotANumber
 from ._common import COLUMNS_HELP, emit, exact
 
-DESCRIPTION = f"""Fit the exact least-squares tensor-product polynomial
+DESCRIPTION = """Fit the exact least-squares tensor-product polynomial
 z = sum c[a][b] x^a y^b (a <= P, b <= Q) to the points in FILE: a grid, a
 grid with points missing, or scattered x,y,z rows.  Decimals in the file are
 exact and so are the coefficients.  Measured points (a probe, a CMM, a

@@ -11,7 +11,6 @@ decimal point there.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, replace
 
 import numpy as np

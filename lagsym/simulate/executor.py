@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import replace
 from decimal import localcontext
 
-from ..errors import ProgramError
 from ..controls import control
 from ..gcode.program import ascii_program
 from ..values import whole

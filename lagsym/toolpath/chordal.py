@@ -300,13 +300,13 @@ def forward_steps(ev: SurfaceEvaluator, tolerance_mm: float, step_mm: float | No
     The sampling step is one whose own chordal error on the surface is a
     quarter of the tolerance, and with a fixed step at most half of it.  A
     program (:class:`~lagsym.machine.ProgramFormat`) that writes positions
-    further apart than the sampling step is refused: its samples would fall
+    as far apart as the sampling step or further is refused: its samples would fall
     on one another.
     """
     fine = tolerance_step(ev, tolerance_mm, mm_per_unit)
     step, fine = (fine, fine) if step_mm is None else (step_mm, min(step_mm / 2.0, fine))
-    if program.resolution_mm > fine:
-        raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, coarser "
+    if program.resolution_mm >= fine:  # samples one resolution apart can round onto one position
+        raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, not finer "
                             f"than the sampling step of {fine:.3g} mm: give more decimals (--decimals), or a "
                             f"larger --step and --tolerance")
     return step, fine
