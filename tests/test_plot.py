@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import pyvista as pv
 from PIL import Image
 
 from conftest import EXAMPLES, ROOT, missing_system_package, need_opengl
@@ -214,6 +215,23 @@ def test_toolpath_figure(surface4):
     check_reference(img, "toolpath")
 
 
+def drawn_bounds(p) -> tuple[float, ...]:
+    """The bounds of what a figure draws (meshes), its axes grid left out."""
+    b = np.array([a.bounds for a in p.actors.values() if isinstance(a, pv.Actor)])
+    return (*[v for lo, hi in zip(b[:, 0::2].min(axis=0), b[:, 1::2].max(axis=0)) for v in (lo, hi)],)
+
+
+def check_axes_read_true_values(p) -> None:
+    """The axes grid holds the drawing, its labels read true heights, and they lie on round values (or the ends)."""
+    axes = p.renderer.cube_axes_actor
+    gx0, gx1, gy0, gy1, gz0, gz1 = axes.GetBounds()
+    x0, x1, y0, y1, z0, z1 = drawn_bounds(p)
+    k = p.scale[2]
+    assert gx0 <= x0 and gx1 >= x1 and gy0 <= y0 and gy1 >= y1 and gz0 <= z0 * k + 1e-9 and gz1 >= z1 * k - 1e-9
+    assert axes.GetXAxisRange() == pytest.approx((gx0, gx1)) and axes.GetYAxisRange() == pytest.approx((gy0, gy1))
+    assert axes.GetZAxisRange() == pytest.approx((gz0 / k, gz1 / k))  # the drawing's heights over its z scale
+
+
 def test_toolpath_figure_is_in_machine_millimetres(surface4):
     """Placed at 20 mm per unit from (100, 0, -5), the surface and the moves share the machine's millimetres."""
     from lagsym.machine import Placement
@@ -222,7 +240,8 @@ def test_toolpath_figure_is_in_machine_millimetres(surface4):
     moves_mm = moves * 20.0 + (100.0, 0.0, -5.0)
     p = plot.toolpath_figure(surface4, moves_mm, rapid=rapid, placement=Placement(20.0, (100.0, 0.0, -5.0)),
                              samples=9, window_size=SIZE, z_exaggeration=1)
-    x0, x1, y0, y1, z0, z1 = p.bounds
+    x0, x1, y0, y1, z0, z1 = drawn_bounds(p)
+    check_axes_read_true_values(p)
     p.close()
     # The control box is [1, 5] x [1, 5]; the highest point is the safe height 5 (surface units).
     assert (x0, x1, y0, y1) == (120.0, 200.0, 20.0, 100.0)
@@ -285,7 +304,9 @@ def test_z_exaggeration(tmp_path):
     zs = [float(p[2]) for p in s1.grid.points()]
     p = plot.surface_figure(s1, samples=9, window_size=SIZE)
     assert p.scale[2] == pytest.approx(4.0 / (max(zs) - min(zs)))  # the drawn height equals the larger plan side
-    assert p.renderer.cube_axes_actor.GetZAxisRange() == pytest.approx((min(zs), max(zs)))
+    # the labels on round heights: 7 to 37 mm labelled 0 to 40 in steps of 10
+    assert p.renderer.cube_axes_actor.GetZAxisRange() == pytest.approx((0.0, 40.0))
+    check_axes_read_true_values(p)
     p.close()
     p = plot.surface_figure(s1, samples=9, window_size=SIZE, z_exaggeration=1)
     assert p.scale[2] == 1.0

@@ -10,7 +10,7 @@ from ..errors import InputError
 from .backend import DEFAULT_WINDOW_SIZE, new_plotter
 from .checks import check_window_size
 from .meshes import scalar_mesh
-from .style import BAR_COLUMN, axis_labels, bar_column, fit, text_size, true_ranges, view, z_factor, z_note
+from .style import BAR_COLUMN, axis_labels, bar_column, fit, text_size, view, z_factor, z_note
 
 __all__ = ["machined_figure", "LEFT_CMAP", "MAX_DRAWN_CELLS"]
 
@@ -78,7 +78,7 @@ def machined_figure(part, *, stages: Sequence[int] | None = None, left_max_mm: f
         actor = p.add_mesh(scalar_mesh(xs, ys, m, name, np.clip(left, 0.0, top)), scalars=name, cmap=LEFT_CMAP,
                            clim=(0.0, top), nan_color="lightgrey", smooth_shading=True, show_scalar_bar=False)
         p.set_scale(zscale=factor)
-        axis_labels(p, "mm", font_size=text_size(h, 1 / 60), axes_ranges=true_ranges(p))
+        axis_labels(p, "mm", font_size=text_size(h, 1 / 60))
         p.add_text(label if title is None or col else f"{title}\n{label}", position="upper_edge", font_size=font,
                    color="black")
         view(p, zoom=0.75)

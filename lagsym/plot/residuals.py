@@ -20,7 +20,7 @@ from ..evaluate import evaluate_grid, evaluate_points
 from .backend import DEFAULT_WINDOW_SIZE, new_plotter
 from .checks import check_samples, check_window_size
 from .meshes import pointcloud, scalar_mesh
-from .style import DEVIATION_CMAP, axis_labels, bar_args, fit, text_size, true_ranges, view, z_factor, z_note
+from .style import DEVIATION_CMAP, axis_labels, bar_args, fit, text_size, view, z_factor, z_note
 
 __all__ = ["residuals_figure", "residual_exaggeration"]
 
@@ -97,7 +97,7 @@ def residuals_figure(fit_result, *, samples: int = 61, units: str | None = None,
                render_points_as_spheres=True, scalar_bar_args=bar_args(name, h))
     factor = z_factor(z_exaggeration, np.ptp(xs), np.ptp(ys), span)
     p.set_scale(zscale=factor)
-    axis_labels(p, units, font_size=text_size(h, 1 / 45), axes_ranges=true_ranges(p))
+    axis_labels(p, units, font_size=text_size(h, 1 / 45))
     if title is None:
         a, b = fit_result.degree
         title = (f"fit of degree {a} x {b} through {count} points: largest residual {top:.3g} {units}, "

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from ..values import positive
 
 __all__ = [
@@ -17,6 +19,7 @@ __all__ = [
     "bar_args",
     "bar_column",
     "axis_labels",
+    "ticks",
     "true_ranges",
     "view",
     "plan_view",
@@ -66,10 +69,55 @@ def units_of(surface, units: str | None) -> str:
     return units or getattr(source, "units", None) or "mm"
 
 
-def axis_labels(plotter, units: str, font_size: int = 10, **extra) -> None:
-    """A grid with x, y and z titled in ``units`` (``extra`` goes to ``show_grid``, e.g. ``axes_ranges``)."""
+def ticks(lo: float, hi: float, drawn_per_unit: float, least_gap: float, most: int = 6) -> tuple[float, float, int]:
+    """Labels for an axis from ``lo`` to ``hi``: ``(first, last, count)`` on round values, or the two ends.
+
+    The step is the smallest of 1, 2, 2.5 and 5 times a power of ten whose
+    labels lie at least ``least_gap`` apart as drawn (``drawn_per_unit``
+    drawn units per axis unit) and number at most ``most``; the axis then
+    runs from a multiple of the step below ``lo`` to one above ``hi``.  Where
+    that would stretch the axis by more than 40 % of its span (a short,
+    stretched z axis), the labels are the two ends alone: fewer labels, never
+    overlapping ones.
+
+    Examples
+    --------
+    >>> ticks(0.0, 100.0, 1.0, 12.5)
+    (0.0, 100.0, 6)
+    >>> ticks(3.14, 6.93, 4.43, 12.5)
+    (3.14, 6.93, 2)
+    >>> ticks(-0.37, 2.61, 10.0, 5.0)
+    (-1.0, 3.0, 5)
+    """
+    span = hi - lo
+    if not (span > 0 and drawn_per_unit > 0 and math.isfinite(span)):
+        return lo, hi, 2
+    power = 10.0 ** math.floor(math.log10(span / 10))
+    for step in (m * power * 10 ** e for e in range(4) for m in (1, 2, 2.5, 5)):
+        first, last = math.floor(lo / step + 1e-9) * step, math.ceil(hi / step - 1e-9) * step
+        count = round((last - first) / step) + 1
+        if step * drawn_per_unit >= least_gap and count <= most:
+            if last - first <= 1.4 * span:
+                return round(first, 12), round(last, 12), count
+            break
+    return lo, hi, 2
+
+
+def axis_labels(plotter, units: str, font_size: int = 10) -> None:
+    """A grid with x, y and z titled in ``units``, its labels on round values reading true heights.
+
+    A stretched or squeezed z (``plotter.scale``) is labelled with the heights
+    of the part, not the drawing's; labels lie at least an eighth of the
+    larger plan side apart as drawn, so a short z axis gets fewer of them.
+    """
+    x0, x1, y0, y1, z0, z1 = true_ranges(plotter)
+    k = plotter.scale[2]
+    gap = max(x1 - x0, y1 - y0, (z1 - z0) * k) / 8
+    (ax, bx, nx), (ay, by, ny), (az, bz, nz) = (ticks(x0, x1, 1.0, gap), ticks(y0, y1, 1.0, gap),
+                                                 ticks(z0, z1, k, gap))
     plotter.show_grid(xtitle=f"x ({units})", ytitle=f"y ({units})", ztitle=f"z ({units})", color="black",
-                      font_size=font_size, fmt="%.3g", **extra)
+                      font_size=font_size, fmt="%.4g", bounds=[ax, bx, ay, by, az * k, bz * k],
+                      axes_ranges=[ax, bx, ay, by, az, bz], n_xlabels=nx, n_ylabels=ny, n_zlabels=nz)
 
 
 def true_ranges(plotter) -> list[float]:

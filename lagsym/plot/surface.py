@@ -33,7 +33,6 @@ from .style import (
     padded,
     text_size,
     title_for,
-    true_ranges,
     view,
     z_factor,
     z_note,
@@ -97,7 +96,7 @@ def surface_figure(surface, *, samples: int = 61, units: str | None = None, titl
         add_control(p, g.x_array, g.y_array, g.z_array)
     factor = z_factor(z_exaggeration, np.ptp(xs), np.ptp(ys), float(np.ptp(zz)))
     p.set_scale(zscale=factor)
-    axis_labels(p, units, font_size=text_size(h, 1 / 45), axes_ranges=true_ranges(p))
+    axis_labels(p, units, font_size=text_size(h, 1 / 45))
     text = title if title is not None else title_for(surface)
     if z_note(factor):
         text = f"{text}\n{z_note(factor)}" if text else z_note(factor)

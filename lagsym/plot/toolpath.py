@@ -19,7 +19,6 @@ from .style import (
     bar_args,
     fit,
     text_size,
-    true_ranges,
     view,
     z_factor,
     z_note,
@@ -92,7 +91,7 @@ def toolpath_figure(surface, moves_mm, *, rapid=None, placement: Placement | Non
     span_z = float(max(zz.max(), pts[:, 2].max()) - min(zz.min(), pts[:, 2].min()))
     factor = z_factor(z_exaggeration, max(np.ptp(xs), np.ptp(pts[:, 0])), max(np.ptp(ys), np.ptp(pts[:, 1])), span_z)
     p.set_scale(zscale=factor)
-    axis_labels(p, "mm", font_size=text_size(h, 1 / 45), axes_ranges=true_ranges(p))
+    axis_labels(p, "mm", font_size=text_size(h, 1 / 45))
     deg = surface.degree
     text = title if title is not None else "\n".join(filter(None, [
         f"Toolpath over the Lagrange surface, degree {deg[0]} x {deg[1]}",
