@@ -17,6 +17,7 @@ FIGURES = {
     "fig10-compare.png": ["plot", "examples/paper-example-4.json", "--show", "compare"],
     "fig11-growth.png": ["plot", "examples/parabola.json", "--show", "growth", "1/(1 + ((x-20)**2 + (y-20)**2)/25)"],
     "measured-residuals.png": ["plot", "--show", "residuals", "examples/probe-12x12.csv"],
+    "probe-residuals.png": ["plot", "--show", "residuals", "examples/probe-results.txt"],
 }
 
 

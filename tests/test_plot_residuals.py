@@ -77,3 +77,27 @@ def test_command_writes_the_picture(tmp_path):
     assert main(["plot", "--show", "residuals", str(EXAMPLES / "probe-12x12.csv"), "--scale", "2", "-o",
                  str(tmp_path / "s.png")], out, err) == 2
     assert "--scale" in err.getvalue() and not (tmp_path / "s.png").exists()
+
+
+def test_probe_results_are_drawn_at_the_probed_nodes(tmp_path):
+    """A probing program's results, as the control printed them, drawn at the nodes the program probed."""
+    import re
+
+    import pyvista as pv
+
+    from lagsym.probe import read_results, surface_points
+
+    text = (EXAMPLES / "probe-results.txt").read_text()
+    nodes = sorted((float(m[1]), float(m[2])) for m in re.finditer(r"^P \d+ X (\S+) Y (\S+) Z \S+ OK$", text, re.M))
+    assert len(nodes) == 49
+    out, err = io.StringIO(), io.StringIO()
+    dst = tmp_path / "probed.png"
+    assert main(["plot", "--show", "residuals", str(EXAMPLES / "probe-results.txt"), "--size", "400x300", "-o",
+                 str(dst)], out, err) == 0, err.getvalue()
+    assert Image.open(dst).size == (400, 300)
+    fitted = fit_surface(surface_points(read_results(text, "probe-results.txt")).points, None)
+    p = plot.residuals_figure(fitted, samples=21, window_size=SIZE, off_screen=True)
+    drawn = [a.mapper.dataset.points for a in p.actors.values()
+             if isinstance(a, pv.Actor) and a.mapper.dataset.n_points == len(nodes)]
+    p.close()
+    assert len(drawn) == 1 and sorted(map(tuple, np.round(drawn[0][:, :2], 4))) == nodes

@@ -98,6 +98,20 @@ ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points m
                             "(see 'lagsym check'); the program header records it")
 
 
+def measured_points(path: str, columns=None):
+    """Measured points: a probing program's results (read as ``lagsym read-probe`` reads them) or a points file."""
+    from ..io import read_scattered_points, read_text
+    from ..io.points import ScatteredPoints
+    from ..probe import is_probe_results, read_results, surface_points
+
+    if path != "-":
+        name, text = read_text(path)
+        if is_probe_results(text):
+            sp = surface_points(read_results(text, name))
+            return ScatteredPoints(sp.points, name, sp.results.units, f"probe results: {sp.describe()}", plain=False)
+    return read_scattered_points(path, columns)
+
+
 def add_conditioning_argument(p) -> None:
     """``--accept-conditioning``, for the commands that turn a surface into something physical."""
     p.add_argument("--accept-conditioning", action="store_true", help=ACCEPT_CONDITIONING_HELP)

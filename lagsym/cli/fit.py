@@ -8,11 +8,9 @@ from ..conditioning import AMPLIFICATION_LIMIT
 from ..errors import InputError
 from ..export.surfacejson import write_surface_json
 from ..fit import CRITERIA, MAX_DEGREE, fit_surface
-from ..io import read_scattered_points, read_text
-from ..io.points import ScatteredPoints
-from ..probe import is_probe_results, read_results, surface_points
+from ..io import read_text
 from ..values import exact_number, NotANumber
-from ._common import COLUMNS_HELP, emit, exact
+from ._common import COLUMNS_HELP, emit, exact, measured_points
 
 DESCRIPTION = """Fit the exact least-squares tensor-product polynomial
 z = sum c[a][b] x^a y^b (a <= P, b <= Q) to the points in FILE: a grid, a
@@ -78,19 +76,8 @@ def read_weights(path: str) -> list:
     return out
 
 
-def _probe_results(path: str):
-    """The surface points of a probing program's results file (``lagsym read-probe``), or None for any other file."""
-    if path == "-":
-        return None
-    name, text = read_text(path)
-    if not is_probe_results(text):
-        return None
-    sp = surface_points(read_results(text, name))
-    return ScatteredPoints(sp.points, name, sp.results.units, f"probe results: {sp.describe()}", plain=False)
-
-
 def run(args, out, err) -> int:
-    data = _probe_results(args.file) or read_scattered_points(args.file, args.columns)
+    data = measured_points(args.file, args.columns)
     if not data.plain:
         err.write(f"{data.source}: read as {data.layout}\n")
     weights = read_weights(args.weights) if args.weights else None

@@ -8,7 +8,7 @@ from ..errors import InputError
 from ..grid import CurvePoints
 from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
-from ._common import SCALE, count, number
+from ._common import SCALE, count, measured_points, number
 
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
@@ -24,8 +24,8 @@ with --show machined PROGRAM, FILE being a job file (TOML), the block after
 each tool of the job's PROGRAM, simulated as lagsym verify --job does and
 coloured by the material left above the surface (the counterpart of the
 paper's photographs, Figures 13 and 15); with --show residuals, FILE being
-measured points (a grid or scattered), the least-squares surface 'lagsym fit'
-chooses (automatic degree) and every point on a stem from it, coloured by its
+measured points (a grid or scattered, or the results a 'lagsym probe' program
+sent back: the probed nodes), the least-squares surface 'lagsym fit' chooses (automatic degree) and every point on a stem from it, coloured by its
 residual z - p(x, y) (stems drawn longer, as the title says).
 Deviations are d = z_f - z_a everywhere, as lagsym compare prints them.
 A file of [x, y] points draws the curve through them (and, with --show basis,
@@ -46,7 +46,8 @@ examples:
   lagsym plot examples/parabola.json --show growth "1/(1 + ((x-20)**2 + (y-20)**2)/25)" -o growth.png
   lagsym job examples/example-4-job.toml -o job.ngc
   lagsym plot examples/example-4-job.toml --show machined job.ngc --cell 0.5 -o machined.png
-  lagsym plot --show residuals examples/probe-12x12.csv -o residuals.png"""
+  lagsym plot --show residuals examples/probe-12x12.csv -o residuals.png
+  lagsym plot --show residuals examples/probe-results.txt -o probed.png"""
 
 SHOW = ("surface", "basis", "compare", "toolpath", "growth", "machined", "residuals")
 TAKES_A_WORD = {"toolpath": "PROGRAM", "growth": "FORMULA", "machined": "PROGRAM"}
@@ -64,7 +65,7 @@ def add_arguments(p) -> None:
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
                    help="surface (default), basis, compare, 'toolpath PROGRAM', 'growth FORMULA', "
-                        "'machined PROGRAM' (FILE a job file) or residuals (FILE measured points)")
+                        "'machined PROGRAM' (FILE a job file) or residuals (FILE measured points or probe results)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the picture to FILE instead of opening a window")
     p.add_argument("--units", help="length unit for the axis labels (default: the points file's, else mm)")
     p.add_argument("--size", type=_size, default=(1280, 960), metavar="WxH",
@@ -208,12 +209,11 @@ def _machined_figure(plot, job_file, program, args):
 def _residuals_figure(plot, file, args):
     """The least-squares surface of measured points (automatic degree) and its residuals as coloured stems."""
     from ..fit import fit_surface
-    from ..io import read_scattered_points
 
     for option in ("scale", "origin"):
         if getattr(args, option) is not None:
             raise InputError(f"--{option} places a program on the machine: it goes with --show toolpath PROGRAM")
-    data = read_scattered_points(file)
+    data = measured_points(file)
     fitted = fit_surface(data.points, None, source=data.source, units=data.units)
     opts = dict(units=args.units or data.units or "mm", window_size=args.size,
                 off_screen=True if args.output else None)
