@@ -108,7 +108,7 @@ def test_tutorials_are_the_notebooks_without_outputs():
     import json
 
     notebooks = sorted((ROOT / "notebooks").glob("*.ipynb"))
-    assert len(notebooks) == 5
+    assert len(notebooks) == 6
     for nb in notebooks:
         link = ROOT / "docs" / nb.name
         assert link.is_symlink() and link.resolve() == nb.resolve(), link
