@@ -79,6 +79,12 @@ def add_arguments(p) -> None:
     t.add_argument("--tool-number", type=_TOOL_NUMBER, default=1, metavar="N", help="tool and length offset number (default 1)")
     t.add_argument("--flute-length", type=_LEN_MM, metavar="MM", help="refuse a step-down longer than the flutes")
     t.add_argument("--reach", type=_LEN_MM, metavar="MM", help="tool length below the holder: refuse a deeper cut")
+    t.add_argument("--plunge-angle", type=number(0.0, 90.0, "degrees", above=True), metavar="DEG",
+                   help="steepest descent into material, degrees from the horizontal: steeper ones ramp down "
+                        "at this angle (default 15, or 3 with --not-centre-cutting; 90: plunge)")
+    t.add_argument("--not-centre-cutting", dest="centre_cutting", action="store_false",
+                   help="the end mill does not cut at its centre: it never plunges, and ramps at 3 degrees "
+                        "unless --plunge-angle says otherwise")
     m = p.add_argument_group("machine")
     m.add_argument("--scale", type=SCALE, default=1.0, help="millimetres per surface unit (default 1)")
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
@@ -105,9 +111,11 @@ def job_data(args) -> dict:
     if args.margin is not None:
         stock["margin"] = args.margin
     tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
-    for key in ("corner_radius", "flute_length", "reach"):
+    for key in ("corner_radius", "flute_length", "reach", "plunge_angle"):
         if getattr(args, key) is not None:
             tool[key] = getattr(args, key)
+    if not args.centre_cutting:
+        tool["centre_cutting"] = False
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
           "plunge_feed": args.plunge_feed, "coolant": args.coolant, "stepdown": args.stepdown, "step": args.step,
           "stock_to_leave": args.stock_to_leave}

@@ -226,11 +226,18 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     if spec.reach_mm is not None and depth > spec.reach_mm:
         raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
                             f"the tool reaches {spec.reach_mm:g} mm below its holder")
+    ramp = dict(radius=tool.radius_mm, tan_a=ramp_slope(tool))
     if spec.pattern == "offset":
-        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec)
+        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec, **ramp)
     else:
-        pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec)
+        pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec, **ramp)
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def ramp_slope(tool: Tool) -> float:
+    """The steepest descent into material the tool makes, as a rise per mm (``inf`` for a plunge at 90 degrees)."""
+    deg = tool.max_ramp_deg
+    return math.inf if deg >= 90.0 else math.tan(math.radians(deg))
 
 
 def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place, *,
