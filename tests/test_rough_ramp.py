@@ -85,4 +85,66 @@ def test_no_descent_into_stock_is_steeper_than_the_ramp_angle(rs274, extra, limi
     assert f"RAMP INTO MATERIAL AT MOST {limit:g} DEG" in text
     count, deepest, steepest = descents_into_stock(moves(rs274, text), limit)
     assert count == 0, (count, deepest)
-    assert steepest <= limit + 0.01, steepest
+    assert limit - 1.0 < steepest <= limit + 0.01, steepest  # the stated angle is the one used, and held
+
+
+def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274):
+    """``--plunge-angle 90`` (a centre-cutting mill that may plunge) is taken, not ignored: the old descents."""
+    text = _program(["--plunge-angle", "90", "--stepdown", "30", "--step", "1"])
+    assert "RAMP INTO MATERIAL AT MOST 90 DEG" in text
+    count, deepest, steepest = descents_into_stock(moves(rs274, text), 15.0)
+    assert count > 0 and steepest > 60, (count, steepest)
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--plunge-angle", "0"], "--plunge-angle"),
+    (["--plunge-angle", "91"], "--plunge-angle"),
+    (["--not-centre-cutting", "--plunge-angle", "90"], "cannot make"),
+    (["--macro", "--not-centre-cutting"], "does not cut at its centre"),
+    (["--macro", "--plunge-angle", "10"], "ramp angle of 10 degrees"),
+])
+def test_a_tool_that_may_not_plunge_is_refused_where_it_would(run_cli, tmp_path, extra, words):
+    out = tmp_path / "r.nc"
+    status, _, err = run_cli(*README, *extra, "-o", out)
+    assert status == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
+JOB = """points = "{points}"
+dialect = "linuxcnc"
+scale = 20
+safe_z = 90
+
+[stock]
+top_above = 2
+
+[tools.rougher]
+number = 1
+shape = "flat"
+diameter = 10
+{extra}
+
+[[operations]]
+kind = "rough"
+tool = "rougher"
+stepdown = 30
+stepover = 5
+step = 1
+"""
+
+
+@pytest.mark.parametrize("extra, status, words", [
+    ("centre_cutting = false", 0, "RAMP INTO MATERIAL AT MOST 3 DEG"),
+    ("centre_cutting = false\nplunge_angle = 5", 0, "RAMP INTO MATERIAL AT MOST 5 DEG"),
+    ("plunge_angle = 40", 0, "RAMP INTO MATERIAL AT MOST 40 DEG"),
+    ("centre_cutting = \"no\"", 2, "tools.rougher.centre_cutting = 'no' must be true or false"),
+    ("plunge_angle = 0", 2, "tools.rougher.plunge_angle = 0"),
+    ("centre_cutting = false\nplunge_angle = 90", 2, "cannot make"),
+])
+def test_the_job_file_gives_the_tool_its_ramp(run_cli, tmp_path, extra, status, words):
+    job = tmp_path / "j.toml"
+    job.write_text(JOB.format(points=EX4.as_posix(), extra=extra))
+    out = tmp_path / "j.ngc"
+    got, _, err = run_cli("job", job, "-o", out)
+    assert got == status, err
+    assert words in (out.read_text() if status == 0 else err)
