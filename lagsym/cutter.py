@@ -71,6 +71,11 @@ class Cutter:
     :attr:`radius_mm` and :attr:`corner_mm` are all the geometry drop-cutter
     and the simulated cut take.
 
+    ``centre_cutting`` says whether the end cuts at its centre, and
+    ``ramp_angle_deg`` (more than 0, at most 90 degrees from the horizontal)
+    the steepest descent into material roughing may make with it;
+    :attr:`max_ramp_deg` is that, or :data:`RAMP_DEG` where none is given.
+
     Examples
     --------
     >>> Cutter("bull", 10.0, corner_radius_mm=1.0).corner_mm

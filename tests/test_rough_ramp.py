@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from test_rough import EX4, R, exact_heights, moves, sweep_flat
+from test_rough import EX4, R, STEPDOWN, STOCK, exact_heights, moves, sweep_flat
 
 README = ["rough", str(EX4), "--scale", "20", "--stock-above", "2", "--tool-shape", "flat", "--tool-diameter", "10",
           "--stepdown", "2", "--stepover", "5", "--stock-to-leave", "0.3", "--safe-z", "90", "--dialect", "linuxcnc"]
@@ -40,7 +41,8 @@ def _program(extra):
 def descents_into_stock(mv, limit_deg):
     """Feed moves that descend steeper than ``limit_deg`` and end with material above the tip under the tool.
 
-    Returns (count, deepest entry mm, steepest angle of any descent that ends below material, degrees).
+    Returns (count, deepest entry mm, steepest angle of any descent that ends below material in degrees, the
+    height map after the program).
     """
     gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
     fx, fy = np.meshgrid(gx, gy, indexing="ij")
@@ -67,33 +69,84 @@ def descents_into_stock(mv, limit_deg):
         if pos is not None:
             sweep_flat(h, gx, gy, pos, (x, y, z), R)
         pos = (x, y, z)
-    return count, deepest, steepest
+    return count, deepest, steepest, h
+
+
+def left_above_reach(mv, h):
+    """The most material the map ``h`` holds above what the flat end reaches from the centres the moves pass
+    (the lowest lattice drop-cutter height over those centres covering a cell) plus the stock, inside the box."""
+    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
+    fx, fy = np.meshgrid(gx, gy, indexing="ij")
+    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    f = np.where(inbox, exact_heights(EX4, np.clip(fx, 20, 100), np.clip(fy, 20, 100)), -np.inf)
+    k = int(round(R / CELL))
+    off = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1) if (i * i + j * j) * CELL * CELL <= R * R]
+    pad = np.pad(f, k, constant_values=-np.inf)
+    cl = np.max([pad[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    passed = np.zeros(cl.shape, dtype=bool)
+    for _, x, y, _ in mv:
+        i, j = int(round((x - gx[0]) / CELL)), int(round((y - gy[0]) / CELL))
+        if 0 <= i < len(gx) and 0 <= j < len(gy):
+            passed[i, j] = True
+    padc = np.pad(np.where(passed, cl, np.inf), k, constant_values=np.inf)
+    reach = np.min([padc[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    assert (h[inbox] - f[inbox]).min() >= STOCK - 0.002, "the roughing cut into the stock to leave"
+    return float((h[inbox] - (np.maximum(reach[inbox], f[inbox]) + STOCK)).max())
+
+
+def _page():
+    return (Path(__file__).resolve().parent.parent / "docs" / "roughing.md").read_text()
+
+
+def _cycle(text):
+    return float(re.search(r"CYCLE TIME ABOUT (\S+) MIN", text).group(1))
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("extra, limit", [
-    ([], 15.0),
-    (["--pattern", "offset"], 15.0),
-    (["--not-centre-cutting"], 3.0),
-    (["--plunge-angle", "30", "--pattern", "offset"], 30.0),
+@pytest.mark.parametrize("extra, limit, quoted", [
+    ([], 15.0, "for the raster (the\nsteepest {s:.2f})"),
+    (["--pattern", "offset"], 15.0, "the offset clearing ({s:.2f})"),
+    (["--not-centre-cutting"], 3.0, "`--not-centre-cutting` ({s:.2f})"),
+    (["--plunge-angle", "30", "--pattern", "offset"], 30.0, None),
 ])
-def test_no_descent_into_stock_is_steeper_than_the_ramp_angle(rs274, extra, limit):
+def test_no_descent_into_stock_is_steeper_than_the_ramp_angle(rs274, extra, limit, quoted):
     """The README roughing (and its offset clearing, a non-centre-cutting mill, a stated angle): no feed move
-    enters the block's material going down steeper than the ramp angle the header states.  Before ramping, the
-    raster made 1,400 such moves, up to 1.86 mm deep at 75 degrees."""
+    enters the block's material going down steeper than the ramp angle the header states, and what is left
+    above the tool's reach stays within a step-down; the figures docs/roughing.md quotes."""
     text = _program(extra)
     assert f"RAMP INTO MATERIAL AT MOST {limit:g} DEG" in text
-    count, deepest, steepest = descents_into_stock(moves(rs274, text), limit)
+    mv = moves(rs274, text)
+    count, deepest, steepest, h = descents_into_stock(mv, limit)
     assert count == 0, (count, deepest)
     assert limit - 1.0 < steepest <= limit + 0.01, steepest  # the stated angle is the one used, and held
+    left = left_above_reach(mv, h)
+    assert left <= STEPDOWN, left
+    page = " ".join(_page().split())
+    if quoted:
+        assert " ".join(quoted.format(s=steepest).split()) in page
+        what = {"[]": "0.75 mm with the ramps", "['--pattern', 'offset']": "0.74 for the offset clearing",
+                "['--not-centre-cutting']": "0.86 at 3 degrees"}[str(extra)]
+        assert f"{left:.2f}" in what and what in page, (left, what)
+    if not extra:
+        assert f"{len(text)} bytes and its cycle time from 120.2 to {_cycle(text):.1f} min" in page
 
 
-def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274):
-    """``--plunge-angle 90`` (a centre-cutting mill that may plunge) is taken, not ignored: the old descents."""
-    text = _program(["--plunge-angle", "90", "--stepdown", "30", "--step", "1"])
+@pytest.mark.slow
+@pytest.mark.parametrize("extra", [[], ["--pattern", "offset"]])
+def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274, extra):
+    """``--plunge-angle 90`` (a centre-cutting mill that may plunge) is taken, not ignored: it plans as before
+    the ramps, and the descents into stock docs/roughing.md quotes are its."""
+    text = _program(["--plunge-angle", "90"] + extra)
     assert "RAMP INTO MATERIAL AT MOST 90 DEG" in text
-    count, deepest, steepest = descents_into_stock(moves(rs274, text), 15.0)
+    mv = moves(rs274, text)
+    count, deepest, steepest, h = descents_into_stock(mv, 15.0)
     assert count > 0 and steepest > 60, (count, steepest)
+    page = " ".join(_page().split())
+    what = "the raster does so in" if not extra else "the offset clearing in"
+    assert f"{what} {count} moves, up to {deepest:.2f} mm deep and {steepest:.0f} degrees steep" in page
+    if not extra:
+        assert f"grows from {len(text)} to" in page and f"cycle time from {_cycle(text):.1f} to" in page
+        assert f"on that height map {left_above_reach(mv, h):.2f} mm at 90 degrees" in " ".join(_page().split())
 
 
 @pytest.mark.parametrize("extra, words", [

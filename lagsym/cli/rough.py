@@ -19,13 +19,16 @@ _TOOL_NUMBER = count(1, 99)
 DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
 points in FILE: at each level (the stock top down by the step-down) a
 raster whose height is never below the cutter's exact drop-cutter height
-plus the stock to leave.  Every level is entered from beside the block, so
-no cutter plunges into solid stock.
+plus the stock to leave.  Every level is entered from beside the block, and
+inside a level no feed move descends into material steeper than the tool's
+ramp angle (--plunge-angle; 15 degrees, 3 with --not-centre-cutting), which
+the header states.
 
 With --macro the program is a parametric macro instead: the control loops
 over the levels, rows and points and computes each tip height from the
 surface equation, never below the drop-cutter height plus the stock (see
-docs/roughing.md for the proof of its clearance).
+docs/roughing.md for the proof of its clearance); it follows the surface
+down as steeply as it falls, so it needs a tool that may plunge.
 
 On a terminal, a progress bar on standard error shows the planning.
 

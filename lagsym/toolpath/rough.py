@@ -25,7 +25,11 @@ the box, so no move spans a corner of that rule.
 Every row starts and ends outside the block by the tool radius plus a
 clearance, so the tool goes down to each level in the air beside the block
 (a flat end that does not cut at its centre is never plunged into solid
-stock) and feeds into the material from the side.  Links that stay outside
+stock) and feeds into the material from the side.  Inside a level no
+descent into material is steeper than the tool's ramp angle
+(:attr:`~lagsym.cutter.Cutter.max_ramp_deg`): the level before bounds the
+material under each sample, and steeper descents ramp, their wedges cleared
+back and forth (:func:`~lagsym.toolpath.roughmoves.ramped`).  Links that stay outside
 the block stay down; a one-way (climb or conventional) raster goes back over
 the block above its top, the only way back that is clear of uncut material.
 """
