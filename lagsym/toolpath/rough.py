@@ -235,6 +235,10 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
         pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec, **ramp)
     else:
         pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec, **ramp)
+    if max_points is not None and len(pts) > max_points:  # the ramps' sweeps back over their wedges add points
+        raise ToolpathError(f"the roughing with its ramps at {tool.max_ramp_deg:g} degrees is {len(pts):.3g} "
+                            f"points, more than the limit of {max_points:.3g}; use larger steps, a steeper "
+                            "--plunge-angle or raise the limit (--max-points)")
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
