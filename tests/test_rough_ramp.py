@@ -155,7 +155,7 @@ def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274, extra):
     (["--not-centre-cutting", "--plunge-angle", "90"], "cannot make"),
     (["--macro", "--not-centre-cutting"], "does not cut at its centre"),
     (["--macro", "--plunge-angle", "10"], "ramp angle of 10 degrees"),
-    (["--plunge-angle", "0.5", "--max-points", "110000"], "with its ramps at 0.5 degrees is 1.33e+05 points"),
+    (["--plunge-angle", "0.5", "--max-points", "110000"], "with its ramps at 0.5 degrees is"),
 ])
 def test_a_tool_that_may_not_plunge_is_refused_where_it_would(run_cli, tmp_path, extra, words):
     out = tmp_path / "r.nc"
