@@ -29,7 +29,12 @@ import numpy as np
 from .errors import InputError, ToolpathError
 from .values import choice, finite, positive
 
-__all__ = ["Cutter", "Tool", "Shape", "SHAPES", "TOOL_SHAPES", "cutter_profile", "corner_radius"]
+__all__ = ["Cutter", "Tool", "Shape", "SHAPES", "TOOL_SHAPES", "cutter_profile", "corner_radius", "RAMP_DEG"]
+
+RAMP_DEG = {True: 15.0, False: 3.0}
+"""The steepest descent into material (degrees from the horizontal) a cutter is given when none is stated:
+15 degrees for a centre-cutting end mill, 3 for one that does not cut at its centre (its uncut core meets a
+post of material about its core's width times the slope, which a shallow ramp keeps thin)."""
 
 
 class Shape(NamedTuple):
@@ -66,6 +71,11 @@ class Cutter:
     :attr:`radius_mm` and :attr:`corner_mm` are all the geometry drop-cutter
     and the simulated cut take.
 
+    ``centre_cutting`` says whether the end cuts at its centre, and
+    ``ramp_angle_deg`` (more than 0, at most 90 degrees from the horizontal)
+    the steepest descent into material roughing may make with it;
+    :attr:`max_ramp_deg` is that, or :data:`RAMP_DEG` where none is given.
+
     Examples
     --------
     >>> Cutter("bull", 10.0, corner_radius_mm=1.0).corner_mm
@@ -81,10 +91,22 @@ class Cutter:
     shape: str = "ball"
     diameter_mm: float = 6.0
     corner_radius_mm: float | None = None
+    centre_cutting: bool = True
+    ramp_angle_deg: float | None = None
 
     def __post_init__(self):
         kind = SHAPES[choice(self.shape, TOOL_SHAPES, "tool shape")]
         object.__setattr__(self, "diameter_mm", positive(self.diameter_mm, "tool diameter", allow_zero=True))
+        if not isinstance(self.centre_cutting, bool):
+            raise InputError(f"centre cutting {self.centre_cutting!r} must be true or false")
+        if self.ramp_angle_deg is not None:
+            a = finite(self.ramp_angle_deg, "ramp angle")
+            if not 0.0 < a <= 90.0:
+                raise InputError(f"ramp angle {a:g} degrees must be more than 0 and at most 90")
+            if a == 90.0 and not self.centre_cutting:
+                raise InputError("ramp angle 90 degrees is a plunge, which a cutter that does not cut at its "
+                                 f"centre cannot make: give a shallower angle (default {RAMP_DEG[False]:g})")
+            object.__setattr__(self, "ramp_angle_deg", a)
         r = self.corner_radius_mm
         if kind.corner_share is not None:
             if r is not None:
@@ -100,6 +122,19 @@ class Cutter:
             raise InputError(f"corner radius {r:g} mm must be more than 0 and less than half the tool diameter "
                              f"({half:g} mm); a corner radius of half the diameter is a ball end (tool shape ball)")
         object.__setattr__(self, "corner_radius_mm", r)
+
+    @property
+    def max_ramp_deg(self) -> float:
+        """The steepest descent into material (degrees from the horizontal): the stated ramp angle, or :data:`RAMP_DEG`.
+
+        Examples
+        --------
+        >>> Cutter("flat", 10.0).max_ramp_deg, Cutter("flat", 10.0, centre_cutting=False).max_ramp_deg
+        (15.0, 3.0)
+        >>> Cutter("flat", 10.0, ramp_angle_deg=90).max_ramp_deg
+        90.0
+        """
+        return RAMP_DEG[self.centre_cutting] if self.ramp_angle_deg is None else float(self.ramp_angle_deg)
 
     @property
     def radius_mm(self) -> float:

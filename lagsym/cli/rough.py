@@ -19,13 +19,16 @@ _TOOL_NUMBER = count(1, 99)
 DESCRIPTION = """Rough a rectangular block down to the exact surface through the control
 points in FILE: at each level (the stock top down by the step-down) a
 raster whose height is never below the cutter's exact drop-cutter height
-plus the stock to leave.  Every level is entered from beside the block, so
-no cutter plunges into solid stock.
+plus the stock to leave.  Every level is entered from beside the block, and
+inside a level no feed move descends into material steeper than the tool's
+ramp angle (--plunge-angle; 15 degrees, 3 with --not-centre-cutting), which
+the header states.
 
 With --macro the program is a parametric macro instead: the control loops
 over the levels, rows and points and computes each tip height from the
 surface equation, never below the drop-cutter height plus the stock (see
-docs/roughing.md for the proof of its clearance).
+docs/roughing.md for the proof of its clearance); it follows the surface
+down as steeply as it falls, so it needs a tool that may plunge.
 
 On a terminal, a progress bar on standard error shows the planning.
 
@@ -79,6 +82,12 @@ def add_arguments(p) -> None:
     t.add_argument("--tool-number", type=_TOOL_NUMBER, default=1, metavar="N", help="tool and length offset number (default 1)")
     t.add_argument("--flute-length", type=_LEN_MM, metavar="MM", help="refuse a step-down longer than the flutes")
     t.add_argument("--reach", type=_LEN_MM, metavar="MM", help="tool length below the holder: refuse a deeper cut")
+    t.add_argument("--plunge-angle", type=number(0.0, 90.0, "degrees", above=True), metavar="DEG",
+                   help="steepest descent into material, degrees from the horizontal: steeper ones ramp down "
+                        "at this angle (default 15, or 3 with --not-centre-cutting; 90: plunge)")
+    t.add_argument("--not-centre-cutting", dest="centre_cutting", action="store_false",
+                   help="the end mill does not cut at its centre: it never plunges, and ramps at 3 degrees "
+                        "unless --plunge-angle says otherwise")
     m = p.add_argument_group("machine")
     m.add_argument("--scale", type=SCALE, default=1.0, help="millimetres per surface unit (default 1)")
     m.add_argument("--origin", default="0,0,0", metavar="X,Y,Z", help="work offset added to every point, mm")
@@ -105,9 +114,11 @@ def job_data(args) -> dict:
     if args.margin is not None:
         stock["margin"] = args.margin
     tool = {"number": args.tool_number, "shape": args.tool_shape, "diameter": args.tool_diameter}
-    for key in ("corner_radius", "flute_length", "reach"):
+    for key in ("corner_radius", "flute_length", "reach", "plunge_angle"):
         if getattr(args, key) is not None:
             tool[key] = getattr(args, key)
+    if not args.centre_cutting:
+        tool["centre_cutting"] = False
     op = {"kind": "rough", "tool": "cutter", "spindle": args.spindle, "feed": args.feed,
           "plunge_feed": args.plunge_feed, "coolant": args.coolant, "stepdown": args.stepdown, "step": args.step,
           "stock_to_leave": args.stock_to_leave}

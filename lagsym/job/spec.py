@@ -53,7 +53,7 @@ _PROBE = {"box": list, "top": float, "bottom": float, "tip_radius": float, "degr
 _REQUIRED_PROBE = ("box", "top", "bottom", "tip_radius")
 _STOCK = {"top": float, "top_above": float, "margin": float, "block": list}
 _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float, "flute_length": float,
-         "reach": float}
+         "reach": float, "centre_cutting": bool, "plunge_angle": float}
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
@@ -177,7 +177,7 @@ def _choice(value, options, key: str, source: str):
 # of a job file is finite and one a program word and the planners can hold.
 _RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plunge_feed": (1.0, 1e5),
            "spindle": (1.0, 2e5), "diameter": (0.0, 1000.0), "corner_radius": (0.0, 500.0), "flute_length": (0.0, 1e4),
-           "reach": (0.0, 1e4),
+           "reach": (0.0, 1e4), "plunge_angle": (0.0, 90.0),
            "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
            "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
            "tolerance": (1e-6, 1000.0)}
@@ -331,7 +331,9 @@ def _tool(name: str, table: dict, source: str) -> ToolSpec:
     shape = _choice(table["shape"], TOOL_SHAPES, where + "shape", source)
     try:
         corner = _positive(table["corner_radius"], where + "corner_radius", source) if "corner_radius" in table else None
-        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source), corner)
+        angle = _positive(table["plunge_angle"], where + "plunge_angle", source) if "plunge_angle" in table else None
+        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source), corner,
+                    centre_cutting=table.get("centre_cutting", True), ramp_angle_deg=angle)
     except LagsymError as e:
         raise InputError(f"{source}: {where}: {e}") from None
     opt = {k: _positive(table[k], where + k, source) for k in ("flute_length", "reach") if k in table}

@@ -52,7 +52,8 @@ from .model import Assign, Choose, Clamp, Item, Loop, Move, SetItem, Var, add, c
 from .raster import Axis, MacroRaster
 from .roughvars import check_rough_variables
 
-__all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]
+__all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING",
+           "check_plunging"]
 
 MACRO_MILLING = ("zigzag",)
 JOB_MACROS = names(point_lists=True, macros=True)
@@ -286,6 +287,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     if spec.milling not in MACRO_MILLING:
         raise ToolpathError(f"milling {spec.milling!r}: a roughing macro cuts zig-zag only (a one-way raster "
                             "retracts over the block between rows); leave out the macro for climb or conventional")
+    check_plunging(tool)
     form = form or ("lagrange" if precision <= 8 else "horner")
     choice(form, FORMS, "form")
     settings = dataclasses.replace(settings, stock_to_leave_mm=spec.stock_to_leave_mm)
@@ -335,6 +337,24 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     loops = MacroLoops(body=setup + body, raster=raster, form=rf, start=start, row_code=row_code,
                        point_code=point_code, title="LAGSYM ROUGHING MACRO")
     return RoughMacro(loops, clear, levels, path, precision, tool, stock, spec)
+
+
+def check_plunging(tool: Tool) -> Tool:
+    """The tool, refused where it may not plunge: a roughing macro follows the surface down as steeply as it falls.
+
+    The control computes each tip from the position alone, not from what the
+    passes before left, so it cannot ramp a descent into material without
+    leaving wedges no later level takes; the point-list roughing
+    (:func:`~lagsym.toolpath.rough.rough_toolpath`) ramps.  A tool with no
+    ramp angle stated is taken to be a centre-cutting mill that may plunge,
+    and the program's header says so.
+    """
+    if tool.centre_cutting and tool.ramp_angle_deg in (None, 90.0):
+        return tool
+    what = ("a cutter that does not cut at its centre" if not tool.centre_cutting
+            else f"a ramp angle of {tool.ramp_angle_deg:g} degrees")
+    raise ToolpathError(f"{what}: a roughing macro descends into material as steeply as the surface falls "
+                        "(it plunges); leave out the macro for roughing that ramps at the tool's angle")
 
 
 def _check_safe_z(highest_mm: float, settings: MachineSettings) -> None:

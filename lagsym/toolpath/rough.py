@@ -25,7 +25,11 @@ the box, so no move spans a corner of that rule.
 Every row starts and ends outside the block by the tool radius plus a
 clearance, so the tool goes down to each level in the air beside the block
 (a flat end that does not cut at its centre is never plunged into solid
-stock) and feeds into the material from the side.  Links that stay outside
+stock) and feeds into the material from the side.  Inside a level no
+descent into material is steeper than the tool's ramp angle
+(:attr:`~lagsym.cutter.Cutter.max_ramp_deg`): the level before bounds the
+material under each sample, and steeper descents ramp, their wedges cleared
+back and forth (:func:`~lagsym.toolpath.roughmoves.ramped`).  Links that stay outside
 the block stay down; a one-way (climb or conventional) raster goes back over
 the block above its top, the only way back that is clear of uncut material.
 """
@@ -226,11 +230,22 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     if spec.reach_mm is not None and depth > spec.reach_mm:
         raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
                             f"the tool reaches {spec.reach_mm:g} mm below its holder")
+    ramp = dict(radius=tool.radius_mm, tan_a=ramp_slope(tool))
     if spec.pattern == "offset":
-        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec)
+        pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec, **ramp)
     else:
-        pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec)
+        pts, kinds, floor = assemble_raster(rows, floors, lifts, z_levels, stock, spec, **ramp)
+    if max_points is not None and len(pts) > max_points:  # the ramps' sweeps back over their wedges add points
+        raise ToolpathError(f"the roughing with its ramps at {tool.max_ramp_deg:g} degrees is {len(pts):.3g} "
+                            f"points, more than the limit of {max_points:.3g}; use larger steps, a steeper "
+                            "--plunge-angle or raise the limit (--max-points)")
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def ramp_slope(tool: Tool) -> float:
+    """The steepest descent into material the tool makes, as a rise per mm (``inf`` for a plunge at 90 degrees)."""
+    deg = tool.max_ramp_deg
+    return math.inf if deg >= 90.0 else math.tan(math.radians(deg))
 
 
 def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place, *,

@@ -32,7 +32,7 @@ import numpy as np
 from .pattern import levels as spaced
 
 __all__ = ["FEED", "RAPID", "PLUNGE", "PATTERNS", "along_samples", "assemble_raster", "offset_line",
-           "assemble_offset"]
+           "assemble_offset", "ramped", "clear_of_block"]
 
 FEED, RAPID, PLUNGE = 0, 1, 2
 """How the tool moves into a point: at the cutting feed, at rapid, or at the plunge feed."""
@@ -58,6 +58,107 @@ def along_samples(lo: float, hi: float, cross: float, box_along, box_cross, *, r
     a, b = min(lo, hi), max(lo, hi)
     out = np.unique(np.concatenate([spaced(a, b, step), e[(e > a) & (e < b)]]))
     return out if lo <= hi else out[::-1]
+
+
+_MAX_SWEEPS = 64  # back-and-forth pairs over one dip: each lowers it by its width times the slope, or stops
+_SWEEP_GAIN_MM = 1e-4  # a pair of sweeps that lowers the tool by less than this anywhere is not made
+
+
+def _ramp_step(z_prev: float, mat_prev: float, cut: float, mat: float, dist: float, tan_a: float) -> float:
+    """The lowest tip at a sample after ``z_prev`` one ``dist`` back: down to ``cut`` at most ``tan_a`` per mm where
+    it may meet material, at once where the tool stays on or above what the passes before left at both ends, or
+    where it ends clear of the block."""
+    ramp = z_prev - tan_a * dist
+    if mat == -math.inf:  # the tool is clear of the block there: nothing to enter
+        return cut
+    if z_prev >= mat_prev:
+        ramp = min(mat, ramp) if ramp > mat else ramp
+    return cut if ramp <= cut else ramp
+
+
+def _sweep(order, z_start: float, cut, mat, gaps, tan_a: float) -> dict:
+    """One pass over the samples ``order`` (consecutive indices, either way) from ``z_start``: each sample's tip."""
+    out = {order[0]: z_start}
+    z = z_start
+    for a, b in zip(order, order[1:]):
+        z = _ramp_step(z, mat[a], cut[b], mat[b], gaps[min(a, b)], tan_a)
+        out[b] = z
+    return out
+
+
+def ramped(gaps, cut, mat, tan_a: float):
+    """Tip heights along one pass that never descends into material steeper than ``tan_a`` (rise per mm).
+
+    ``cut`` is the height wanted at each sample (the level or the floor),
+    ``mat`` the most material there can be under the tool at each sample
+    (the tip heights of the pass before over the same samples: the tool
+    passed there at that height, so its whole disc is clear down to it;
+    ``-inf`` where the disc misses the block), ``gaps`` the distances
+    between consecutive samples.  A descent steeper than ``tan_a`` is made
+    only from a sample where the tool is on or above that material to one
+    where it is too (the straight move between stays above the pass
+    before's); any other descent ramps down along the pass at ``tan_a``.
+    Where the ramp leaves the tool above ``cut`` (a wedge on a slope down),
+    the tool goes on to where it is back at ``cut``, then back over the
+    wedge and forward again, each sweep ramping down into what the one
+    before left, until it is cut (or a pair of sweeps gains nothing: a dip
+    narrower than the ramp can reach, whose rest the next level or the
+    finishing takes).
+
+    Returns the visits (sample index and tip, in the order the tool makes
+    them) and the lowest tip at each sample (the next level's ``mat``).
+
+    Examples
+    --------
+    >>> visits, low = ramped([1.0, 1.0, 1.0], [5.0, 5.0, 2.0, 2.0], [5.0, 5.0, 5.0, 5.0], 1.0)
+    >>> visits
+    [(0, 5.0), (1, 5.0), (2, 4.0), (3, 3.0), (2, 2.0), (1, 5.0), (2, 2.0), (3, 2.0)]
+    >>> low.tolist()
+    [5.0, 5.0, 2.0, 2.0]
+    """
+    cut = np.asarray(cut, float)
+    mat = np.asarray(mat, float)
+    mat = np.where(mat == -np.inf, mat, np.maximum(mat, cut))
+    n = len(cut)
+    if not math.isfinite(tan_a):
+        return [(i, float(cut[i])) for i in range(n)], cut.copy()
+    drop = cut[:-1] - cut[1:]
+    steep = (drop > tan_a * np.asarray(gaps)) & ~((cut[:-1] >= mat[:-1]) & (cut[1:] >= mat[1:]))
+    steep &= mat[1:] > -np.inf
+    if not steep.any():
+        return [(i, float(cut[i])) for i in range(n)], cut.copy()
+    gaps, cut_l, mat_l = list(gaps), cut.tolist(), mat.tolist()
+    first = _sweep(list(range(n)), cut_l[0], cut_l, mat_l, gaps, tan_a)
+    low = np.array([first[i] for i in range(n)])
+    wedge = low > cut + 1e-9
+    visits, done = [], 0
+    runs = np.flatnonzero(np.diff(np.concatenate([[0], wedge.astype(np.int8), [0]])))
+    for p, q in zip(runs[::2], runs[1::2]):  # samples p..q-1 stand above cut
+        lo, hi = max(p - 1, 0), min(q, n - 1)
+        visits += [(i, float(low[i])) for i in range(done, hi + 1)]
+        done = hi + 1
+        span = list(range(lo, hi + 1))
+        for _ in range(_MAX_SWEEPS):
+            here = low.tolist()
+            back = _sweep(span[::-1], here[hi], cut_l, here, gaps, tan_a)
+            fwd = _sweep(span, back[lo], cut_l, [back.get(i, here[i]) for i in range(n)], gaps, tan_a)
+            gain = max(here[i] - fwd[i] for i in span)
+            if gain < _SWEEP_GAIN_MM:
+                break
+            visits += [(i, back[i]) for i in span[::-1][1:]] + [(i, fwd[i]) for i in span[1:]]
+            for i in span:
+                low[i] = min(fwd[i], back[i], low[i])
+            if (low[span] <= cut[span] + 1e-9).all():
+                break
+    visits += [(i, float(low[i])) for i in range(done, n)]
+    return visits, low
+
+
+def clear_of_block(x, y, stock, radius: float) -> np.ndarray:
+    """Where a tool of ``radius`` centred at ``x, y`` (mm) has no part of the block under it."""
+    gx = np.maximum(np.maximum(stock.x0 - np.asarray(x), np.asarray(x) - stock.x1), 0.0)
+    gy = np.maximum(np.maximum(stock.y0 - np.asarray(y), np.asarray(y) - stock.y1), 0.0)
+    return np.hypot(gx, gy) > radius
 
 
 def _segment(p, q, box, radius: float, step: float):
@@ -94,20 +195,36 @@ def offset_line(stock, box, radius: float, spec) -> tuple[np.ndarray, np.ndarray
     return np.concatenate(xs), np.concatenate(ys)
 
 
-def _kept_corners(x, y, z) -> np.ndarray:
-    """Indices to emit: the middle of three samples on one straight line at one height is left out."""
+def _kept_visits(idx, z, x=None, y=None) -> np.ndarray:
+    """Indices into the visits to emit: the middle of three at one height, on one straight line and passed one
+    way, is on a straight move (a turn back over the same samples is kept)."""
+    idx, z = np.asarray(idx), np.asarray(z)
     flat = np.zeros(len(z), dtype=bool)
-    straight = (x[1:-1] - x[:-2]) * (y[2:] - y[1:-1]) == (y[1:-1] - y[:-2]) * (x[2:] - x[1:-1])
-    flat[1:-1] = (z[1:-1] == z[:-2]) & (z[1:-1] == z[2:]) & straight
+    one_way = (idx[1:-1] - idx[:-2]) * (idx[2:] - idx[1:-1]) > 0
+    flat[1:-1] = (z[1:-1] == z[:-2]) & (z[1:-1] == z[2:]) & one_way
+    if x is not None:
+        px, py = np.asarray(x)[idx], np.asarray(y)[idx]
+        flat[1:-1] &= (px[1:-1] - px[:-2]) * (py[2:] - py[1:-1]) == (py[1:-1] - py[:-2]) * (px[2:] - px[1:-1])
     return np.flatnonzero(~flat)
 
 
-def assemble_offset(x, y, floor, up, z_levels, *, stock, spec):
-    """The offset path's moves level by level: down beside the block, the loops, up and over to the next."""
+def assemble_offset(x, y, floor, up, z_levels, *, stock, spec, radius: float = 0.0, tan_a: float = math.inf):
+    """The offset path's moves level by level: down beside the block, the loops, up and over to the next.
+
+    No descent into material is steeper than ``tan_a`` (rise per mm):
+    :func:`ramped`, the material under each position taken from the level
+    before (the block's top at the first), none where the tool of
+    ``radius`` is clear of the block.
+    """
     top = stock.top_mm + spec.clearance_mm
     pts, kinds, floors = [], [], []
+    gaps = np.hypot(np.diff(x), np.diff(y))
+    mat = np.where(clear_of_block(x, y, stock, radius), -np.inf, stock.top_mm)
     for zl in z_levels:
-        z = np.maximum(zl, floor + up)
+        visits, low = ramped(gaps, np.maximum(zl, floor + up), mat, tan_a)
+        mat = np.where(np.isfinite(mat), low, -np.inf)
+        idx = np.array([v[0] for v in visits])
+        z = np.array([v[1] for v in visits])
         if pts:
             pts.append((pts[-1][0], pts[-1][1], top))
             kinds.append(RAPID)
@@ -122,10 +239,11 @@ def assemble_offset(x, y, floor, up, z_levels, *, stock, spec):
         pts.append((x[0], y[0], float(z[0])))
         kinds.append(PLUNGE)
         floors.append(-np.inf)
-        for j in _kept_corners(x, y, z)[1:]:
-            pts.append((float(x[j]), float(y[j]), float(z[j])))
+        for j in _kept_visits(idx, z, x, y)[1:]:
+            i = idx[j]
+            pts.append((float(x[i]), float(y[i]), float(z[j])))
             kinds.append(FEED)
-            floors.append(float(floor[j]))
+            floors.append(float(floor[i]))
     pts.append((pts[-1][0], pts[-1][1], top))
     kinds.append(RAPID)
     floors.append(-np.inf)
@@ -141,15 +259,13 @@ def _climb_forward(direction: str, progress: int) -> bool:
     return progress < 0 if direction == "x" else progress > 0
 
 
-def _kept(z: np.ndarray) -> np.ndarray:
-    """Indices of a row's samples to emit: the middle of three samples at one height is on a straight move."""
-    flat = np.zeros(len(z), dtype=bool)
-    flat[1:-1] = (z[1:-1] == z[:-2]) & (z[1:-1] == z[2:])
-    return np.flatnonzero(~flat)
-
-
-def assemble_raster(rows, floors, lifts, z_levels, stock, spec):
+def assemble_raster(rows, floors, lifts, z_levels, stock, spec, *, radius: float = 0.0, tan_a: float = math.inf):
     """The moves level by level: rows, links outside the block, and retracts above it for a one-way raster.
+
+    No descent into material is steeper than ``tan_a`` (rise per mm): each
+    row is :func:`ramped`, the material under each sample taken from the
+    level before on the same row (the block's top at the first), none
+    where the tool of ``radius`` is clear of the block.
 
     Long because the three kinds of link (along a row end, down between
     levels, back above the block) are decided here together with the row
@@ -164,6 +280,10 @@ def assemble_raster(rows, floors, lifts, z_levels, stock, spec):
         kinds.append(kind)
         floor.append(f)
 
+    mats = []
+    for r in rows:
+        rx, ry = (r.along, np.full(len(r.along), r.cross)) if along_x else (np.full(len(r.along), r.cross), r.along)
+        mats.append(np.where(clear_of_block(rx, ry, stock, radius), -np.inf, stock.top_mm))
     toggle = 0
     for k, zl in enumerate(z_levels):
         order = range(len(rows)) if k % 2 == 0 else range(len(rows) - 1, -1, -1)
@@ -175,8 +295,12 @@ def assemble_raster(rows, floors, lifts, z_levels, stock, spec):
                 toggle += 1
             else:
                 fwd = _climb_forward(spec.direction, progress) == (spec.milling == "climb")
-            a, ff, uu = (r.along, f, up) if fwd else (r.along[::-1], f[::-1], up[::-1])
-            z = np.maximum(zl, ff + uu)
+            a, ff, uu, mm = (r.along, f, up, mats[i]) if fwd else (r.along[::-1], f[::-1], up[::-1], mats[i][::-1])
+            visits, low = ramped(np.abs(np.diff(a)), np.maximum(zl, ff + uu), mm, tan_a)
+            low = np.where(np.isfinite(mm), low, -np.inf)
+            mats[i] = low if fwd else low[::-1]
+            idx = np.array([v[0] for v in visits])
+            z = np.array([v[1] for v in visits])
             if not pts:
                 add(a[0], r.cross, top, RAPID)
                 add(a[0], r.cross, float(z[0]), PLUNGE)
@@ -190,8 +314,8 @@ def assemble_raster(rows, floors, lifts, z_levels, stock, spec):
                 if zl + spec.clearance_mm < top:
                     add(a[0], r.cross, zl + spec.clearance_mm, RAPID)
                 add(a[0], r.cross, float(z[0]), PLUNGE)
-            for j in _kept(z)[1:]:
-                add(float(a[j]), r.cross, float(z[j]), FEED, float(ff[j]))
+            for j in _kept_visits(idx, z)[1:]:
+                add(float(a[idx[j]]), r.cross, float(z[j]), FEED, float(ff[idx[j]]))
     last = pts[-1]
     add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
     return pts, kinds, floor
