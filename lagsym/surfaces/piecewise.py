@@ -317,6 +317,7 @@ class PiecewiseEvaluator:
         self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
                                          for k in range(m)] for i in range(n)]))
         self._evaluators: dict = {}
+        self._derivatives: dict = {}
 
     @cached_property
     def upper_heights(self) -> np.ndarray:
@@ -348,12 +349,19 @@ class PiecewiseEvaluator:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         shape = x.shape
         i, k, s, t, hx, hy = self.locate(x.ravel(), y.ravel())
-        a = self.local[i, k]  # (N, 4, 4): a[p, u, v] multiplies s**u t**v
-        a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(a, 1, 2), dx), 1, 2), dy)
+        a = self._derived(dx, dy)[i, k]  # (N, 4, 4): a[p, u, v] multiplies s**u t**v
         ps = np.stack([np.ones_like(s), s, s * s, s * s * s], axis=1)
         pt = np.stack([np.ones_like(t), t, t * t, t * t * t], axis=1)
         z = np.einsum("pu,puv,pv->p", ps, a, pt) / (hx ** dx * hy ** dy)
         return z.reshape(shape)
+
+    def _derived(self, dx: int, dy: int) -> np.ndarray:
+        """Every piece's local coefficients differentiated ``dx`` times in s and ``dy`` in t (made once)."""
+        found = self._derivatives.get((dx, dy))
+        if found is None:
+            a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(self.local, 2, 3), dx), 2, 3), dy)
+            found = self._derivatives[dx, dy] = readonly(a)
+        return found
 
     def curvature_bound(self, samples: int = 5) -> float:
         """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on ``samples`` x ``samples`` points of every piece.
@@ -366,7 +374,7 @@ class PiecewiseEvaluator:
         hx, hy = np.diff(self.breaks_x), np.diff(self.breaks_y)
         worst = 0.0
         for dx, dy in ((2, 0), (0, 2), (1, 1)):
-            a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(self.local, 2, 3), dx), 2, 3), dy)
+            a = self._derived(dx, dy)
             d = np.einsum("su,ikuv,tv->ikst", powers, a, powers)
             d = d / (hx[:, None, None, None] ** dx * hy[None, :, None, None] ** dy)
             worst = max(worst, float(np.abs(d).max()))
@@ -387,7 +395,7 @@ class PiecewiseEvaluator:
         hx, hy = np.diff(self.breaks_x), np.diff(self.breaks_y)
         out = np.empty((3, 2) + self.local.shape[:2])
         for e, (dx, dy) in enumerate(((2, 0), (0, 2), (1, 1))):
-            a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(self.local, 2, 3), dx), 2, 3), dy)
+            a = self._derived(dx, dy)
             b = np.einsum("ja,ikab,lb->ikjl", w, a, w) / (hx[:, None, None, None] ** dx * hy[None, :, None, None] ** dy)
             pad = 1e-9 * (np.abs(b).max(axis=(2, 3)) + 1e-300)
             out[e, 0], out[e, 1] = b.min(axis=(2, 3)) - pad, b.max(axis=(2, 3)) + pad
