@@ -226,3 +226,27 @@ def test_command_line_verifies_a_piecewise_file(tmp_path, plan):
     out, err = io.StringIO(), io.StringIO()
     assert main(args, out, err) == 1
     assert "GOUGE" in out.getvalue()
+
+
+@pytest.mark.slow
+def test_the_measured_data_page_quotes_verify(tmp_path, monkeypatch):
+    """docs/measured-data.md's verify run on the pieces, from the commands it shows."""
+    import re
+
+    from conftest import ROOT
+
+    from lagsym.cli import main
+
+    page = (ROOT / "docs" / "measured-data.md").read_text()
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    for cmd in ("piecewise examples/part-20x20.csv -o pieces.json",
+                "toolpath pieces.json --tool-diameter 6 --stepover 2 --step 1 -o pieces.nc"):
+        assert f"$ lagsym {cmd}\n" in page
+        assert main(cmd.split(), io.StringIO(), io.StringIO()) == 0
+    cmd = "verify pieces.json pieces.nc --tool-diameter 6 --max-left 0.5"
+    out = io.StringIO()
+    assert main(cmd.split(), out, io.StringIO()) == 0
+    assert f"$ lagsym {cmd}\n{out.getvalue()}" in page
+    left = float(re.search(r"material left +(\S+) mm", out.getvalue()).group(1))
+    assert f"leaves cusps of {left:.1f} mm" in " ".join(page.split())
