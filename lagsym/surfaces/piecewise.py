@@ -290,6 +290,13 @@ def piecewise_surface(grid: ControlGrid) -> PiecewiseSurface:
     return PiecewiseSurface(grid, *frozen)
 
 
+def _axis(breaks: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The cell of each coordinate (a border: the cell after it; clipped to the first and last) and its
+    position in it (0 to 1 inside)."""
+    i = np.clip(np.searchsorted(breaks, v, side="right") - 1, 0, len(breaks) - 2)
+    return i, (v - breaks[i]) / (breaks[i + 1] - breaks[i])
+
+
 def _local_derivative(a: np.ndarray, d: int) -> np.ndarray:
     """Coefficients along the last axis of ``a`` differentiated ``d`` times (the same length, zero-padded)."""
     for _ in range(d):
@@ -354,6 +361,29 @@ class PiecewiseEvaluator:
         pt = np.stack([np.ones_like(t), t, t * t, t * t * t], axis=1)
         z = np.einsum("pu,puv,pv->p", ps, a, pt) / (hx ** dx * hy ** dy)
         return z.reshape(shape)
+
+    def grid(self, xs, ys, engine=None) -> np.ndarray:
+        """``Z[i, j] = F(xs[i], ys[j])`` on a grid, each point from the piece whose cell holds it.
+
+        Each value is a bicubic in its cell's coordinates on ``[0, 1]``: 16
+        terms, so its rounding error is a few units of rounding times the
+        piece's coefficients, about the size of the surface.  Points outside the box take
+        the nearest edge piece (extrapolation).  ``engine`` is accepted as
+        :meth:`lagsym.evaluate.SurfaceEvaluator.grid` takes it (pieces always run in NumPy).
+        """
+        xs = np.asarray(xs, dtype=float).ravel()
+        ys = np.asarray(ys, dtype=float).ravel()
+        i, s = _axis(self.breaks_x, xs)
+        k, t = _axis(self.breaks_y, ys)
+        ps = np.stack([np.ones_like(s), s, s * s, s * s * s], axis=1)
+        pt = np.stack([np.ones_like(t), t, t * t, t * t * t], axis=1)
+        out = np.empty((len(xs), len(ys)))
+        rows = max(1, (1 << 16) // max(len(ys), 1))
+        for r0 in range(0, len(xs), rows):
+            r1 = min(r0 + rows, len(xs))
+            w = np.einsum("pu,pkuv->pkv", ps[r0:r1], self.local[i[r0:r1]])  # (rows, pieces in y, 4)
+            out[r0:r1] = np.einsum("pqv,qv->pq", w[:, k, :], pt)
+        return out
 
     def _derived(self, dx: int, dy: int) -> np.ndarray:
         """Every piece's local coefficients differentiated ``dx`` times in s and ``dy`` in t (made once)."""
