@@ -10,7 +10,9 @@ block, work offset, tools, operations) and write them as one point-list
 program, in order, with a tool change, spindle speed, feeds and coolant for
 each.  Every key of the job file is checked.  The cycle-time estimate of
 each operation and of the whole job is printed and written in the program's
-header.  See docs/roughing.md for the job file.
+header.  See docs/roughing.md for the job file.  The points file may be a
+piecewise surface ('lagsym piecewise'); a roughing macro (macro = true) is
+refused for it.
 
 On a terminal, a progress bar on standard error shows the planning of each operation.
 
