@@ -45,7 +45,7 @@ On a terminal, a progress bar on standard error shows the moves swept.
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6 --max-left 0.12
   lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1
-  lagsym verify pieces.json pieces.nc --tool-diameter 6
+  lagsym verify pieces.json pieces.nc --tool-diameter 6 --max-left 0.5
   lagsym verify --job examples/example-4-job.toml job.ngc --cell 0.5"""
 
 
