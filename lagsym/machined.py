@@ -23,11 +23,11 @@ import numpy as np
 
 from ._arrays import freeze_fields
 from .errors import InputError
-from .evaluate import evaluate_grid
 from .gcode import Moves, first_line_with, is_macro, macro_uses, parse_moves, program_blocks, tool_changes
 from .job.operations import job_stock, job_surface
 from .machine import Placement, Tool, mm_per_program_unit
 from .progress import Progress, Tally
+from .toolpath.dropcutter import evaluator_of
 from .verify import MAX_CELLS, height_map_axes, press_moves
 from .verify.heightmap import segments, tool_grid
 
@@ -224,9 +224,7 @@ def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:
     out = np.full((len(xs), len(ys)), np.nan)
     if ix.any() and iy.any():
         sx, sy = placement.to_surface(np.clip(xs[ix], bx0, bx1), np.clip(ys[iy], by0, by1))
-        own = getattr(surface, "evaluator", None)  # a piecewise surface evaluates its own pieces
-        z = own.grid(sx, sy) if own is not None else evaluate_grid(surface, sx, sy)
-        out[np.ix_(ix, iy)] = placement.height_mm(z)
+        out[np.ix_(ix, iy)] = placement.height_mm(evaluator_of(surface).grid(sx, sy))
     return out
 
 

@@ -47,7 +47,7 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import InputError
-from ..evaluate import evaluate_grid, surface_evaluator
+from ..evaluate import surface_evaluator
 from ..gcode import Moves, numeric_words, program_blocks, program_units
 from ..gcode.words import plain_move
 from ..machine import MAX_LEFT_MM, Placement, Tool, mm_per_program_unit
@@ -260,7 +260,7 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
     ev = _evaluator(surface)
-    surf = placement.height_mm(_heights(surface, ev, sx, sy))
+    surf = placement.height_mm(ev.grid(sx, sy))
     slope = _slopes(ev, sx, sy)
     limit = gouge_limit(program_resolution_mm, float(slope.max())) if gouge_limit_mm is None else float(gouge_limit_mm)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
@@ -347,14 +347,6 @@ def _left(cut, surf, slope, winner, *, moves, grid, curvature, ev, placement) ->
 def _evaluator(surface):
     """The numeric evaluator of the surface: a piecewise surface's own, else the polynomial's."""
     return surface.evaluator if isinstance(surface, PiecewiseSurface) else surface_evaluator(surface)
-
-
-def _heights(surface, ev, sx, sy) -> np.ndarray:
-    """The surface (its own units) at the cell centres ``sx`` x ``sy``."""
-    if isinstance(surface, PiecewiseSurface):
-        gx, gy = np.meshgrid(sx, sy, indexing="ij")
-        return ev.fast_points(gx, gy)
-    return evaluate_grid(surface, sx, sy)
 
 
 def _slopes(ev, sx, sy) -> np.ndarray:
