@@ -23,13 +23,11 @@ import numpy as np
 
 from ._arrays import freeze_fields
 from .errors import InputError
-from .evaluate import evaluate_grid
 from .gcode import Moves, first_line_with, is_macro, macro_uses, parse_moves, program_blocks, tool_changes
-from .io import read_points
-from .job.operations import job_stock
-from .lagrange import lagrange_surface
+from .job.operations import job_stock, job_surface
 from .machine import Placement, Tool, mm_per_program_unit
 from .progress import Progress, Tally
+from .toolpath.dropcutter import evaluator_of
 from .verify import MAX_CELLS, height_map_axes, press_moves
 from .verify.heightmap import segments, tool_grid
 
@@ -132,7 +130,7 @@ def machine_part(surface, moves: Moves, changes: list[tuple[int, int]], tools: d
 
     Parameters
     ----------
-    surface : LagrangeSurface
+    surface : LagrangeSurface or PiecewiseSurface
         The exact surface; ``placement`` puts it on the machine.
     moves : Moves
         The program's moves (:func:`lagsym.gcode.parse_moves`).
@@ -187,7 +185,7 @@ def machine_job(spec, text: str, source: str = "<program>", **options) -> Machin
     :func:`machine_part` (``cell_mm``, ``gouge_limit_mm``, ``max_cells``, ``progress``), which for a
     macro program is told the blocks executed too (:func:`lagsym.simulate.simulate`).
     """
-    surface = lagrange_surface(read_points(spec.points))
+    surface = job_surface(spec)
     stock = job_stock(spec, surface)
     moves = job_moves(spec, text, source, options.get("progress"))
     if is_macro(text, _SIMULATED):
@@ -226,7 +224,7 @@ def _surface_on(surface, placement: Placement, xs, ys) -> np.ndarray:
     out = np.full((len(xs), len(ys)), np.nan)
     if ix.any() and iy.any():
         sx, sy = placement.to_surface(np.clip(xs[ix], bx0, bx1), np.clip(ys[iy], by0, by1))
-        out[np.ix_(ix, iy)] = placement.height_mm(evaluate_grid(surface, sx, sy))
+        out[np.ix_(ix, iy)] = placement.height_mm(evaluator_of(surface).grid(sx, sy))
     return out
 
 

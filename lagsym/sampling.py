@@ -207,7 +207,7 @@ def sample_grid(
 
     Parameters
     ----------
-    control : ControlGrid or LagrangeSurface
+    control : ControlGrid, LagrangeSurface or PiecewiseSurface
         Whose control box is the default domain and the interpolation range.
     nx, ny : int, optional
         Number of grid lines in x and y (edges included), at least 2; one
@@ -297,6 +297,8 @@ def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: Sampl
     expanded power basis, run as ``engine`` rules (a
     :class:`lagsym.evaluate.Engine`; the current one by default): the same
     bits whichever engine runs.
+    A piecewise surface (:mod:`lagsym.surfaces.piecewise`) is sampled with
+    its own evaluator, each point from the piece whose cell holds it.
 
     Examples
     --------
@@ -308,9 +310,16 @@ def sample(surface, nx: int | None = None, ny: int | None = None, *, grid: Sampl
     [[0.0, 0.0], [1.0, 1.0], [4.0, 4.0]]
     """
     g = grid if grid is not None else sample_grid(surface, nx, ny, **kwargs)
-    z = surface_evaluator(surface).grid(g.xs, g.ys, engine=engine)
+    z = _evaluator(surface).grid(g.xs, g.ys, engine=engine)
     z.setflags(write=False)
     return Sample(_lines(g.xs, g.ny, 0), _lines(g.ys, g.nx, 1), z)
+
+
+def _evaluator(surface):
+    """The numeric evaluator a sample uses: the one a surface of pieces brings along
+    (:attr:`lagsym.surfaces.piecewise.PiecewiseSurface.evaluator`), else the polynomial's stable one."""
+    own = getattr(surface, "evaluator", None)
+    return own if own is not None else surface_evaluator(surface)
 
 
 def _lines(values: np.ndarray, count: int, axis: int) -> np.ndarray:
@@ -335,9 +344,15 @@ def iter_blocks(surface, grid: SampleGrid, block_points: int = BLOCK_POINTS, *,
     Each block holds about ``block_points`` points (at least one row), so the
     memory in use does not grow with the grid.  ``engine`` as in :func:`sample`.
     """
-    ev = surface_evaluator(surface)
     engine = current_engine() if engine is None else engine
     rows = max(1, block_points // grid.ny)
+    own = getattr(surface, "evaluator", None)
+    if own is not None:
+        for start in range(0, grid.nx, rows):
+            xs = grid.xs[start:start + rows]
+            yield Block(start, xs, grid.ys, own.grid(xs, grid.ys))
+        return
+    ev = surface_evaluator(surface)
     compiled = engine.use_compiled(min(rows, grid.nx) * grid.ny)  # the blocks may run compiled: then the factors too
     w = ev.x_factor(grid.xs, compiled)  # (nx, m): small
     ty = ev.y_basis(grid.ys, compiled)  # (m, ny): small

@@ -249,7 +249,7 @@ def test_command_line(tmp_path):
     assert "11 x 11 = 121 exact bicubic pieces through 12 x 12 points, C1" in out.getvalue()
     s = parse_piecewise_json(dst.read_text())
     assert s.exact_value(s.grid.x[3], s.grid.y[4]) == Fraction(s.grid.z[3][4])
-    for cmd in (["macro", str(dst)], ["sample", str(dst)], ["check", str(dst)]):
+    for cmd in (["macro", str(dst)], ["check", str(dst)]):
         out, err = io.StringIO(), io.StringIO()
         assert main(cmd, out, err) == 2
         assert len(err.getvalue().strip().splitlines()) == 1 and "piece" in err.getvalue()

@@ -81,17 +81,9 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
 
 def read_piecewise(path: str):
     """The surface of ``path`` when it is a ``lagsym-piecewise`` file, else None (a points file)."""
-    from ..io import read_text
+    from ..export.piecewisejson import read_piecewise_file
 
-    if str(path) == "-":  # standard input is read once, as points
-        return None
-    name, text = read_text(path)
-    head = text.lstrip()[:400]
-    if not head.startswith("{") or '"lagsym-piecewise"' not in head:
-        return None
-    from ..export.piecewisejson import parse_piecewise_json
-
-    return parse_piecewise_json(text, name)
+    return read_piecewise_file(path)
 
 
 ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points more than lagsym's limit "

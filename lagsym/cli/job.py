@@ -10,7 +10,9 @@ block, work offset, tools, operations) and write them as one point-list
 program, in order, with a tool change, spindle speed, feeds and coolant for
 each.  Every key of the job file is checked.  The cycle-time estimate of
 each operation and of the whole job is printed and written in the program's
-header.  See docs/roughing.md for the job file.
+header.  See docs/roughing.md for the job file.  The points file may be a
+piecewise surface ('lagsym piecewise'); a roughing macro (macro = true) is
+refused for it.
 
 On a terminal, a progress bar on standard error shows the planning of each operation.
 
@@ -75,8 +77,11 @@ def guard_job(spec, args, err):
     """The job, refused if its surface amplifies data errors beyond the limit (unless accepted, then noted)."""
     from dataclasses import replace
 
+    from ..export.piecewisejson import read_piecewise_file
     from ..io import read_points
 
+    if spec.grid is None and read_piecewise_file(spec.points) is not None:
+        return spec  # local pieces: each point moves the surface near it only, so no guard rail
     grid = spec.grid if spec.grid is not None else read_points(spec.points)
     return replace(spec, notes=spec.notes + conditioning_notes(grid, args, err))
 

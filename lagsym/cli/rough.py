@@ -30,6 +30,10 @@ surface equation, never below the drop-cutter height plus the stock (see
 docs/roughing.md for the proof of its clearance); it follows the surface
 down as steeply as it falls, so it needs a tool that may plunge.
 
+FILE may be a piecewise surface ('lagsym piecewise'): the cutter is dropped
+on every piece within its reach, as for toolpath.  --macro is refused for
+it: a macro evaluates one polynomial on the control.
+
 On a terminal, a progress bar on standard error shows the planning.
 
 examples:
@@ -40,7 +44,7 @@ examples:
 
 
 def add_arguments(p) -> None:
-    p.add_argument("file", help="points file: JSON or CSV with x,y,z")
+    p.add_argument("file", help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", help="write the program to FILE instead of standard output")
     p.add_argument("--dialect", choices=names(point_lists=True), default="fanuc",
@@ -183,6 +187,14 @@ def run(args, out, err) -> int:
     from .job import guard_job, report
 
     _refuse(args)
+    if args.macro:
+        from ..errors import InputError
+        from ..macro.roughing import piecewise_macro_refusal
+        from ._common import read_piecewise
+
+        pieces = read_piecewise(args.file)
+        if pieces is not None:
+            raise InputError(f"--macro: {piecewise_macro_refusal(pieces, 'a roughing macro')}")
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
     spec = guard_job(parse_job(job_data(args), "lagsym rough"), args, err)
     with progress_bar(err) as progress:

@@ -11,7 +11,7 @@ from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
-from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
+from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin, read_piecewise
 from ._progress import progress_bar
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
@@ -21,7 +21,10 @@ the deepest rapid (G00) into the part, the most material left anywhere on the
 part (its edges included) and where, the scallop between passes (normal to
 the surface, a tool radius or more from the edges) and the area the tool never
 reached.  Any point-list program can be checked this way, lagsym's or not,
-with G02/G03 arcs (I J K centres, G17/G18/G19) too.
+with G02/G03 arcs (I J K centres, G17/G18/G19) too.  SURFACE may be a
+piecewise surface ('lagsym piecewise'): each point is compared with the
+piece whose cell holds it, and the curvature in the material-left bound is
+bounded piece by piece (its second derivatives jump at the borders).
 
 exit status: 0 the program passes; 1 it gouges or a rapid goes into the part
 (deeper than the gouge limit), or it leaves more material than --max-left
@@ -42,6 +45,7 @@ On a terminal, a progress bar on standard error shows the moves swept.
 examples:
   lagsym verify examples/paper-example-4.json O1000.nc --scale 20 --tool-diameter 6 --max-left 0.12
   lagsym verify examples/paper-example-1.json part.ngc --scale 10 --tool-diameter 6 --cell 0.1
+  lagsym verify pieces.json pieces.nc --tool-diameter 6 --max-left 0.5
   lagsym verify --job examples/example-4-job.toml job.ngc --cell 0.5"""
 
 
@@ -51,7 +55,8 @@ _SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": Non
 
 
 def add_arguments(p) -> None:
-    p.add_argument("surface", metavar="SURFACE", help="points file: JSON or CSV with x,y,z (with --job: the job file)")
+    p.add_argument("surface", metavar="SURFACE",
+                   help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface (with --job: the job file)")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves, G02/G03 arcs with I J K)")
     p.add_argument("--job", action="store_true",
                    help="SURFACE is a job file (TOML): simulate the whole job from its block, tool by tool")
@@ -86,7 +91,7 @@ def run(args, out, err) -> int:
     for key, default in _SINGLE_TOOL.items():
         if getattr(args, key) is None:
             setattr(args, key, default)
-    surface = lagrange_surface(read_points(args.surface))
+    surface = read_piecewise(args.surface) or lagrange_surface(read_points(args.surface))
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)

@@ -27,7 +27,7 @@ from ..grid import grid_from_table
 from ..surfaces.piecewise import CONTINUITY, PiecewiseSurface, piecewise_surface
 from ..values import as_exact
 
-__all__ = ["FORMAT", "piecewise_document", "write_piecewise_json", "parse_piecewise_json"]
+__all__ = ["FORMAT", "piecewise_document", "write_piecewise_json", "parse_piecewise_json", "read_piecewise_file"]
 
 FORMAT = "lagsym-piecewise"
 
@@ -55,6 +55,22 @@ def write_piecewise_json(stream: IO[str], surface: PiecewiseSurface) -> None:
         else:
             lines.append(f" {json.dumps(key)}: {json.dumps(value)}")
     stream.write("{\n" + ",\n".join(lines) + "\n}\n")
+
+
+def read_piecewise_file(path) -> PiecewiseSurface | None:
+    """The surface of the file ``path`` when it is a ``lagsym-piecewise`` document, else None (a points file).
+
+    Standard input (``"-"``) is read once, as points, so it gives None.
+    """
+    from ..io import read_text
+
+    if str(path) == "-":
+        return None
+    name, text = read_text(path)
+    head = text.lstrip()[:400]
+    if not head.startswith("{") or f'"{FORMAT}"' not in head:
+        return None
+    return parse_piecewise_json(text, name)
 
 
 def parse_piecewise_json(text: str, source: str = "<piecewise>") -> PiecewiseSurface:

@@ -15,19 +15,21 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import InputError, LagsymError, ToolpathError
-from ..evaluate import surface_evaluator
+from ..export.piecewisejson import read_piecewise_file
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec
 from ..macro import DEFAULT_PRECISION
-from ..macro.roughing import rough_macro
+from ..macro.roughing import piecewise_macro_refusal, rough_macro
 from ..progress import Progress, Tally, prefixed
+from ..surfaces.piecewise import PiecewiseSurface
 from ..toolpath import plan_toolpath
+from ..toolpath.dropcutter import evaluator_of
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
 from .spec import JobSpec, OperationSpec, ToolSpec
 
-__all__ = ["Operation", "plan_job", "job_stock", "PlannedJob"]
+__all__ = ["Operation", "plan_job", "job_stock", "job_surface", "PlannedJob"]
 
 
 @dataclass(frozen=True)
@@ -64,9 +66,18 @@ class PlannedJob:
     operations: tuple
 
 
+def job_surface(spec: JobSpec):
+    """The job's exact surface: its fitted measurement's polynomial, the pieces of a ``lagsym piecewise`` file
+    (:mod:`lagsym.surfaces.piecewise`), or the polynomial through its points file."""
+    if spec.grid is not None:
+        return lagrange_surface(spec.grid)
+    pieces = read_piecewise_file(spec.points)
+    return pieces if pieces is not None else lagrange_surface(read_points(spec.points))
+
+
 def job_stock(spec: JobSpec, surface, evaluator=None) -> Stock:
     """The block the job file describes, in machine mm."""
-    ev = evaluator or surface_evaluator(surface)
+    ev = evaluator or evaluator_of(surface)
     place = _settings(spec).placement
     st = spec.stock
     box = place.box_mm(ev.bounds)
@@ -102,8 +113,8 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     """
     if spec.grid is None and spec.points is None:
         raise InputError(f"{spec.source}: the job's surface is measured: fit the measurement first (--measured)")
-    surface = lagrange_surface(spec.grid if spec.grid is not None else read_points(spec.points))
-    ev = surface_evaluator(surface)
+    surface = job_surface(spec)
+    ev = evaluator_of(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:
         raise InputError(f"{spec.source}: safe_z = {spec.safe_z_mm:g} mm is not above the stock top {stock.top_mm:g} mm")
@@ -132,6 +143,8 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
                        milling=o.get("milling", "climb" if o.get("pattern") == "offset" else "zigzag"),
                        flute_length_mm=tool.flute_length_mm, reach_mm=tool.reach_mm)
         if o.get("macro"):
+            if isinstance(surface, PiecewiseSurface):
+                raise ToolpathError(piecewise_macro_refusal(surface, "a roughing macro (macro = true)"))
             precision = o.get("precision", DEFAULT_PRECISION[spec.dialect])
             rm = rough_macro(surface, tool.tool, stock, rs, _settings(spec, op), precision=precision, evaluator=ev,
                              max_points=limits[0])

@@ -43,6 +43,7 @@ from ..controls import control, names
 from ..errors import ToolpathError
 from ..evaluate import surface_evaluator
 from ..machine import MachineSettings, Tool, program_units_per_mm
+from ..surfaces.piecewise import PiecewiseSurface
 from ..toolpath.rough import RoughSpec, Stock, check_points, check_rough_request
 from ..values import choice
 from .clearance import Clearance, clearance_tables
@@ -263,6 +264,13 @@ def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: Mach
     return 2.0 * worst + 3.0 * ulp
 
 
+def piecewise_macro_refusal(surface: PiecewiseSurface, what: str) -> str:
+    """Why ``what`` (a macro) is not written for a piecewise surface, in one line."""
+    a, b = surface.shape
+    return (f"{what} evaluates one polynomial on the control, and {surface.source} is {a} x {b} = {a * b} "
+            f"bicubic pieces: rough it as a point list (leave out the macro)")
+
+
 def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, *,
                 precision: int, form: str | None = None, evaluator=None, max_points: int | None = None) -> RoughMacro:
     """Plan the parametric roughing of ``stock`` for ``settings.dialect`` at the control's ``precision``.
@@ -282,6 +290,8 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     >>> [round(float(z), 4) for z in rm.levels_mm], bool(rm.points_mm[:, 2].min() >= 1.5)
     ([2.5, 1.5006], True)
     """
+    if isinstance(surface, PiecewiseSurface):
+        raise ToolpathError(piecewise_macro_refusal(surface, "a roughing macro"))
     if spec.pattern != "raster":
         raise ToolpathError(f"pattern {spec.pattern!r}: a roughing macro runs raster rows")
     if spec.milling not in MACRO_MILLING:

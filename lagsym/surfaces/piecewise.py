@@ -38,12 +38,11 @@ from functools import cached_property
 from math import comb
 
 import flint
-import numpy as np
 
-from .._arrays import readonly
 from ..errors import GridError
 from ..grid import ControlGrid, grid_from_table
 from ..lagrange import LagrangeSurface, horner2
+from .piecewise_numeric import PiecewiseEvaluator
 
 __all__ = ["CONTINUITY", "PiecewiseSurface", "PiecewiseEvaluator", "lagrange_slopes", "piecewise_surface",
            "piecewise_evaluator", "MAX_PIECES"]
@@ -288,99 +287,6 @@ def piecewise_surface(grid: ControlGrid) -> PiecewiseSurface:
     zxy = _apply_cols(zx, grid.y)
     frozen = [tuple(tuple(r) for r in t) for t in (zx, zy, zxy)]
     return PiecewiseSurface(grid, *frozen)
-
-
-def _local_derivative(a: np.ndarray, d: int) -> np.ndarray:
-    """Coefficients along the last axis of ``a`` differentiated ``d`` times (the same length, zero-padded)."""
-    for _ in range(d):
-        k = np.arange(1, a.shape[-1])
-        a = np.concatenate([a[..., 1:] * k, np.zeros(a.shape[:-1] + (1,))], axis=-1)
-    return a
-
-
-class PiecewiseEvaluator:
-    """The numeric (float64) evaluator of a :class:`PiecewiseSurface`, as the toolpath planner asks one.
-
-    ``bounds``, ``fast_points`` (values and partial derivatives at scattered
-    points) and ``curvature_bound`` answer as
-    :class:`~lagsym.evaluate.SurfaceEvaluator`'s do; ``piece_evaluator(i, k)``
-    is a piece's own evaluator, which drop-cutter searches on.
-    """
-
-    def __init__(self, surface: PiecewiseSurface):
-        self.surface = surface
-        g = surface.grid
-        self.breaks_x = readonly(np.array([float(v) for v in g.x]))
-        self.breaks_y = readonly(np.array([float(v) for v in g.y]))
-        self.bounds = (float(g.x[0]), float(g.x[-1]), float(g.y[0]), float(g.y[-1]))
-        n, m = surface.shape
-        self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
-                                         for k in range(m)] for i in range(n)]))
-        self._evaluators: dict = {}
-
-    @cached_property
-    def upper_heights(self) -> np.ndarray:
-        """``[i, k]``: no point of piece ``(i, k)`` lies above this (its highest Bezier control point, rounded up).
-
-        A Bezier patch lies in the convex hull of its control points; the
-        float rounding of the conversion is covered by a relative ``1e-12``.
-        """
-        w = np.array([[comb(j, a) / comb(3, a) if a <= j else 0.0 for a in range(4)] for j in range(4)])
-        b = np.einsum("ja,ikab,lb->ikjl", w, self.local, w)
-        top = b.max(axis=(2, 3))
-        return readonly(top + 1e-12 * (np.abs(b).max(axis=(2, 3)) + 1.0))
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """Coefficients of a piece in x and in y."""
-        return 4, 4
-
-    def locate(self, x, y):
-        """Piece indices and cell coordinates ``(i, k, s, t)`` of points (clipped to the box)."""
-        bx, by = self.breaks_x, self.breaks_y
-        i = np.clip(np.searchsorted(bx, x, side="right") - 1, 0, len(bx) - 2)
-        k = np.clip(np.searchsorted(by, y, side="right") - 1, 0, len(by) - 2)
-        hx, hy = bx[i + 1] - bx[i], by[k + 1] - by[k]
-        return i, k, (x - bx[i]) / hx, (y - by[k]) / hy, hx, hy
-
-    def fast_points(self, x, y, dx: int = 0, dy: int = 0) -> np.ndarray:
-        """``F(x, y)`` or a partial derivative at scattered points, each from the piece whose cell holds it."""
-        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        shape = x.shape
-        i, k, s, t, hx, hy = self.locate(x.ravel(), y.ravel())
-        a = self.local[i, k]  # (N, 4, 4): a[p, u, v] multiplies s**u t**v
-        a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(a, 1, 2), dx), 1, 2), dy)
-        ps = np.stack([np.ones_like(s), s, s * s, s * s * s], axis=1)
-        pt = np.stack([np.ones_like(t), t, t * t, t * t * t], axis=1)
-        z = np.einsum("pu,puv,pv->p", ps, a, pt) / (hx ** dx * hy ** dy)
-        return z.reshape(shape)
-
-    def curvature_bound(self, samples: int = 5) -> float:
-        """Largest ``|F_xx|``, ``|F_yy|`` or ``|F_xy|`` seen on ``samples`` x ``samples`` points of every piece.
-
-        Each piece is sampled on its own closed cell, so the values either side of a border (where second
-        derivatives jump) are both seen.
-        """
-        u = np.linspace(0.0, 1.0, samples)
-        powers = np.stack([np.ones_like(u), u, u * u, u * u * u], axis=1)  # (samples, 4)
-        hx, hy = np.diff(self.breaks_x), np.diff(self.breaks_y)
-        worst = 0.0
-        for dx, dy in ((2, 0), (0, 2), (1, 1)):
-            a = _local_derivative(np.swapaxes(_local_derivative(np.swapaxes(self.local, 2, 3), dx), 2, 3), dy)
-            d = np.einsum("su,ikuv,tv->ikst", powers, a, powers)
-            d = d / (hx[:, None, None, None] ** dx * hy[None, :, None, None] ** dy)
-            worst = max(worst, float(np.abs(d).max()))
-        return worst
-
-    def piece_evaluator(self, i: int, k: int):
-        """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use."""
-        from ..evaluate import surface_evaluator
-
-        found = self._evaluators.get((i, k))
-        if found is None:
-            piece = self.surface.piece(i, k)
-            found = self._evaluators[(i, k)] = (piece, surface_evaluator(piece))
-        return found
 
 
 def piecewise_evaluator(surface: PiecewiseSurface) -> PiecewiseEvaluator:

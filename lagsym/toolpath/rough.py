@@ -43,12 +43,12 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ToolpathError
-from ..evaluate import SurfaceEvaluator, surface_evaluator
+from ..evaluate import SurfaceEvaluator
 from ..machine import DIRECTIONS, MachineSettings, Tool
 from ..progress import Progress, Tally
 from ..values import choice, finite, positive
 from .chordal import check_moves, crosses_box_edge, lift
-from .dropcutter import drop_cutter, telling_compiles
+from .dropcutter import drop_cutter, evaluator_of, telling_compiles
 from .pattern import levels as spaced
 from .plan import MAX_PLAN_POINTS
 from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
@@ -176,7 +176,9 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
 
     Parameters
     ----------
-    surface : LagrangeSurface
+    surface : LagrangeSurface or PiecewiseSurface
+        One polynomial, or C1 bicubic pieces (:mod:`lagsym.surfaces.piecewise`):
+        drop-cutter rests the tool on every piece within its reach.
     tool : Tool
         Flat, ball (or any shape drop-cutter knows) end mill.
     stock : Stock
@@ -205,7 +207,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     >>> bool((rp.points_mm[:, 2] >= rp.floor_mm).all()), round(float(rp.points_mm[:, 2].min()), 6)
     (True, 1.5)
     """
-    ev = evaluator or surface_evaluator(surface)
+    ev = evaluator or evaluator_of(surface)
     place = settings.placement
     box = place.box_mm(ev.bounds)
     check_rough_request(tool, stock, spec, ev, place, max_points=max_samples, option="--max-samples")

@@ -47,11 +47,12 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import InputError
-from ..evaluate import evaluate_grid, surface_evaluator
+from ..evaluate import surface_evaluator
 from ..gcode import Moves, numeric_words, program_blocks, program_units
 from ..gcode.words import plain_move
 from ..machine import MAX_LEFT_MM, Placement, Tool, mm_per_program_unit
 from ..progress import Progress
+from ..surfaces.piecewise import PiecewiseSurface
 from .bounds import curvature_limits, deepest_cut, left_bound
 from .heightmap import MAX_CELLS, MAX_CONTACTS, check_work, height_map_axes, press_moves, sweep, tool_grid
 from .swept import lowest_along
@@ -227,8 +228,10 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
 
     Parameters
     ----------
-    surface : LagrangeSurface
-        The exact surface.
+    surface : LagrangeSurface or PiecewiseSurface
+        The exact surface: one polynomial, or C1 bicubic pieces
+        (:mod:`lagsym.surfaces.piecewise`), each point of the map from the
+        piece whose cell holds it and the curvature bounded piece by piece.
     moves : Moves
         The program's moves (:func:`lagsym.gcode.parse_moves`).
     tool : Tool
@@ -256,8 +259,9 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     xs, ys = height_map_axes(placement.box_mm(surface.grid.bounds), cell_mm, max_cells)
     hx, hy = xs[1] - xs[0], ys[1] - ys[0]
     sx, sy = placement.to_surface(xs, ys)
-    surf = placement.height_mm(evaluate_grid(surface, sx, sy))
-    slope = _slopes(surface, sx, sy)
+    ev = _evaluator(surface)
+    surf = placement.height_mm(ev.grid(sx, sy))
+    slope = _slopes(ev, sx, sy)
     limit = gouge_limit(program_resolution_mm, float(slope.max())) if gouge_limit_mm is None else float(gouge_limit_mm)
     # Moves before the program's first Z run at the machine's height, which the program does not say: skip them.
     known = np.asarray(moves.z_known, dtype=bool)
@@ -273,8 +277,11 @@ def simulate_cut(surface, moves: Moves, tool: Tool, placement: Placement = Place
     winner = np.full(cut.shape, -1, dtype=np.int64)
     segments, _ = press_moves(cut, xs, ys, path[feed], path[feed + 1], tool, max_contacts=None, progress=progress,
                               winner=winner)
-    ev = surface_evaluator(surface)
     curvature = curvature_limits(ev, sx, sy, placement.mm_per_unit)
+    if isinstance(surface, PiecewiseSurface):
+        # The Hessian jumps at the borders, where a cell centre rarely falls: each piece's certified bound too.
+        certified = ev.curvature_limits()
+        curvature = tuple(max(c, v / placement.mm_per_unit) for c, v in zip(curvature, certified))
     grid = (xs, ys, r, corner)
     gouge, gouge_at, _ = deepest_cut(ev, placement, cut, surf, winner, moves=(path[feed], path[feed + 1]), grid=grid)
     crash, crash_segments = _rapids(ev, placement, surf, path, use & rapid, lines=np.asarray(moves.line), grid=grid)
@@ -337,9 +344,13 @@ def _left(cut, surf, slope, winner, *, moves, grid, curvature, ev, placement) ->
     return best
 
 
-def _slopes(surface, sx, sy) -> np.ndarray:
+def _evaluator(surface):
+    """The numeric evaluator of the surface: a piecewise surface's own, else the polynomial's."""
+    return surface.evaluator if isinstance(surface, PiecewiseSurface) else surface_evaluator(surface)
+
+
+def _slopes(ev, sx, sy) -> np.ndarray:
     """The surface's slope ``|grad F|`` at every cell centre (the scale cancels)."""
-    ev = surface_evaluator(surface)
     gx, gy = np.meshgrid(sx, sy, indexing="ij")
     fx, fy = ev.fast_points(gx.ravel(), gy.ravel(), dx=1), ev.fast_points(gx.ravel(), gy.ravel(), dy=1)
     return np.hypot(fx, fy).reshape(gx.shape)
