@@ -11,7 +11,7 @@ from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
-from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin
+from ._common import add_exact_limit, exact_limit, CORNER_MM, SCALE, TOOL_MM, count, number, origin
 from ._progress import progress_bar
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
@@ -51,6 +51,7 @@ _SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": Non
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("surface", metavar="SURFACE", help="points file: JSON or CSV with x,y,z (with --job: the job file)")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves, G02/G03 arcs with I J K)")
     p.add_argument("--job", action="store_true",
@@ -86,7 +87,7 @@ def run(args, out, err) -> int:
     for key, default in _SINGLE_TOOL.items():
         if getattr(args, key) is None:
             setattr(args, key, default)
-    surface = lagrange_surface(read_points(args.surface))
+    surface = lagrange_surface(read_points(args.surface), max_mb=exact_limit(args))
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
     moves = parse_moves(text, source=args.program)
