@@ -166,3 +166,38 @@ def test_the_docs_quote_the_limit_and_the_figures_in_force():
     assert f"`--max-exact-mb` ({MAX_EXACT_MB} MB)" in cli and f"at most {MAX_EXACT_MB} MB (`--max-exact-mb`)" in formats
     assert "points 0.1 apart: 2.7 GB; of 500 points: 306 MB" in cli.replace("\n", " ")
     assert "a curve of 1000 points 0.1 apart (2.7 GB)" in formats
+
+
+def test_a_power_of_powers_in_a_formula_is_refused_with_its_size_before_it_is_computed(tmp_path):
+    # Before, exact_value and 'plot --show growth' never ended on this formula.
+    text = "((((x+1e300)**64)**64)**64)**64"
+    inner = Fraction(10**300 + 1) ** 64  # the first power, computed here; the second would be 64 times its bits
+    bits = (inner.numerator.bit_length() + inner.denominator.bit_length()) * 64
+    r = _child(f"from lagsym.formula import parse_formula; parse_formula({text!r}).exact_value(0, 0)", timeout=20)
+    assert r.returncode == 1 and f"about {bits:,} bits" in r.stderr and "limit of 1,000,000" in r.stderr, r.stderr
+    points = tmp_path / "p.csv"
+    points.write_text("x,y,z\n" + "".join(f"{i},{k},{i * k}\n" for i in range(3) for k in range(3)))
+    image = tmp_path / "g.png"
+    r = _child("import sys; from lagsym.cli import main; "
+               f"sys.exit(main(['plot', {str(points)!r}, '--show', 'growth', {text!r}, '-o', {str(image)!r}]))")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and f"about {bits:,} bits" in r.stderr, r.stderr
+    assert not image.exists()
+
+
+def test_a_power_within_the_limit_is_exact_and_the_limit_is_the_callers():
+    from lagsym.formula import FormulaError, parse_formula
+
+    f = parse_formula("(x + 1/3)**64")
+    assert f.exact_value(1, 0) == Fraction(4, 3) ** 64
+    bits = ((4).bit_length() + (3).bit_length()) * 64
+    with pytest.raises(FormulaError, match=rf"about {bits} bits, more than the limit of 100 \(max_bits=\)"):
+        f.exact_value(1, 0, max_bits=100)
+
+
+def test_the_formula_limit_docs_formats_quotes_is_in_force():
+    from pathlib import Path
+
+    from lagsym.formula import MAX_EXACT_BITS, MAX_EXACT_EXPONENT
+
+    formats = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
+    assert f"integer powers within +-{MAX_EXACT_EXPONENT} and no power of more than {MAX_EXACT_BITS} bits" in formats
