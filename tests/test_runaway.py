@@ -201,3 +201,34 @@ def test_the_formula_limit_docs_formats_quotes_is_in_force():
 
     formats = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
     assert f"integer powers within +-{MAX_EXACT_EXPONENT} and no power of more than {MAX_EXACT_BITS} bits" in formats
+
+
+ARC = "G02 X30. Y30. I80000. J0.\n"  # most of a circle of 80 m radius: about 145,000 pieces
+
+
+def test_a_program_of_long_arcs_is_refused_as_it_is_read_with_the_count(tmp_path, run_cli):
+    # Before, 300 such lines (7 KB) exhausted memory in verify (MemoryError, exit 70).
+    from lagsym.gcode import parse_moves
+
+    head = "G21 G90\nG00 X0 Y0 Z60\n"
+    total = len(parse_moves(head + ARC + "M30\n", max_points=None).points_mm)
+    program = tmp_path / "arcs.nc"
+    program.write_text(head + ARC + "M30\n")
+    points = tmp_path / "p.csv"
+    points.write_text("x,y,z\n" + "".join(f"{i * 20},{k * 20},{i + k}\n" for i in range(3) for k in range(3)))
+    status, _, err = run_cli("verify", points, program, "--max-moves", total - 1)
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"line 3: the moves so far make {total:,} points" in err and f"limit of {total - 1:,}" in err
+    assert "--max-moves" in err
+    program.write_text(head + ARC * 300 + "M30\n")
+    r = _child(f"import sys; from lagsym.cli import main; sys.exit(main(['verify', {str(points)!r}, {str(program)!r}]))")
+    assert r.returncode == 2 and "more than the limit of 2,000,000; raise the limit (--max-moves)" in r.stderr, r.stderr
+
+
+def test_the_move_limit_docs_cli_quotes_is_in_force():
+    from pathlib import Path
+
+    from lagsym.gcode.moves import MAX_MOVE_POINTS
+
+    cli = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text().replace("\n", " ")
+    assert f"`--max-moves` ({MAX_MOVE_POINTS:.0e} points".replace("e+0", "e") in cli

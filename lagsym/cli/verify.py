@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from ..errors import ExitStatus, InputError
 from ..gcode import parse_moves
+from ..gcode.moves import MAX_MOVE_POINTS
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
@@ -76,6 +77,9 @@ def add_arguments(p) -> None:
                         "(default: reported, not checked; not with --job)")
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
+    p.add_argument("--max-moves", type=count(1, 10**9), default=MAX_MOVE_POINTS, metavar="N",
+                   help=f"refuse a program whose moves make more than N points, each arc read as pieces that "
+                        f"sag 1e-5 mm, counted as it is read (default {MAX_MOVE_POINTS:.2g})")
     p.add_argument("--max-contacts", type=count(1, 10**14), metavar="N",
                    help=f"refuse a simulation of more than N segments swept times cells under the tool "
                         f"(default {MAX_CONTACTS:.2g})")
@@ -90,7 +94,7 @@ def run(args, out, err) -> int:
     surface = lagrange_surface(read_points(args.surface), max_mb=exact_limit(args))
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
-    moves = parse_moves(text, source=args.program)
+    moves = parse_moves(text, source=args.program, max_points=args.max_moves)
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     with progress_bar(err) as progress:
         report = simulate_cut(surface, moves, tool, place, cell_mm=args.cell,
