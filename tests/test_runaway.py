@@ -232,3 +232,33 @@ def test_the_move_limit_docs_cli_quotes_is_in_force():
 
     cli = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text().replace("\n", " ")
     assert f"`--max-moves` ({MAX_MOVE_POINTS:.0e} points".replace("e+0", "e") in cli
+
+
+def test_a_program_of_too_many_lines_is_refused_before_it_is_read(tmp_path, run_cli):
+    # Before, 60 MB of '#100=[#100+1.]' ran without end and a 20 MB program exhausted memory.
+    from lagsym.simulate import MAX_PROGRAM_LINES
+
+    body = "#100=[#100+1.]\n"
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1000\n#100=0.\n" + body * 40 + "M30\n%\n")
+    lines = program.read_text().count("\n") + 1
+    status, _, err = run_cli("simulate", program, "--max-lines", lines - 1)
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"p.nc: {lines:,} lines, more than the limit of {lines - 1:,}" in err and "--max-lines" in err
+    status, out, err = run_cli("simulate", program, "--max-lines", lines)
+    assert status == 0 and f"{40 + 2} blocks executed" in err, err
+    program.write_text("%\nO1000\n#100=0.\n" + body * (MAX_PROGRAM_LINES * 3) + "M30\n%\n")
+    r = _child(f"import sys; from lagsym.cli import main; sys.exit(main(['simulate', {str(program)!r}]))")
+    lines = MAX_PROGRAM_LINES * 3 + 6
+    assert r.returncode == 2 and f"{lines:,} lines, more than the limit of {MAX_PROGRAM_LINES:,}" in r.stderr, r.stderr
+
+
+def test_the_line_limit_the_docs_quote_is_in_force():
+    from pathlib import Path
+
+    from lagsym.simulate import MAX_PROGRAM_LINES
+
+    docs = Path(__file__).resolve().parent.parent / "docs"
+    cli = (docs / "cli.md").read_text().replace("\n", " ")
+    assert f"`--max-lines` ({MAX_PROGRAM_LINES}) lines" in cli
+    assert f"at most {MAX_PROGRAM_LINES} lines (`--max-lines`)" in (docs / "formats.md").read_text()

@@ -209,10 +209,7 @@ def parse_moves(text: str, source: str = "<program>", max_points: int | None = M
                 v = target[letter] * modal.factor
                 pos[k] = v if modal.absolute else pos[k] + v
         ends = arc_points(before, pos, offset, modal.plane, modal.motion == 3, where) if arc else [tuple(pos)]
-        if max_points is not None and len(pts) + len(ends) > max_points:
-            raise ProgramError(f"{where}: the moves so far make {len(pts) + len(ends):,} points (arcs read as pieces "
-                               f"that sag {ARC_SAG_MM:g} mm), more than the limit of {max_points:,}; "
-                               f"raise the limit (--max-moves)")
+        _check_count(len(pts) + len(ends), max_points, where)
         for end in ends:
             pts.append(tuple(end))
             rapid.append(modal.motion == 0)
@@ -227,6 +224,12 @@ def parse_moves(text: str, source: str = "<program>", max_points: int | None = M
         line=np.array(lines, dtype=int),
         z_known=np.array(zk, dtype=bool),
     )
+
+
+def _check_count(count: int, max_points: int | None, where: str) -> None:
+    if max_points is not None and count > max_points:
+        raise ProgramError(f"{where}: the moves so far make {count:,} points (arcs read as pieces that sag "
+                           f"{ARC_SAG_MM:g} mm), more than the limit of {max_points:,}; raise the limit (--max-moves)")
 
 
 def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.ndarray]:
