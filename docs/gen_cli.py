@@ -58,7 +58,7 @@ def page() -> str:
         "`--max-moves` (2e6 points of the program's moves, each arc read as pieces, counted as it is read),",
         "`equation --max-terms` (2500 terms), and `--max-exact-mb` (400 MB) on every command that",
         "computes an exact polynomial from points (`curve`, `equation`, `check`, `sample`, `export`,",
-        "`plot`, `toolpath`, `macro`, `verify`): the size of its rationals, estimated from the",
+        "`plot`, `toolpath`, `rough`, `job`, `macro`, `verify`): the size of its rationals, estimated from the",
         "number of nodes, their denominators and span before any of it is made (a curve of 1000",
         "points 0.1 apart: 2.7 GB; of 500 points: 306 MB).  A program `simulate` runs that would never end",
         "stops within seconds with the runaway alarm (exit 2): at once when a loop can be seen in",

@@ -262,3 +262,15 @@ def test_the_line_limit_the_docs_quote_is_in_force():
     cli = (docs / "cli.md").read_text().replace("\n", " ")
     assert f"`--max-lines` ({MAX_PROGRAM_LINES}) lines" in cli
     assert f"at most {MAX_PROGRAM_LINES} lines (`--max-lines`)" in (docs / "formats.md").read_text()
+
+
+def test_a_job_on_too_large_a_grid_names_the_option_job_has(tmp_path, run_cli):
+    points = tmp_path / "p.csv"
+    points.write_text("x,y,z\n" + "".join(f"{i},{k},{(i + k) % 3}\n" for i in range(30) for k in range(3)))
+    job = tmp_path / "j.toml"
+    job.write_text(f'points = "{points}"\ndialect = "linuxcnc"\nsafe_z = 90\n\n[stock]\ntop_above = 2\n\n[tools.ball6]\nnumber = 2\n'
+                   'shape = "ball"\ndiameter = 6\n\n[[operations]]\nkind = "finish"\ntool = "ball6"\n')
+    out = tmp_path / "j.nc"
+    status, _, err = run_cli("job", job, "-o", out, "--max-exact-mb", "0.001", "--accept-conditioning")
+    assert status == 2 and "30 x 3 nodes" in err and "limit of 0.001 MB" in err and "--max-exact-mb" in err, err
+    assert not out.exists()
