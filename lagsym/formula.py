@@ -39,6 +39,7 @@ MAX_LENGTH = 2000
 MAX_DEPTH = 60  # nesting of brackets and unary signs; deeper text is refused, not a RecursionError
 MAX_HEIGHT = 200  # operations one inside another in the parsed tree (a chain of 200 terms), for the same reason
 MAX_EXACT_EXPONENT = 64
+MAX_EXACT_BITS = 1_000_000  # bits of numerator and denominator of one exact value (about 300000 digits)
 
 _NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "sqrt": np.sqrt, "abs": np.abs}
 _TOKEN = re.compile(
@@ -210,7 +211,7 @@ def _numeric(tree, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.power(a, b)
 
 
-def _exact(tree, x: Fraction, y: Fraction, text: str) -> Fraction:
+def _exact(tree, x: Fraction, y: Fraction, text: str, max_bits: int) -> Fraction:
     tag = tree[0]
     if tag == "num":
         return tree[1]
@@ -220,9 +221,9 @@ def _exact(tree, x: Fraction, y: Fraction, text: str) -> Fraction:
         name = "pi" if tag == "pi" else tree[1]
         raise FormulaError(f"formula {text!r}: {name} has no exact rational value")
     if tag == "neg":
-        return -_exact(tree[1], x, y, text)
-    a = _exact(tree[1], x, y, text)
-    b = _exact(tree[2], x, y, text)
+        return -_exact(tree[1], x, y, text, max_bits)
+    a = _exact(tree[1], x, y, text, max_bits)
+    b = _exact(tree[2], x, y, text, max_bits)
     if tag == "+":
         return a + b
     if tag == "-":
@@ -239,6 +240,11 @@ def _exact(tree, x: Fraction, y: Fraction, text: str) -> Fraction:
         )
     if a == 0 and b < 0:
         raise FormulaError(f"formula {text!r}: 0 to a negative power at (x, y) = ({x}, {y})")
+    # The size of the power, known before it is computed: powers of powers reach millions of digits.
+    bits = (a.numerator.bit_length() + a.denominator.bit_length()) * abs(int(b))
+    if bits > max_bits:
+        raise FormulaError(f"formula {text!r}: a power at (x, y) = ({x}, {y}) would be an exact value of about "
+                           f"{bits:,} bits, more than the limit of {max_bits:,} (max_bits=); no exact value")
     return a ** int(b)
 
 
@@ -285,16 +291,18 @@ class Formula:
         ys = np.asarray(ys, dtype=float).ravel()
         return self(xs[:, None], ys[None, :])
 
-    def exact_value(self, x, y) -> Fraction:
+    def exact_value(self, x, y, max_bits: int = MAX_EXACT_BITS) -> Fraction:
         """``f(x, y)`` in exact rational arithmetic.
 
         Raises
         ------
         FormulaError
             If the formula uses a function or ``pi``, a power that is not a
-            small integer, or divides by zero at this point.
+            small integer, or divides by zero at this point, or a power
+            would take more than ``max_bits`` bits (checked before it is
+            computed).
         """
-        return _exact(self.tree, Fraction(x), Fraction(y), self.text)
+        return _exact(self.tree, Fraction(x), Fraction(y), self.text, max_bits)
 
 
 def parse_formula(text: str) -> Formula:

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import flint
 
 from .errors import InputError
+from .exactsize import MAX_EXACT_MB, check_exact_size
 from .values import as_exact
 
 from .grid import ControlGrid, CurvePoints
@@ -375,7 +376,8 @@ def horner2(coefficients, x: Fraction, y: Fraction) -> Fraction:
     return acc
 
 
-def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x") -> LagrangeCurve:
+def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
+                   max_mb: float | None = MAX_EXACT_MB) -> LagrangeCurve:
     """The exact Lagrange curve through ``points`` (paper eq. 1-3).
 
     Parameters
@@ -384,6 +386,8 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x") -> Lagrange
         The nodes and values.
     x : sympy.Symbol or str, optional
         The variable of the polynomial: plain ``x`` by default.
+    max_mb : float or None, optional
+        Refuse, before any work, a curve estimated at more megabytes (``--max-exact-mb``; :mod:`lagsym.exactsize`).
 
     Examples
     --------
@@ -396,6 +400,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x") -> Lagrange
     >>> lagrange_curve(pts, x=t).expr.subs(t, 2)
     3
     """
+    check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
     c = b.transpose() * yv
@@ -403,7 +408,8 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x") -> Lagrange
                          variable=_variable(x, "x"))
 
 
-def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Symbol | str = "y") -> LagrangeSurface:
+def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Symbol | str = "y", *,
+                     max_mb: float | None = MAX_EXACT_MB) -> LagrangeSurface:
     """The exact tensor-product Lagrange surface through ``grid`` (paper eqs. 6-7).
 
     Parameters
@@ -413,6 +419,8 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     x, y : sympy.Symbol or str, optional
         The variables of the polynomial: plain ``x`` and ``y`` by default, the
         symbols ``sympy.symbols('x y')`` gives.
+    max_mb : float or None, optional
+        Refuse, before any work, a surface estimated at more megabytes (``--max-exact-mb``; :mod:`lagsym.exactsize`).
 
     Examples
     --------
@@ -432,6 +440,8 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     if sx == sy:
         raise InputError(f"x and y are both the symbol {sx}: a surface needs two different variables")
     n, m = grid.shape
+    check_exact_size(f"surface through {n} x {m} nodes", grid.source, grid.x, grid.y,
+                [v for row in grid.z for v in row], max_mb)
     bx = _basis_matrix(grid.x)
     by = _basis_matrix(grid.y)
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])

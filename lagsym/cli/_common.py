@@ -61,6 +61,22 @@ def add_points_arguments(p) -> None:
     p.add_argument("--snap", metavar="TOL", help=SNAP_HELP)
 
 
+def add_exact_limit(p) -> None:
+    """``--max-exact-mb``: the limit on the estimated size of an exact polynomial, checked before it is made."""
+    from ..exactsize import MAX_EXACT_MB
+
+    p.add_argument("--max-exact-mb", type=number(0.001, 1e9), default=MAX_EXACT_MB, metavar="MB",
+                   help=f"refuse an exact polynomial whose rationals are estimated at more than MB megabytes, "
+                        f"before computing it (default {MAX_EXACT_MB})")
+
+
+def exact_limit(args) -> float:
+    """The command's ``--max-exact-mb``, or the default for a command without it."""
+    from ..exactsize import MAX_EXACT_MB
+
+    return getattr(args, "max_exact_mb", MAX_EXACT_MB)
+
+
 def load_points(path: str, args, err: IO[str], what: str = "surface"):
     """Read the points file ``path`` with the command's ``--columns`` and ``--snap``.
 

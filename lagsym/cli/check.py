@@ -8,7 +8,7 @@ from ..conditioning import check_curve, check_surface
 from ..errors import ExitStatus
 from ..grid import CurvePoints
 from ..lagrange import lagrange_curve, lagrange_surface
-from ._common import add_points_arguments, load_points
+from ._common import add_exact_limit, exact_limit, add_points_arguments, load_points
 
 DESCRIPTION = """Measure what the paper's section 4 warns about for the points in FILE:
 degree in each direction (above the paper's line of 6 a warning only on
@@ -26,6 +26,7 @@ examples:
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("file", help="points file (surface x,y,z or curve x,y)")
     add_points_arguments(p)
     p.add_argument("--strict", action="store_true", help="exit with status 1 when there is a warning")
@@ -34,7 +35,9 @@ def add_arguments(p) -> None:
 
 def run(args, out, err) -> int:
     pts = load_points(args.file, args, err, "any")
-    report = check_curve(lagrange_curve(pts)) if isinstance(pts, CurvePoints) else check_surface(lagrange_surface(pts))
+    limit = exact_limit(args)
+    report = (check_curve(lagrange_curve(pts, max_mb=limit)) if isinstance(pts, CurvePoints)
+              else check_surface(lagrange_surface(pts, max_mb=limit)))
     if args.format == "json":
         doc = {
             "source": report.source,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..equation import render
 from ..lagrange import lagrange_curve
-from ._common import add_points_arguments, emit, load_points
+from ._common import add_exact_limit, exact_limit, add_points_arguments, emit, load_points
 from .equation import add_format_arguments, report_rounding
 
 DESCRIPTION = """Print the exact Lagrange interpolating polynomial y = F(x) through the
@@ -17,13 +17,14 @@ examples:
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("file", help="points file: JSON or a table with x,y")
     add_points_arguments(p)
     add_format_arguments(p)
 
 
 def run(args, out, err) -> int:
-    curve = lagrange_curve(load_points(args.file, args, err, "curve"))
+    curve = lagrange_curve(load_points(args.file, args, err, "curve"), max_mb=exact_limit(args))
     emit(render(curve, args.format, args.digits, args.max_terms), args.output, out)
     report_rounding(curve, args.digits, curve.points.units, err)
     return 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..equation import FORMATS, MAX_TERMS, render, rounding_miss
 from ..lagrange import lagrange_surface
-from ._common import DIGITS, add_points_arguments, count, emit, load_points
+from ._common import add_exact_limit, exact_limit, DIGITS, add_points_arguments, count, emit, load_points
 
 DESCRIPTION = """Print the exact tensor-product Lagrange surface z = F(x, y) through the
 control points in FILE (JSON or a table: CSV, TSV, .xyz), with exact rational
@@ -19,6 +19,7 @@ examples:
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("file", help="points file: JSON or a table with x,y,z")
     add_points_arguments(p)
     add_format_arguments(p)
@@ -35,7 +36,7 @@ def add_format_arguments(p) -> None:
 
 
 def run(args, out, err) -> int:
-    surface = lagrange_surface(load_points(args.file, args, err))
+    surface = lagrange_surface(load_points(args.file, args, err), max_mb=exact_limit(args))
     emit(render(surface, args.format, args.digits, args.max_terms), args.output, out)
     report_rounding(surface, args.digits, surface.grid.units, err)
     return 0

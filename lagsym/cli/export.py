@@ -10,7 +10,7 @@ from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ._common import add_conditioning_argument, conditioning_notes, count, read_piecewise
+from ._common import add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, count, read_piecewise
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
@@ -39,6 +39,7 @@ examples:
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("file", help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", required=True,
@@ -74,7 +75,7 @@ def run(args, out, err) -> int:
     else:
         if args.method == "lagrange":  # the other methods do not interpolate, so do not amplify the points' errors
             conditioning_notes(grid, args, err)
-        patch = cad_patch(lagrange_surface(grid) if args.method == "lagrange" else grid, args.method,
+        patch = cad_patch(lagrange_surface(grid, max_mb=exact_limit(args)) if args.method == "lagrange" else grid, args.method,
                           degree=args.degree or 3)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
     lo, hi = grid.z_range()

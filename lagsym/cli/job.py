@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..io import write_text
-from ._common import add_conditioning_argument, conditioning_notes, cusp_note
+from ._common import add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
@@ -42,8 +42,9 @@ def add_max_points(p) -> None:
     """``--max-points`` (as ``toolpath`` has it) and ``--max-samples``: each operation is estimated first."""
     from ..toolpath.plan import MAX_PLAN_POINTS
     from ..toolpath.rough import MAX_ROUGH_SAMPLES
-    from ._common import count
+    from ._common import add_exact_limit, count
 
+    add_exact_limit(p)
     p.add_argument("--max-points", type=count(1, 10**12), default=MAX_PLAN_POINTS, metavar="N",
                    help=f"refuse an operation of more than N points, estimated before it is planned "
                         f"(default {MAX_PLAN_POINTS:.0e})")
@@ -63,7 +64,8 @@ def run(args, out, err) -> int:
         spec = measured_job(spec, args.measured, err)
     spec = guard_job(spec, args, err)
     with progress_bar(err) as progress:
-        planned = plan_job(spec, args.max_points, args.max_samples, progress=progress)
+        planned = plan_job(spec, args.max_points, args.max_samples, progress=progress,
+                           max_exact_mb=exact_limit(args))
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

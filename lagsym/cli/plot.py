@@ -8,7 +8,7 @@ from ..errors import InputError
 from ..grid import CurvePoints
 from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
-from ._common import SCALE, count, measured_points, number
+from ._common import add_exact_limit, exact_limit, SCALE, count, measured_points, number
 
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
@@ -61,6 +61,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,
@@ -140,7 +141,7 @@ def run(args, out, err) -> int:
     if args.z_exaggeration is not None:
         opts["z_exaggeration"] = args.z_exaggeration
     if isinstance(points, CurvePoints):
-        curve = lagrange_curve(points)
+        curve = lagrange_curve(points, max_mb=exact_limit(args))
         figure = plot.curve_basis_figure(curve, **opts) if what == "basis" else plot.curve_figure(curve, **opts)
     elif what == "compare":
         figure = _compare_figure(plot, points, args, opts)
@@ -149,7 +150,7 @@ def run(args, out, err) -> int:
     elif what == "growth":
         figure = _growth_figure(plot, points, program, opts)
     else:
-        surface = lagrange_surface(points)
+        surface = lagrange_surface(points, max_mb=exact_limit(args))
         figure = plot.basis_figure(surface, **opts) if what == "basis" else plot.surface_figure(surface, **opts)
     if args.output:
         plot.save_figure(figure, args.output)
@@ -246,4 +247,5 @@ def _toolpath_figure(plot, grid, program, args, opts):
                       origin(args.origin or "0,0,0"))
     ends_rapid = np.concatenate([[False], rapid])  # plot marks the move that ends at each point
     opts = {k: v for k, v in opts.items() if k != "units"}  # checked in run: the machine's mm
-    return plot.toolpath_figure(lagrange_surface(grid), points_mm, rapid=ends_rapid, placement=place, **opts)
+    surface = lagrange_surface(grid, max_mb=exact_limit(args))
+    return plot.toolpath_figure(surface, points_mm, rapid=ends_rapid, placement=place, **opts)

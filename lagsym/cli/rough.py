@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..io import write_text
 from ..machine import DIRECTIONS, UNITS
-from ._common import (add_conditioning_argument, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
+from ._common import (add_conditioning_argument, exact_limit, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, LENGTH_MM, PROGRAM_NUMBER, SCALE, SPINDLE_RPM, TOOL_MM, count,
                       number, origin)
 from .job import add_max_points
 
@@ -198,7 +198,7 @@ def run(args, out, err) -> int:
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
     spec = guard_job(parse_job(job_data(args), "lagsym rough"), args, err)
     with progress_bar(err) as progress:
-        planned = plan_job(spec, args.max_points, samples, progress=progress)
+        planned = plan_job(spec, args.max_points, samples, progress=progress, max_exact_mb=exact_limit(args))
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from ..controls import CONTROLS, control
 from ..io import read_program
-from ..simulate import BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, SIM_DIALECTS, detect_dialect, moves_csv, simulate
+from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, detect_dialect,
+                        moves_csv, simulate)
+from ..simulate.runaway import check_lines
 from ._common import count, emit, exact
 from ._progress import progress_bar
 
@@ -54,6 +56,9 @@ def add_arguments(p) -> None:
     p.add_argument("--max-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_BLOCKS, metavar="N",
                    help=f"stop after N executed blocks as a runaway loop (default {MAX_BLOCKS}; the moves take "
                         f"at most {BYTES_PER_MOVE} bytes a block, up to {MAX_BLOCKS_LIMIT})")
+    p.add_argument("--max-lines", type=count(1, 10**9), default=MAX_PROGRAM_LINES, metavar="N",
+                   help=f"refuse a program of more than N lines before reading it (default {MAX_PROGRAM_LINES}; "
+                        f"each takes about 11 KB while read and compiled)")
     p.add_argument("--max-idle-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_IDLE_BLOCKS, metavar="N",
                    help=f"stop after N blocks in a row without a move as a runaway loop (default {MAX_IDLE_BLOCKS})")
     p.add_argument("--surface", metavar="FORMULA|FILE",
@@ -68,12 +73,13 @@ def add_arguments(p) -> None:
 
 def run(args, out, err) -> int:
     text = read_program(args.program)
+    check_lines(text, args.max_lines, args.program)  # named here: the library does not know the file
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or control(dialect).macro.default_precision
     target = _target(args.surface, args.tip_radius) if args.surface else None
     with progress_bar(err) as progress:
         sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks,
-                       progress=progress, target=target)
+                       progress=progress, target=target, max_lines=args.max_lines)
     if args.print_output:
         emit("\n".join(sim.output), args.print_output, out)
     emit(moves_csv(sim), args.output, out)

@@ -7,11 +7,12 @@ from __future__ import annotations
 
 from ..errors import ExitStatus, InputError
 from ..gcode import parse_moves
+from ..gcode.moves import MAX_MOVE_POINTS
 from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
-from ._common import CORNER_MM, SCALE, TOOL_MM, count, number, origin, read_piecewise
+from ._common import add_exact_limit, exact_limit, CORNER_MM, SCALE, TOOL_MM, count, number, origin, read_piecewise
 from ._progress import progress_bar
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
@@ -55,6 +56,7 @@ _SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": Non
 
 
 def add_arguments(p) -> None:
+    add_exact_limit(p)
     p.add_argument("surface", metavar="SURFACE",
                    help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface (with --job: the job file)")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves, G02/G03 arcs with I J K)")
@@ -80,6 +82,9 @@ def add_arguments(p) -> None:
                         "(default: reported, not checked; not with --job)")
     p.add_argument("--max-cells", type=count(1, 10**10), default=MAX_CELLS, metavar="N",
                    help=f"refuse a height map of more than N cells (default {MAX_CELLS:.2g})")
+    p.add_argument("--max-moves", type=count(1, 10**9), default=MAX_MOVE_POINTS, metavar="N",
+                   help=f"refuse a program whose moves make more than N points, each arc read as pieces that "
+                        f"sag 1e-5 mm, counted as it is read (default {MAX_MOVE_POINTS:.2g})")
     p.add_argument("--max-contacts", type=count(1, 10**14), metavar="N",
                    help=f"refuse a simulation of more than N segments swept times cells under the tool "
                         f"(default {MAX_CONTACTS:.2g})")
@@ -91,10 +96,10 @@ def run(args, out, err) -> int:
     for key, default in _SINGLE_TOOL.items():
         if getattr(args, key) is None:
             setattr(args, key, default)
-    surface = read_piecewise(args.surface) or lagrange_surface(read_points(args.surface))
+    surface = read_piecewise(args.surface) or lagrange_surface(read_points(args.surface), max_mb=exact_limit(args))
     place = Placement(mm_per_surface_unit(surface.grid.units, args.scale), origin(args.origin))
     text = read_program(args.program)
-    moves = parse_moves(text, source=args.program)
+    moves = parse_moves(text, source=args.program, max_points=args.max_moves)
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     with progress_bar(err) as progress:
         report = simulate_cut(surface, moves, tool, place, cell_mm=args.cell,

@@ -63,12 +63,20 @@ def chebyshev_transform(nodes) -> tuple[float, float, flint.fmpq_mat]:
     # x**a = (o + h s)**a = sum_p C(a, p) o**(a-p) h**p s**p
     shift = flint.fmpq_mat(n, n, [fmpq(comb(q, p) * o ** (q - p) * h**p) if q >= p else 0
                                   for p in range(n) for q in range(n)])
-    # cheb[p, k]: coefficient of s**p in T_k(s)
-    rows = [[1] + [0] * (n - 1), [0, 1] + [0] * (n - 2)][:n]
-    for k in range(2, n):
-        rows.append([2 * (rows[k - 1][p - 1] if p else 0) - rows[k - 2][p] for p in range(n)])
-    cheb = flint.fmpq_mat(n, n, [rows[k][p] for p in range(n) for k in range(n)])
-    return offset, scale, cheb.solve(shift)
+    # powers[k, p]: the coefficient of T_k(s) in s**p, in closed form,
+    # s**p = 2**(1-p) sum_{k = p, p-2, ...} C(p, (p-k)/2) T_k(s) with the T_0 term halved.
+    # Solving the triangular system of the T_k's power coefficients instead gives the same
+    # matrix, but a general exact solve grows its intermediate rationals: over a minute for
+    # 100 nodes with decimal coordinates, where this product takes under a second.
+    powers = flint.fmpq_mat(n, n, [_power_in_chebyshev(k, p) for k in range(n) for p in range(n)])
+    return offset, scale, powers * shift
+
+
+def _power_in_chebyshev(k: int, p: int) -> flint.fmpq:
+    """The coefficient of ``T_k(s)`` in ``s**p``."""
+    if k > p or (p - k) % 2:
+        return flint.fmpq(0)
+    return flint.fmpq(comb(p, (p - k) // 2) * (1 if k == 0 else 2), 2**p)
 
 
 SPLIT = 134217729.0

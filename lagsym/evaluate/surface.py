@@ -35,7 +35,6 @@ from .chebyshev import (
     chebyshev_transform,
     data_range,
     fmpq,
-    fraction,
     split,
 )
 
@@ -420,7 +419,8 @@ def _make_evaluator(surface) -> SurfaceEvaluator:
     n, m = g.shape
     power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
     cheb = ax * power * ay.transpose()
-    coeffs = np.array([[float(fraction(cheb[a, b])) for b in range(m)] for a in range(n)])
+    # int / int is correctly rounded, as float(Fraction) is, without reducing a Fraction first
+    coeffs = np.array([[int(cheb[a, b].p) / int(cheb[a, b].q) for b in range(m)] for a in range(n)])
     return SurfaceEvaluator(
         x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh,
         coefficients=_readonly(coeffs),

@@ -36,11 +36,11 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import ProgramError
 from ..machine import mm_per_program_unit
-from .arcs import arc_points
+from .arcs import ARC_SAG_MM, arc_points
 from .program import END_M, ascii_program, program_blocks, unrun_code
 from .words import WordError, numeric_words, plain_move
 
-__all__ = ["Moves", "parse_moves", "move_points", "tool_changes"]
+__all__ = ["MAX_MOVE_POINTS", "Moves", "parse_moves", "move_points", "tool_changes"]
 
 _IGNORED_LETTERS = set("NSTHDP")
 
@@ -142,7 +142,10 @@ class _Modal:
             self.absolute = g == 90
 
 
-def parse_moves(text: str, source: str = "<program>") -> Moves:
+MAX_MOVE_POINTS = 2_000_000  # points of one program's moves, arcs read as pieces: about 550 MB while read
+
+
+def parse_moves(text: str, source: str = "<program>", max_points: int | None = MAX_MOVE_POINTS) -> Moves:
     """Read the straight moves of a point-list program.
 
     Parameters
@@ -151,6 +154,10 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
         The program text (any line ending).
     source : str
         A name for messages (the file name).
+    max_points : int or None
+        Refuse a program whose moves, each arc read as its pieces, make more
+        points than this (``verify --max-moves``), counted before each move's
+        points are kept; None: no limit.
 
     Examples
     --------
@@ -202,6 +209,7 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
                 v = target[letter] * modal.factor
                 pos[k] = v if modal.absolute else pos[k] + v
         ends = arc_points(before, pos, offset, modal.plane, modal.motion == 3, where) if arc else [tuple(pos)]
+        _check_count(len(pts) + len(ends), max_points, where)
         for end in ends:
             pts.append(tuple(end))
             rapid.append(modal.motion == 0)
@@ -216,6 +224,12 @@ def parse_moves(text: str, source: str = "<program>") -> Moves:
         line=np.array(lines, dtype=int),
         z_known=np.array(zk, dtype=bool),
     )
+
+
+def _check_count(count: int, max_points: int | None, where: str) -> None:
+    if max_points is not None and count > max_points:
+        raise ProgramError(f"{where}: the moves so far make {count:,} points (arcs read as pieces that sag "
+                           f"{ARC_SAG_MM:g} mm), more than the limit of {max_points:,}; raise the limit (--max-moves)")
 
 
 def move_points(text: str, source: str = "<program>") -> tuple[np.ndarray, np.ndarray]:

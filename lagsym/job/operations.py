@@ -16,6 +16,7 @@ import numpy as np
 from .._arrays import freeze_fields
 from ..errors import InputError, LagsymError, ToolpathError
 from ..export.piecewisejson import read_piecewise_file
+from ..exactsize import MAX_EXACT_MB
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec
@@ -66,13 +67,13 @@ class PlannedJob:
     operations: tuple
 
 
-def job_surface(spec: JobSpec):
+def job_surface(spec: JobSpec, max_exact_mb: float = MAX_EXACT_MB):
     """The job's exact surface: its fitted measurement's polynomial, the pieces of a ``lagsym piecewise`` file
     (:mod:`lagsym.surfaces.piecewise`), or the polynomial through its points file."""
     if spec.grid is not None:
-        return lagrange_surface(spec.grid)
+        return lagrange_surface(spec.grid, max_mb=max_exact_mb)
     pieces = read_piecewise_file(spec.points)
-    return pieces if pieces is not None else lagrange_surface(read_points(spec.points))
+    return pieces if pieces is not None else lagrange_surface(read_points(spec.points), max_mb=max_exact_mb)
 
 
 def job_stock(spec: JobSpec, surface, evaluator=None) -> Stock:
@@ -102,18 +103,20 @@ def _settings(spec: JobSpec, op: OperationSpec | None = None, stock_mm: float = 
 
 
 def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
-             max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None) -> PlannedJob:
+             max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None,
+             max_exact_mb: float | None = MAX_EXACT_MB) -> PlannedJob:
     """Read the points, build the block and plan every operation in order.
 
     Each operation is estimated before it is planned: at most ``max_points``
-    points, and a roughing level at most ``max_samples`` drop-cutter samples.
+    points, and a roughing level at most ``max_samples`` drop-cutter samples;
+    the exact surface at most ``max_exact_mb`` (:mod:`lagsym.exactsize`).
     ``progress`` is told the operations planned (stage ``operations``) and
     each planner's own stages after the operation's label
     (``rough T1: dropping the tool``; :mod:`lagsym.progress`).
     """
     if spec.grid is None and spec.points is None:
         raise InputError(f"{spec.source}: the job's surface is measured: fit the measurement first (--measured)")
-    surface = job_surface(spec)
+    surface = job_surface(spec, max_exact_mb)
     ev = evaluator_of(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:

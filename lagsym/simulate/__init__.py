@@ -49,8 +49,8 @@ from .executor import MAX_DO, simulate
 from .expressions import MAX_BRACKETS
 from .reader import SIM_DIALECTS, detect_dialect
 from .result import BYTES_PER_MOVE, SimMove, SimMoves, Simulation, moves_csv
-from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS
+from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES
 
 __all__ = ["ControlAlarm", "SimMove", "SimMoves", "Simulation", "simulate", "detect_dialect", "moves_csv",
            "SIM_DIALECTS", "MAX_BRACKETS", "MAX_DO",
-           "MAX_BLOCKS", "MAX_IDLE_BLOCKS", "BYTES_PER_MOVE"]
+           "MAX_BLOCKS", "MAX_IDLE_BLOCKS", "MAX_PROGRAM_LINES", "BYTES_PER_MOVE"]

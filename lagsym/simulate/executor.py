@@ -15,7 +15,7 @@ from .compiler import alarm_block, compile_program
 from .control import ControlState
 from .reader import SIM_DIALECTS, detect_dialect, read_blocks
 from .result import Simulation
-from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS, Runaway, endless_jumps
+from .runaway import MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, Runaway, check_lines, endless_jumps
 
 __all__ = ["simulate", "MAX_DO"]
 
@@ -24,7 +24,7 @@ MAX_DO = 3  # Fanuc: DO1..DO3
 
 def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
              variable_ranges=None, max_blocks: int = MAX_BLOCKS, max_idle_blocks: int = MAX_IDLE_BLOCKS,
-             progress: Progress | None = None, target=None) -> Simulation:
+             progress: Progress | None = None, target=None, max_lines: int | None = MAX_PROGRAM_LINES) -> Simulation:
     """Execute ``text`` as the control would, with ``precision`` significant digits.
 
     Parameters
@@ -49,6 +49,10 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
         Blocks executed without a move before the run is stopped as a runaway
         loop.  A run that comes back to a block with every variable and the
         position unchanged is stopped at once (see :mod:`~lagsym.simulate.runaway`).
+    max_lines : int or None
+        Refuse a program of more lines than this before any is read
+        (``--max-lines``): each is read into typed blocks and compiled, about
+        11 KB a line while it runs; None: no limit.
     target : ProbeTarget, optional
         What the probing moves (Fanuc/Haas ``G31``, LinuxCNC ``G38.2``)
         touch (:func:`~lagsym.simulate.probing.probe_target`); without one a
@@ -78,6 +82,7 @@ def simulate(text: str, dialect: str | None = None, precision: int = 8, *,
     precision = whole(precision, "precision (significant digits)", 1, 34)
     max_blocks = whole(max_blocks, "max_blocks", 1, 1 << 62)
     max_idle_blocks = whole(max_idle_blocks, "max_idle_blocks", 1, 1 << 62)
+    check_lines(text, max_lines)
     blocks = _match_loops(read_blocks(text, c))
     labels = _labels(blocks)
     m = ControlState(c, int(precision), variable_ranges or None)

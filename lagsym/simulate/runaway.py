@@ -26,7 +26,9 @@ from __future__ import annotations
 
 from decimal import Decimal
 
+from ..errors import InputError
 from ..gcode.program import END_M, unrun_code
+from ..values import whole
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile, OIf,
                      OWhile, Stop, While, Words, probe_code)
@@ -35,7 +37,18 @@ from .control import ControlState
 __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
 
 MAX_BLOCKS = 5_000_000  # 2.0 times the 2.53 million of the README's Example 4 ball macro at 8 digits
+MAX_PROGRAM_LINES = 100_000  # lines read and compiled: about 11 KB each while compiled, so about 1.1 GB
 MAX_IDLE_BLOCKS = 200_000  # lagsym's macros move every few hundred blocks at most (a 12x12 Heidenhain one: 613)
+
+
+def check_lines(text: str, max_lines: int | None, source: str = "the program") -> None:
+    """Refuse ``text`` of more than ``max_lines`` lines, before any is read into blocks (None: no limit)."""
+    if max_lines is None:
+        return
+    lines = text.count("\n") + 1
+    if lines > whole(max_lines, "max_lines", 1, 1 << 62):
+        raise InputError(f"{source}: {lines:,} lines, more than the limit of {max_lines:,} (about "
+                         f"{lines * 11e3 / 1e9:.2g} GB to read and compile them); raise the limit (--max-lines)")
 
 
 class Runaway:
