@@ -15,6 +15,9 @@ EXAMPLES = ROOT / "examples"
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+# No background compile from the commands the tests start: the session compiles the kernel itself (below), and
+# tests/test_first_run.py turns it on where it is what is tested.
+os.environ["LAGSYM_NO_BACKGROUND_COMPILE"] = "1"
 
 settings.register_profile("ci", max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile("dev", max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -42,3 +42,38 @@ def test_roughing_says_so_too(tmp_path):
     assert r.returncode == 0, r.stderr
     # A job's stages carry the operation's name.
     assert r.stderr.startswith("lagsym: rough T1: " + LINE[len("lagsym: "):]), r.stderr
+
+
+def test_the_first_command_leaves_the_kernel_compiled_for_the_first_plan(tmp_path):
+    """The README's first command (lagsym equation) starts the compile in the background; the toolpath that follows
+    loads the kernel from the cache and says nothing of compiling."""
+    import time
+
+    cache = tmp_path / "numba-cache"
+    env = {k: v for k, v in os.environ.items() if k != "LAGSYM_NO_BACKGROUND_COMPILE"}
+    env["NUMBA_CACHE_DIR"] = str(cache)
+    eq = subprocess.run([sys.executable, "-m", "lagsym", "equation", str(EXAMPLES / "paper-example-1.json")], env=env,
+                        capture_output=True, text=True, timeout=120)
+    assert eq.returncode == 0 and eq.stderr == "", eq.stderr
+    # the background process compiles the cutter kernel, then the evaluation kernels: wait for the last index
+    deadline = time.monotonic() + 600
+    while not (any(cache.rglob("kernel.drop_chunk-*.nbi")) and any(cache.rglob("compiled.points_kernel-*.nbi"))):
+        assert time.monotonic() < deadline, "the background compile left no kernel in the cache"
+        time.sleep(0.5)
+    r = _run(tmp_path, cache)
+    assert r.returncode == 0, r.stderr
+    assert "compiling" not in r.stderr, r.stderr
+
+
+def test_the_background_compile_is_off_when_asked_or_already_done(tmp_path, monkeypatch):
+    from lagsym.toolpath import warmup
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "empty"))
+    monkeypatch.setenv(warmup.OFF, "1")
+    assert warmup.start_in_background() is False
+    monkeypatch.delenv(warmup.OFF)
+    folder = warmup.cache_folder()
+    assert folder is not None and not warmup.kernel_cached(folder)
+    folder.mkdir(parents=True)
+    (folder / "kernel.drop_chunk-407.py311.nbi").write_bytes(b"")
+    assert warmup.kernel_cached() and warmup.start_in_background() is False

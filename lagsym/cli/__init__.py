@@ -237,4 +237,8 @@ def run_console() -> None:
     except KeyboardInterrupt:  # between main's own handlers (a second Ctrl-C)
         sys.stderr.write("lagsym: interrupted\n")
         status = ExitStatus.INTERRUPTED
+    # the first command after an install leaves the cutter kernel compiling in the background (toolpath.warmup)
+    from ..toolpath.warmup import start_in_background
+
+    start_in_background()
     sys.exit(status)

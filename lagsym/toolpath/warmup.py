@@ -1,0 +1,102 @@
+"""The cutter kernel compiled in the background after the first command of an install, so the first plan need not wait.
+
+Numba compiles the cutter kernel (:mod:`.kernel`) and the evaluation
+kernels (:mod:`lagsym.evaluate.compiled`) the first time they run and keeps
+the machine code in its cache, beside the modules (or under
+``NUMBA_CACHE_DIR``).  Compiling takes several seconds; loading takes a
+fraction of one.  So when a ``lagsym`` command ends and the cache holds no
+cutter kernel yet, :func:`start_in_background` starts a detached process at
+low priority that runs the kernels once on a tiny surface, filling the cache:
+the README's first command (``lagsym equation``) leaves the kernels ready for
+the ``toolpath`` that follows (and the large evaluations of ``sample`` and
+``verify``).  A command that plans before the cache is
+filled compiles the kernel itself and says so (:mod:`.compiling`).
+
+Nothing here imports Numba: the check is a look for the cache's index file.
+``LAGSYM_NO_BACKGROUND_COMPILE=1`` turns the background process off.  Where
+the cache would not be beside the modules or under ``NUMBA_CACHE_DIR`` (a
+read-only install), nothing is started, so no command starts a process
+that cannot leave its work behind.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+__all__ = ["OFF", "cache_folder", "kernel_cached", "start_in_background", "compile_kernels"]
+
+OFF = "LAGSYM_NO_BACKGROUND_COMPILE"
+_KERNEL = Path(__file__).resolve().with_name("kernel.py")
+
+
+def cache_folder(module: Path = _KERNEL) -> Path | None:
+    """Where Numba keeps the machine code of ``module``: under ``NUMBA_CACHE_DIR`` or beside it (None: elsewhere).
+
+    The same rule as Numba's own cache locators: ``NUMBA_CACHE_DIR`` holds a
+    folder named after the module's folder and a SHA-1 of its path; else the
+    ``__pycache__`` beside the module, if it can be written.
+    """
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    folder = module.parent
+    if root:
+        return Path(root) / f"{folder.name}_{hashlib.sha1(str(folder).encode()).hexdigest()}"
+    cache = folder / "__pycache__"
+    writable = os.access(cache, os.W_OK) if cache.exists() else os.access(folder, os.W_OK)
+    return cache if writable else None
+
+
+def kernel_cached(folder: Path | None = None) -> bool:
+    """Whether the cache already holds an index of the cutter kernel's machine code."""
+    folder = cache_folder() if folder is None else folder
+    return folder is not None and any(folder.glob(f"{_KERNEL.stem}.drop_chunk-*.nbi"))
+
+
+def start_in_background() -> bool:
+    """Start the detached process that fills the cache, unless it holds the kernel, cannot or is told not to.
+
+    Returns whether a process was started.  It runs in a session of its own
+    at low priority, reads and writes nothing the user sees, and a failure
+    to start it is not an error: the next plan compiles as before.
+    """
+    if os.environ.get(OFF) == "1" or cache_folder() is None or kernel_cached():
+        return False
+    try:
+        subprocess.Popen([sys.executable, "-m", "lagsym.toolpath.warmup"], stdin=subprocess.DEVNULL,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                         close_fds=True)
+    except OSError:
+        return False
+    return True
+
+
+def compile_kernels() -> None:
+    """Run the cutter kernel for each cutter shape, then the evaluation kernels, on a tiny surface: Numba caches them."""
+    import numpy as np
+
+    from ..evaluate import evaluate_grid, evaluate_points
+    from ..evaluate.engine import COMPILED_POINTS, Engine, use_engine
+    from ..grid import grid_from_table
+    from ..lagrange import lagrange_surface
+    from .dropcutter import drop_cutter
+
+    surface = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 0]]))
+    xs = np.linspace(0.0, 2.0, 5)
+    for shape, corner in (("ball", None), ("flat", None), ("bull", 0.1)):
+        drop_cutter(surface, xs, xs, 0.5, shape, corner=corner)
+    side = int(COMPILED_POINTS ** 0.5) + 1  # a batch large enough to run compiled
+    with use_engine(Engine("compiled")):
+        many = np.linspace(0.0, 2.0, side)
+        evaluate_grid(surface, many, many)
+        evaluate_points(surface, np.resize(many, COMPILED_POINTS), np.resize(many[::-1], COMPILED_POINTS))
+
+
+if __name__ == "__main__":
+    try:
+        os.nice(10)  # behind whatever the user runs next
+    except OSError:
+        pass
+    compile_kernels()
