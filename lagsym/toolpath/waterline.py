@@ -227,30 +227,81 @@ class _Drop:
     def along(self, a: np.ndarray, b: np.ndarray, spacing: float) -> np.ndarray:
         """The most each straight move ``a[k] -> b[k]`` (x, y surface units, z mm) lies below the cutter path.
 
-        Checked at points ``spacing`` (surface units) apart inside each move,
-        :data:`EDGE_DENSER` times closer where a move has an end with the
-        tool axis beyond the box (where the tool rolls onto the box's edge its
-        height rises like a square root, faster than any bound on the
-        surface's bending), plus at each point a quarter of its downward
-        second difference (:func:`.chordal.bends`: what the path may bend
-        below the points between them); 0 or less where the move stays above.
+        :meth:`samples` along each move, each taken with a quarter of its
+        downward second difference (:func:`.chordal.bends`: what the path
+        may bend below the points between them); 0 or less where the move
+        stays above.
+        """
+        k, _, pz, z, bend = self.samples(a, b, spacing)
+        out = np.full(len(a), -np.inf)
+        np.maximum.at(out, k, z - pz + bend)
+        return out
+
+    def samples(self, a: np.ndarray, b: np.ndarray, spacing: float):
+        """Cutter locations along each straight move ``a[k] -> b[k]``: ``(move, t, z on the move, tip height, bend)``.
+
+        Each move is sampled at its ends and at points at most ``spacing``
+        (surface units) apart inside it, :data:`EDGE_DENSER` times closer
+        where a move with an end beyond the box has the tool within its
+        radius of a box edge it runs across (where the tool rolls onto the
+        edge its height rises like a square root, faster than any bound on
+        the surface's bending; clear of such edges the path bends no faster
+        than the surface, :mod:`.chordal`).  ``bend`` is, at each sample
+        inside its move, a quarter of the downward second difference there
+        (for unequal steps, the second derivative the three samples show times
+        the longer step squared over four), 0 at the ends.
         """
         x0, x1, y0, y1 = self.cl.ev.bounds
         beyond = ((a[:, 0] < x0) | (a[:, 0] > x1) | (a[:, 1] < y0) | (a[:, 1] > y1)
                   | (b[:, 0] < x0) | (b[:, 0] > x1) | (b[:, 1] < y0) | (b[:, 1] > y1))
-        step = np.where(beyond, spacing / EDGE_DENSER, spacing)
-        n = np.maximum(np.ceil(np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]) / step), 2).astype(int)
-        k = np.repeat(np.arange(len(a)), n + 1)
-        t = (np.arange(k.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)) / np.repeat(n, n + 1)
+        # The part of each move where the tool stays clear of every box edge the move runs across: one interval
+        # [t0, t1] of it (empty: t0 >= t1).
+        r = self.cl.radius * (1 + 1e-9)
+        t0, t1 = np.zeros(len(a)), np.ones(len(a))
+        for c, lo, hi in ((0, x0 + r, x1 - r), (1, y0 + r, y1 - r)):
+            d = b[:, c] - a[:, c]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ta, tb = (lo - a[:, c]) / d, (hi - a[:, c]) / d
+            flat = d == 0
+            enter, leave = np.minimum(ta, tb), np.maximum(ta, tb)
+            # A move along an edge keeps the same part of the tool off the box all along it: that edge bends it no
+            # faster than the surface (:func:`.chordal.crosses_box_edge`).
+            t0 = np.where(flat, t0, np.maximum(t0, enter))
+            t1 = np.where(flat, t1, np.minimum(t1, leave))
+        whole = ~beyond | (t0 >= t1)  # one piece: evenly at the one spacing
+        t0, t1 = np.where(whole, 1.0, np.clip(t0, 0.0, 1.0)), np.where(whole, 1.0, np.clip(t1, 0.0, 1.0))
+        length = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
+        fine = spacing / EDGE_DENSER
+        # Up to three pieces a move: [0, t0], [t0, t1], [t1, 1], each evenly sampled, the first at the edge spacing
+        # where a move is beyond and not whole (with ``whole`` it is the move itself at its own spacing).
+        first_step = np.where(beyond, fine, spacing)
+        span = np.stack([t0, t1 - t0, 1.0 - t1], axis=1)
+        steps = np.stack([first_step, np.full(len(a), spacing), np.full(len(a), fine)], axis=1)
+        n = np.where(span > 0, np.maximum(np.ceil(span * length[:, None] / steps), 1), 0).astype(int)
+        widest = np.argmax(span, axis=1)  # two steps at least, as for a move of length 0
+        n[np.arange(len(a)), widest] = np.where(n.sum(axis=1) < 2, 2, n[np.arange(len(a)), widest])
+        per = n.sum(axis=1) + 1  # samples of each move: the pieces share their ends
+        k = np.repeat(np.arange(len(a)), per)
+        pos = np.arange(k.size) - np.repeat(np.cumsum(per) - per, per)  # index within the move
+        cum = np.concatenate([np.zeros((len(a), 1), dtype=int), np.cumsum(n, axis=1)], axis=1)
+        piece = np.minimum((pos[:, None] >= cum[k, 1:]).sum(axis=1), 2)
+        lo_t = np.concatenate([np.zeros((len(a), 1)), np.cumsum(span, axis=1)], axis=1)
+        nk = np.maximum(n[k, piece], 1)
+        t = lo_t[k, piece] + (pos - cum[k, piece]) / nk * span[k, piece]
+        t = np.where(pos == per[k] - 1, 1.0, t)
         p = a[k] + t[:, None] * (b[k] - a[k])
         z = self(p[:, 0], p[:, 1])
-        below = z - p[:, 2]
         bend = np.zeros(len(z))
-        inner = np.flatnonzero(k[:-2] == k[2:]) + 1  # points with both neighbours on their move
-        bend[inner] = np.maximum(0.0, -(z[inner - 1] - 2.0 * z[inner] + z[inner + 1])) / 4.0
-        out = np.full(len(a), -np.inf)
-        np.maximum.at(out, k, below + bend)
-        return out
+        inner = np.flatnonzero(k[:-2] == k[2:]) + 1  # samples with both neighbours on their move
+        if inner.size:
+            even = piece[inner - 1] == piece[inner + 1]  # within one evenly sampled piece
+            h1, h2 = t[inner] - t[inner - 1], t[inner + 1] - t[inner]
+            hmax = np.maximum(h1, h2)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                uneven = ((z[inner + 1] - z[inner]) / h2 - (z[inner] - z[inner - 1]) / h1) / (h1 + h2) * hmax * hmax / 2.0
+            second = (z[inner - 1] - 2.0 * z[inner] + z[inner + 1]) / 4.0
+            bend[inner] = np.maximum(0.0, -np.where(even, second, uneven))
+        return k, t, p[:, 2], z, bend
 
 
 def _field(drop: _Drop, reach, nx: int, ny: int, radius_mm: float, scallop_mm: float, *, direction: str,
@@ -437,10 +488,14 @@ def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing:
         return []
     margin = kappa * (spacing * mpu) ** 2 / 8
     near = np.hypot(q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]) * mpu <= NEAR_RADII * radius_mm
-    clear = near & (drop.along(p, q, spacing) + margin <= 0)
-    flat_p, flat_q = p.copy(), q.copy()
-    flat_p[:, 2] = flat_q[:, 2] = 0.0
-    top = np.maximum(np.maximum(p[:, 2], q[:, 2]), drop.along(flat_p, flat_q, spacing) + margin)
+    # One set of samples for both: how far the straight move lies below the cutter path, and the highest cutter
+    # location under the link.
+    k, _, pz, z, bend = drop.samples(p, q, spacing)
+    below, highest = np.full(len(p), -np.inf), np.full(len(p), -np.inf)
+    np.maximum.at(below, k, z - pz + bend)
+    np.maximum.at(highest, k, z + bend)
+    clear = near & (below + margin <= 0)
+    top = np.maximum(np.maximum(p[:, 2], q[:, 2]), highest + margin)
     h = top + LINK_CLEARANCE_MM
     return [np.empty((0, 3)) if c else np.array([[a[0], a[1], z], [b[0], b[1], z]])
             for c, a, b, z in zip(clear, p, q, h)]
