@@ -254,29 +254,35 @@ class _Drop:
         x0, x1, y0, y1 = self.cl.ev.bounds
         beyond = ((a[:, 0] < x0) | (a[:, 0] > x1) | (a[:, 1] < y0) | (a[:, 1] > y1)
                   | (b[:, 0] < x0) | (b[:, 0] > x1) | (b[:, 1] < y0) | (b[:, 1] > y1))
-        # The part of each move where the tool stays clear of every box edge the move runs across: one interval
-        # [t0, t1] of it (empty: t0 >= t1).
+        # Along each move, the interval [enter, leave] of each axis with the tool clear of that axis's box edges: a
+        # move along an edge keeps the same part of the tool off the box all along it, so that edge bends it no
+        # faster than the surface (:func:`.chordal.crosses_box_edge`) and counts as clear.
         r = self.cl.radius * (1 + 1e-9)
-        t0, t1 = np.zeros(len(a)), np.ones(len(a))
+        length = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
+        enter, leave, across = [], [], []
         for c, lo, hi in ((0, x0 + r, x1 - r), (1, y0 + r, y1 - r)):
             d = b[:, c] - a[:, c]
             with np.errstate(divide="ignore", invalid="ignore"):
                 ta, tb = (lo - a[:, c]) / d, (hi - a[:, c]) / d
+                across.append(np.where(length > 0, np.abs(d) / length, 1.0))  # the move's share across the edges
             flat = d == 0
-            enter, leave = np.minimum(ta, tb), np.maximum(ta, tb)
-            # A move along an edge keeps the same part of the tool off the box all along it: that edge bends it no
-            # faster than the surface (:func:`.chordal.crosses_box_edge`).
-            t0 = np.where(flat, t0, np.maximum(t0, enter))
-            t1 = np.where(flat, t1, np.minimum(t1, leave))
-        whole = ~beyond | (t0 >= t1)  # one piece: evenly at the one spacing
-        t0, t1 = np.where(whole, 1.0, np.clip(t0, 0.0, 1.0)), np.where(whole, 1.0, np.clip(t1, 0.0, 1.0))
-        length = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
-        fine = spacing / EDGE_DENSER
-        # Up to three pieces a move: [0, t0], [t0, t1], [t1, 1], each evenly sampled, the first at the edge spacing
-        # where a move is beyond and not whole (with ``whole`` it is the move itself at its own spacing).
-        first_step = np.where(beyond, fine, spacing)
-        span = np.stack([t0, t1 - t0, 1.0 - t1], axis=1)
-        steps = np.stack([first_step, np.full(len(a), spacing), np.full(len(a), fine)], axis=1)
+            enter.append(np.where(flat, -np.inf, np.minimum(ta, tb)))
+            leave.append(np.where(flat, np.inf, np.maximum(ta, tb)))
+        # Five pieces a move between those bounds, each evenly sampled: at ``spacing``, or where a move beyond the
+        # box has the tool near an edge it runs across, at most ``spacing / EDGE_DENSER`` apart across that edge
+        # (the square-root onset is across it: as close as on a move straight across), along the move near edges
+        # of both axes (a corner).  A move with no end beyond is one piece.
+        cuts = np.sort(np.clip(np.stack([enter[0], leave[0], enter[1], leave[1]], axis=1), 0.0, 1.0), axis=1)
+        cuts = np.where(beyond[:, None], cuts, 1.0)
+        bounds = np.concatenate([np.zeros((len(a), 1)), cuts, np.ones((len(a), 1))], axis=1)
+        span = np.diff(bounds, axis=1)
+        mid = 0.5 * (bounds[:, :-1] + bounds[:, 1:])
+        near_x = (mid < enter[0][:, None]) | (mid > leave[0][:, None])
+        near_y = (mid < enter[1][:, None]) | (mid > leave[1][:, None])
+        share = np.where(near_x & near_y, 1.0, np.where(near_x, across[0][:, None],
+                                                        np.where(near_y, across[1][:, None], 0.0)))
+        with np.errstate(divide="ignore"):
+            steps = np.where(beyond[:, None], np.minimum(spacing, spacing / EDGE_DENSER / share), spacing)
         n = np.where(span > 0, np.maximum(np.ceil(span * length[:, None] / steps), 1), 0).astype(int)
         widest = np.argmax(span, axis=1)  # two steps at least, as for a move of length 0
         n[np.arange(len(a)), widest] = np.where(n.sum(axis=1) < 2, 2, n[np.arange(len(a)), widest])
@@ -284,7 +290,7 @@ class _Drop:
         k = np.repeat(np.arange(len(a)), per)
         pos = np.arange(k.size) - np.repeat(np.cumsum(per) - per, per)  # index within the move
         cum = np.concatenate([np.zeros((len(a), 1), dtype=int), np.cumsum(n, axis=1)], axis=1)
-        piece = np.minimum((pos[:, None] >= cum[k, 1:]).sum(axis=1), 2)
+        piece = np.minimum((pos[:, None] >= cum[k, 1:]).sum(axis=1), n.shape[1] - 1)
         lo_t = np.concatenate([np.zeros((len(a), 1)), np.cumsum(span, axis=1)], axis=1)
         nk = np.maximum(n[k, piece], 1)
         t = lo_t[k, piece] + (pos - cum[k, piece]) / nk * span[k, piece]
