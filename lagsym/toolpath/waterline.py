@@ -28,7 +28,9 @@ one program:
   pieces (where a contour leaves the steep parts or the reach);
 * **moves**: each contour thinned to the points whose chords stay within the
   chordal tolerance of it in plan (Douglas-Peucker), each chord then checked
-  by drop-cutter at points a quarter of the grid apart, and both its ends
+  by drop-cutter at points a quarter of the grid apart (:data:`EDGE_DENSER`
+  times closer across a box edge the tool comes near with the move beyond the
+  box), and both its ends
   lifted by the most the cutter path rises above it there plus
   ``κ h² / 8`` (the sag a path bending no faster than the surface's
   curvature bound ``κ`` can hide between samples ``h`` apart), so no move
@@ -71,6 +73,7 @@ from .pattern import within_reach
 from .dropcutter import telling_compiles
 from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, cutter_and_reach, plan_toolpath
 from .contours import BISECTIONS, contour_passes
+from .movesamples import EDGE_DENSER, move_samples
 from .scallop import _TIGHT, _allowed_d
 from .workers import MIN_POINTS, Workers
 
@@ -88,9 +91,6 @@ GRID_MM = 0.25
 
 LINK_CLEARANCE_MM = 1.0
 """How far above the highest cutter location under it a link between distant passes runs."""
-
-EDGE_DENSER = 32
-"""How many times closer a move with the tool axis beyond the box is checked."""
 
 NEAR_RADII = 4.0
 """A next pass within this many tool radii is joined by a straight move where one stays above the cutter path."""
@@ -238,76 +238,9 @@ class _Drop:
         return out
 
     def samples(self, a: np.ndarray, b: np.ndarray, spacing: float):
-        """Cutter locations along each straight move ``a[k] -> b[k]``: ``(move, t, z on the move, tip height, bend)``.
-
-        Each move is sampled at its ends and at points at most ``spacing``
-        (surface units) apart inside it, :data:`EDGE_DENSER` times closer
-        where a move with an end beyond the box has the tool within its
-        radius of a box edge it runs across (where the tool rolls onto the
-        edge its height rises like a square root, faster than any bound on
-        the surface's bending; clear of such edges the path bends no faster
-        than the surface, :mod:`.chordal`).  ``bend`` is, at each sample
-        inside its move, a quarter of the downward second difference there
-        (for unequal steps, the second derivative the three samples show times
-        the longer step squared over four), 0 at the ends.
-        """
-        x0, x1, y0, y1 = self.cl.ev.bounds
-        beyond = ((a[:, 0] < x0) | (a[:, 0] > x1) | (a[:, 1] < y0) | (a[:, 1] > y1)
-                  | (b[:, 0] < x0) | (b[:, 0] > x1) | (b[:, 1] < y0) | (b[:, 1] > y1))
-        # Along each move, the interval [enter, leave] of each axis with the tool clear of that axis's box edges: a
-        # move along an edge keeps the same part of the tool off the box all along it, so that edge bends it no
-        # faster than the surface (:func:`.chordal.crosses_box_edge`) and counts as clear.
-        r = self.cl.radius * (1 + 1e-9)
-        length = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
-        enter, leave, across = [], [], []
-        for c, lo, hi in ((0, x0 + r, x1 - r), (1, y0 + r, y1 - r)):
-            d = b[:, c] - a[:, c]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ta, tb = (lo - a[:, c]) / d, (hi - a[:, c]) / d
-                across.append(np.where(length > 0, np.abs(d) / length, 1.0))  # the move's share across the edges
-            flat = d == 0
-            enter.append(np.where(flat, -np.inf, np.minimum(ta, tb)))
-            leave.append(np.where(flat, np.inf, np.maximum(ta, tb)))
-        # Five pieces a move between those bounds, each evenly sampled: at ``spacing``, or where a move beyond the
-        # box has the tool near an edge it runs across, at most ``spacing / EDGE_DENSER`` apart across that edge
-        # (the square-root onset is across it: as close as on a move straight across), along the move near edges
-        # of both axes (a corner).  A move with no end beyond is one piece.
-        cuts = np.sort(np.clip(np.stack([enter[0], leave[0], enter[1], leave[1]], axis=1), 0.0, 1.0), axis=1)
-        cuts = np.where(beyond[:, None], cuts, 1.0)
-        bounds = np.concatenate([np.zeros((len(a), 1)), cuts, np.ones((len(a), 1))], axis=1)
-        span = np.diff(bounds, axis=1)
-        mid = 0.5 * (bounds[:, :-1] + bounds[:, 1:])
-        near_x = (mid < enter[0][:, None]) | (mid > leave[0][:, None])
-        near_y = (mid < enter[1][:, None]) | (mid > leave[1][:, None])
-        share = np.where(near_x & near_y, 1.0, np.where(near_x, across[0][:, None],
-                                                        np.where(near_y, across[1][:, None], 0.0)))
-        with np.errstate(divide="ignore"):
-            steps = np.where(beyond[:, None], np.minimum(spacing, spacing / EDGE_DENSER / share), spacing)
-        n = np.where(span > 0, np.maximum(np.ceil(span * length[:, None] / steps), 1), 0).astype(int)
-        widest = np.argmax(span, axis=1)  # two steps at least, as for a move of length 0
-        n[np.arange(len(a)), widest] = np.where(n.sum(axis=1) < 2, 2, n[np.arange(len(a)), widest])
-        per = n.sum(axis=1) + 1  # samples of each move: the pieces share their ends
-        k = np.repeat(np.arange(len(a)), per)
-        pos = np.arange(k.size) - np.repeat(np.cumsum(per) - per, per)  # index within the move
-        cum = np.concatenate([np.zeros((len(a), 1), dtype=int), np.cumsum(n, axis=1)], axis=1)
-        piece = np.minimum((pos[:, None] >= cum[k, 1:]).sum(axis=1), n.shape[1] - 1)
-        lo_t = np.concatenate([np.zeros((len(a), 1)), np.cumsum(span, axis=1)], axis=1)
-        nk = np.maximum(n[k, piece], 1)
-        t = lo_t[k, piece] + (pos - cum[k, piece]) / nk * span[k, piece]
-        t = np.where(pos == per[k] - 1, 1.0, t)
-        p = a[k] + t[:, None] * (b[k] - a[k])
-        z = self(p[:, 0], p[:, 1])
-        bend = np.zeros(len(z))
-        inner = np.flatnonzero(k[:-2] == k[2:]) + 1  # samples with both neighbours on their move
-        if inner.size:
-            even = piece[inner - 1] == piece[inner + 1]  # within one evenly sampled piece
-            h1, h2 = t[inner] - t[inner - 1], t[inner + 1] - t[inner]
-            hmax = np.maximum(h1, h2)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                uneven = ((z[inner + 1] - z[inner]) / h2 - (z[inner] - z[inner - 1]) / h1) / (h1 + h2) * hmax * hmax / 2.0
-            second = (z[inner - 1] - 2.0 * z[inner] + z[inner + 1]) / 4.0
-            bend[inner] = np.maximum(0.0, -np.where(even, second, uneven))
-        return k, t, p[:, 2], z, bend
+        """Cutter locations along each straight move ``a[k] -> b[k]``: ``(move, t, z on the move, tip height, bend)``
+        (:func:`.movesamples.move_samples`)."""
+        return move_samples(self, a, b, spacing, self.cl.ev.bounds, self.cl.radius)
 
 
 def _field(drop: _Drop, reach, nx: int, ny: int, radius_mm: float, scallop_mm: float, *, direction: str,
