@@ -22,8 +22,8 @@ one program:
   raster;
 * **contours**: at each level, the grid's cells whose cutter locations lie on
   either side of the level (marching squares), each crossing refined by
-  bisection on the exact drop-cutter value along its cell edge to
-  :data:`BISECTIONS` halvings, the low end kept (the tool there is at or above
+  false position and bisection on the exact drop-cutter value along its cell
+  edge to a bracket :data:`BISECTIONS` halvings wide, the low end kept (the tool there is at or above
   the exact drop-cutter height); crossings chained into closed loops and open
   pieces (where a contour leaves the steep parts or the reach);
 * **moves**: each contour thinned to the points whose chords stay within the
