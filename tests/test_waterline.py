@@ -178,3 +178,36 @@ def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_tha
     assert int(m.group(2).replace(",", "")) == n_ss and int(m.group(4).replace(",", "")) == n_r
     for quoted, measured in ((float(m.group(1)), left_ss), (float(m.group(3)), left_r)):
         assert measured <= quoted < measured + 0.001, (quoted, measured)
+
+
+def test_contour_crossings_are_bracketed_as_ten_bisections_would_leave_them():
+    """Each crossing's low end lies at or below the level, and 1/1024 of its edge further on lies above it (checked on
+    the function itself), with fewer evaluations than ten bisections on a smooth field."""
+    from lagsym.toolpath.contours import BISECTIONS, _crossings
+
+    def f(x, y):
+        return np.sin(3 * x) + 0.5 * y * y + 0.2 * x * y
+
+    rng = np.random.default_rng(11)
+    ax, ay = rng.uniform(0, 2, 4000), rng.uniform(0, 2, 4000)
+    bx, by = ax + rng.choice([0.0, 0.0125], 4000), ay
+    by = np.where(bx == ax, ay + 0.0125, by)
+    za, zb = f(ax, ay), f(bx, by)
+    swap = za > zb
+    lx, hx, ly, hy = np.where(swap, bx, ax), np.where(swap, ax, bx), np.where(swap, by, ay), np.where(swap, ay, by)
+    zl, zh = np.minimum(za, zb), np.maximum(za, zb)
+    keep = zl < zh
+    lx, hx, ly, hy, zl, zh = (v[keep] for v in (lx, hx, ly, hy, zl, zh))
+    lev = zl + rng.uniform(0, 1, len(zl)) * (zh - zl)
+    lev = np.where(lev < zh, lev, zl)
+    calls = []
+
+    def drop(x, y):
+        calls.append(len(x))
+        return f(x, y)
+
+    x, y = _crossings(drop, lx, ly, hx, hy, zl, zh, lev)
+    assert (f(x, y) <= lev).all()
+    w = 0.5 ** BISECTIONS * (1 + 1e-6)
+    assert (f(x + w * (hx - lx), y + w * (hy - ly)) > lev).all()
+    assert sum(calls) < 0.6 * BISECTIONS * len(lev), sum(calls) / len(lev)

@@ -1,4 +1,4 @@
-"""The contours of waterline finishing: levels spaced from the slope, marching squares, bisection, thinning.
+"""The contours of waterline finishing: levels spaced from the slope, marching squares, bracketing, thinning.
 
 :mod:`.waterline` states what is computed; ``f`` is its grid of cutter
 locations (``xs, ys, z, dz``) and ``drop`` its tip heights at surface
@@ -14,7 +14,10 @@ import numpy as np
 __all__ = ["BISECTIONS", "contour_passes"]
 
 BISECTIONS = 10
-"""Halvings of a grid edge where a contour crosses it (to about 0.00025 mm)."""
+"""A crossing is bracketed to the width this many halvings of its grid edge leave (about 0.00025 mm)."""
+
+
+_FALSE_POSITIONS = 2  # steps of false position before the last, a pair of points
 
 
 def _levels(f, steep: np.ndarray, d0: float) -> list[float]:
@@ -65,14 +68,8 @@ def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: flo
     gx, gy = np.meshgrid(f.xs, f.ys, indexing="ij")
     gx, gy = gx.ravel(), gy.ravel()
     lev = np.array(levels)[e[:, 0]]
-    lx, ly, hx, hy = gx[e[:, 2]], gy[e[:, 2]], gx[e[:, 3]], gy[e[:, 3]]
-    for _ in range(BISECTIONS):  # the low end stays at or below the level: the tool there clears the surface
-        mx, my = 0.5 * (lx + hx), 0.5 * (ly + hy)
-        up = drop(mx, my) > lev
-        lx, ly = np.where(up, lx, mx), np.where(up, ly, my)
-        hx, hy = np.where(up, mx, hx), np.where(up, my, hy)
-        if counter is not None:
-            counter.add(len(mx))
+    lx, ly = _crossings(drop, gx[e[:, 2]], gy[e[:, 2]], gx[e[:, 3]], gy[e[:, 3]], f.z.ravel()[e[:, 2]],
+                        f.z.ravel()[e[:, 3]], lev, counter)
     where = {(int(li), int(eid)): k for k, (li, eid) in enumerate(e[:, :2])}
     passes = []
     for li, level in enumerate(levels):
@@ -85,6 +82,56 @@ def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: flo
             passes.append((pts[keep], closed, ("contour", li)))
     steps = [-d for d in np.diff(levels)] if len(levels) > 1 else [0.0]
     return passes, steps
+
+
+def _crossings(drop, lx, ly, hx, hy, zl, zh, lev, counter=None):
+    """Where each grid edge from ``(lx, ly)`` (tip height ``zl``, at or below ``lev``) to ``(hx, hy)`` (``zh``, above
+    it) crosses the level: the low end of a bracket of the exact crossing at most ``2**-BISECTIONS`` of the edge
+    wide, as many bisections would leave it.
+
+    The bracket is narrowed by steps of false position on the drop-cutter
+    values (the last a pair of points that width apart about its estimate),
+    then halved where it is still wider; the low end stays at or below the
+    level: the tool there clears the surface.
+    """
+    width = 0.5 ** BISECTIONS
+    ul, uh = np.zeros(len(lev)), np.ones(len(lev))
+
+    def at(u):
+        n = len(u) // len(lev)  # one or two points an edge
+        z = drop(np.tile(lx, n) + u * np.tile(hx - lx, n), np.tile(ly, n) + u * np.tile(hy - ly, n))
+        if counter is not None:
+            counter.add(len(u))
+        return z
+
+    def narrowed(u, z, ul, uh, zl, zh):
+        up = z > lev
+        return np.where(up, ul, u), np.where(up, u, uh), np.where(up, zl, z), np.where(up, z, zh)
+
+    def estimate():
+        return ul + np.clip((lev - zl) / (zh - zl), 0.0, 1.0) * (uh - ul)
+
+    for _ in range(_FALSE_POSITIONS):
+        u = np.clip(estimate(), ul + 0.01 * (uh - ul), uh - 0.01 * (uh - ul))
+        ul, uh, zl, zh = narrowed(u, at(u), ul, uh, zl, zh)
+    u = estimate()
+    lo = np.clip(u - 0.5 * width, ul, uh)
+    hi = np.clip(lo + width, ul, uh)
+    lo = np.clip(hi - width, ul, uh)
+    z = at(np.concatenate([lo, hi]))
+    up_lo, up_hi = z[:len(lo)] > lev, z[len(lo):] > lev
+    ul, uh = np.where(up_lo, ul, np.where(up_hi, lo, hi)), np.where(up_lo, lo, np.where(up_hi, hi, uh))
+    for _ in range(BISECTIONS):  # the bracket is at most the whole edge: as many halvings bring it to ``width``
+        wide = np.flatnonzero(uh - ul > width * (1 + 1e-9))
+        if not wide.size:
+            break
+        m = 0.5 * (ul[wide] + uh[wide])
+        zm = drop(lx[wide] + m * (hx[wide] - lx[wide]), ly[wide] + m * (hy[wide] - ly[wide]))
+        if counter is not None:
+            counter.add(len(m))
+        up = zm > lev[wide]
+        ul[wide], uh[wide] = np.where(up, ul[wide], m), np.where(up, m, uh[wide])
+    return lx + ul * (hx - lx), ly + ul * (hy - ly)
 
 
 def _chains(above: np.ndarray, steep: np.ndarray, nx: int, ny: int, li: int, where: dict):

@@ -22,13 +22,15 @@ one program:
   raster;
 * **contours**: at each level, the grid's cells whose cutter locations lie on
   either side of the level (marching squares), each crossing refined by
-  bisection on the exact drop-cutter value along its cell edge to
-  :data:`BISECTIONS` halvings, the low end kept (the tool there is at or above
+  false position and bisection on the exact drop-cutter value along its cell
+  edge to a bracket :data:`BISECTIONS` halvings wide, the low end kept (the tool there is at or above
   the exact drop-cutter height); crossings chained into closed loops and open
   pieces (where a contour leaves the steep parts or the reach);
 * **moves**: each contour thinned to the points whose chords stay within the
   chordal tolerance of it in plan (Douglas-Peucker), each chord then checked
-  by drop-cutter at points a quarter of the grid apart, and both its ends
+  by drop-cutter at points a quarter of the grid apart (:data:`EDGE_DENSER`
+  times closer across a box edge the tool comes near with the move beyond the
+  box), and both its ends
   lifted by the most the cutter path rises above it there plus
   ``κ h² / 8`` (the sag a path bending no faster than the surface's
   curvature bound ``κ`` can hide between samples ``h`` apart), so no move
@@ -71,6 +73,7 @@ from .pattern import within_reach
 from .dropcutter import telling_compiles
 from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, cutter_and_reach, plan_toolpath
 from .contours import BISECTIONS, contour_passes
+from .movesamples import EDGE_DENSER, move_samples
 from .scallop import _TIGHT, _allowed_d
 from .workers import MIN_POINTS, Workers
 
@@ -88,9 +91,6 @@ GRID_MM = 0.25
 
 LINK_CLEARANCE_MM = 1.0
 """How far above the highest cutter location under it a link between distant passes runs."""
-
-EDGE_DENSER = 32
-"""How many times closer a move with the tool axis beyond the box is checked."""
 
 NEAR_RADII = 4.0
 """A next pass within this many tool radii is joined by a straight move where one stays above the cutter path."""
@@ -227,30 +227,20 @@ class _Drop:
     def along(self, a: np.ndarray, b: np.ndarray, spacing: float) -> np.ndarray:
         """The most each straight move ``a[k] -> b[k]`` (x, y surface units, z mm) lies below the cutter path.
 
-        Checked at points ``spacing`` (surface units) apart inside each move,
-        :data:`EDGE_DENSER` times closer where a move has an end with the
-        tool axis beyond the box (where the tool rolls onto the box's edge its
-        height rises like a square root, faster than any bound on the
-        surface's bending), plus at each point a quarter of its downward
-        second difference (:func:`.chordal.bends`: what the path may bend
-        below the points between them); 0 or less where the move stays above.
+        :meth:`samples` along each move, each taken with a quarter of its
+        downward second difference (:func:`.chordal.bends`: what the path
+        may bend below the points between them); 0 or less where the move
+        stays above.
         """
-        x0, x1, y0, y1 = self.cl.ev.bounds
-        beyond = ((a[:, 0] < x0) | (a[:, 0] > x1) | (a[:, 1] < y0) | (a[:, 1] > y1)
-                  | (b[:, 0] < x0) | (b[:, 0] > x1) | (b[:, 1] < y0) | (b[:, 1] > y1))
-        step = np.where(beyond, spacing / EDGE_DENSER, spacing)
-        n = np.maximum(np.ceil(np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]) / step), 2).astype(int)
-        k = np.repeat(np.arange(len(a)), n + 1)
-        t = (np.arange(k.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)) / np.repeat(n, n + 1)
-        p = a[k] + t[:, None] * (b[k] - a[k])
-        z = self(p[:, 0], p[:, 1])
-        below = z - p[:, 2]
-        bend = np.zeros(len(z))
-        inner = np.flatnonzero(k[:-2] == k[2:]) + 1  # points with both neighbours on their move
-        bend[inner] = np.maximum(0.0, -(z[inner - 1] - 2.0 * z[inner] + z[inner + 1])) / 4.0
+        k, _, pz, z, bend = self.samples(a, b, spacing)
         out = np.full(len(a), -np.inf)
-        np.maximum.at(out, k, below + bend)
+        np.maximum.at(out, k, z - pz + bend)
         return out
+
+    def samples(self, a: np.ndarray, b: np.ndarray, spacing: float):
+        """Cutter locations along each straight move ``a[k] -> b[k]``: ``(move, t, z on the move, tip height, bend)``
+        (:func:`.movesamples.move_samples`)."""
+        return move_samples(self, a, b, spacing, self.cl.ev.bounds, self.cl.radius)
 
 
 def _field(drop: _Drop, reach, nx: int, ny: int, radius_mm: float, scallop_mm: float, *, direction: str,
@@ -437,10 +427,14 @@ def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing:
         return []
     margin = kappa * (spacing * mpu) ** 2 / 8
     near = np.hypot(q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]) * mpu <= NEAR_RADII * radius_mm
-    clear = near & (drop.along(p, q, spacing) + margin <= 0)
-    flat_p, flat_q = p.copy(), q.copy()
-    flat_p[:, 2] = flat_q[:, 2] = 0.0
-    top = np.maximum(np.maximum(p[:, 2], q[:, 2]), drop.along(flat_p, flat_q, spacing) + margin)
+    # One set of samples for both: how far the straight move lies below the cutter path, and the highest cutter
+    # location under the link.
+    k, _, pz, z, bend = drop.samples(p, q, spacing)
+    below, highest = np.full(len(p), -np.inf), np.full(len(p), -np.inf)
+    np.maximum.at(below, k, z - pz + bend)
+    np.maximum.at(highest, k, z + bend)
+    clear = near & (below + margin <= 0)
+    top = np.maximum(np.maximum(p[:, 2], q[:, 2]), highest + margin)
     h = top + LINK_CLEARANCE_MM
     return [np.empty((0, 3)) if c else np.array([[a[0], a[1], z], [b[0], b[1], z]])
             for c, a, b, z in zip(clear, p, q, h)]
