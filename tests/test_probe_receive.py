@@ -4,6 +4,7 @@ and to the DNC server."""
 from __future__ import annotations
 
 import io
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +18,7 @@ from lagsym.simulate import simulate
 from lagsym.simulate.probing import probe_target
 
 from simcontrol import PtyPair, punch, wait_until
+from test_probe import TOLERANCE, _centre_heights, _moves
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,6 +52,19 @@ def test_dprnt_output_received_as_probe_results_then_fitted(tmp_path):
     assert f"probe results: {len(lines) - 2} nodes, tip radius 1 mm".encode() in err
     o, e = io.StringIO(), io.StringIO()
     assert main(["fit", str(target), "--degree", "2", "-o", str(tmp_path / "s.json")], o, e) == 0, e.getvalue()
+    largest = float(re.search(r"residuals: max ([\d.e+-]+)", o.getvalue() + e.getvalue()).group(1))
+    # ... and machined: the finishing program from the received results, checked by brute force against the formula
+    nc = tmp_path / "part.nc"
+    o, e = io.StringIO(), io.StringIO()
+    assert main(["toolpath", str(tmp_path / "s.json"), "--tool-diameter", "6", "--stepover", "2", "--step", "1",
+                 "--tolerance", str(TOLERANCE), "--safe-z", "20", "-o", str(nc)], o, e) == 0, e.getvalue()
+    pts = _moves(nc.read_text())
+    over = pts[(pts[:, 0] >= 0) & (pts[:, 0] <= 40) & (pts[:, 1] >= 0) & (pts[:, 1] <= 30)]
+    assert len(over) > 100
+    at = over[:, 2] + 3.0 - _centre_heights(parse_formula(TRUE), over[:, 0], over[:, 1], 3.0)
+    stated = largest + 5e-5 + 1e-4 + 2e-5  # the fit, the printed digit, the tip compensation, the brute force
+    assert -at.min() <= stated, (at.min(), stated)
+    assert at.max() <= stated + TOLERANCE + 5e-4, (at.max(), stated)
 
 
 def test_a_dprnt_stream_cut_mid_line_is_refused_naming_the_node(tmp_path):
