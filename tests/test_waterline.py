@@ -206,7 +206,7 @@ def test_contour_crossings_are_bracketed_as_ten_bisections_would_leave_them():
         calls.append(len(x))
         return f(x, y)
 
-    x, y = _crossings(drop, lx, ly, hx, hy, zl, zh, lev)
+    x, y = _crossings(drop, (lx, ly, zl), (hx, hy, zh), lev)
     assert (f(x, y) <= lev).all()
     w = 0.5 ** BISECTIONS * (1 + 1e-6)
     assert (f(x + w * (hx - lx), y + w * (hy - ly)) > lev).all()

@@ -68,8 +68,9 @@ def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: flo
     gx, gy = np.meshgrid(f.xs, f.ys, indexing="ij")
     gx, gy = gx.ravel(), gy.ravel()
     lev = np.array(levels)[e[:, 0]]
-    lx, ly = _crossings(drop, gx[e[:, 2]], gy[e[:, 2]], gx[e[:, 3]], gy[e[:, 3]], f.z.ravel()[e[:, 2]],
-                        f.z.ravel()[e[:, 3]], lev, counter)
+    fz = f.z.ravel()
+    lx, ly = _crossings(drop, (gx[e[:, 2]], gy[e[:, 2]], fz[e[:, 2]]), (gx[e[:, 3]], gy[e[:, 3]], fz[e[:, 3]]), lev,
+                        counter)
     where = {(int(li), int(eid)): k for k, (li, eid) in enumerate(e[:, :2])}
     passes = []
     for li, level in enumerate(levels):
@@ -84,9 +85,9 @@ def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: flo
     return passes, steps
 
 
-def _crossings(drop, lx, ly, hx, hy, zl, zh, lev, counter=None):
-    """Where each grid edge from ``(lx, ly)`` (tip height ``zl``, at or below ``lev``) to ``(hx, hy)`` (``zh``, above
-    it) crosses the level: the low end of a bracket of the exact crossing at most ``2**-BISECTIONS`` of the edge
+def _crossings(drop, low, high, lev, counter=None):
+    """Where each grid edge from ``low = (lx, ly, zl)`` (tip height ``zl`` at or below ``lev``) to
+    ``high = (hx, hy, zh)`` (``zh`` above it) crosses the level: the low end of a bracket of the exact crossing at most ``2**-BISECTIONS`` of the edge
     wide, as many bisections would leave it.
 
     The bracket is narrowed by steps of false position on the drop-cutter
@@ -94,6 +95,7 @@ def _crossings(drop, lx, ly, hx, hy, zl, zh, lev, counter=None):
     then halved where it is still wider; the low end stays at or below the
     level: the tool there clears the surface.
     """
+    (lx, ly, zl), (hx, hy, zh) = low, high
     width = 0.5 ** BISECTIONS
     ul, uh = np.zeros(len(lev)), np.ones(len(lev))
 
