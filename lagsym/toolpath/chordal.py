@@ -126,7 +126,12 @@ def _deviations(t, z, keep):
     k = np.arange(keep[0], keep[-1])
     m = np.searchsorted(keep, k, side="right") - 1  # the move each fine sample starts or lies inside
     i, j = keep[m], keep[m + 1]
-    dev = z[k] - (z[i] + (t[k] - t[i]) / (t[j] - t[i]) * (z[j] - z[i]))
+    span = t[j] - t[i]
+    # Samples rounded onto one written position make a move straight up or down:
+    # a sample there is measured from the nearest point of that vertical move.
+    frac = np.divide(t[k] - t[i], span, out=np.zeros_like(span, dtype=float), where=span != 0)
+    vertical = np.clip(z[k], np.minimum(z[i], z[j]), np.maximum(z[i], z[j]))
+    dev = z[k] - np.where(span != 0, z[i] + frac * (z[j] - z[i]), vertical)
     return k, i, dev, keep[:-1] - keep[0]
 
 
