@@ -163,6 +163,25 @@ def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_c
     assert status == 0, err
     assert quoted == (out + err).strip()
     assert f"takes {quoted.split('macro program:')[1].split()[0]} bytes on a Fanuc" in text
+    # The paper page's conclusion quotes the same run.
+    size, seconds = quoted.split("macro program:")[1].split()[0], quoted.split("bytes, ")[1].split()[0]
+    ratio = quoted.split("the point list is ")[1].split()[0]
+    paper = " ".join(page("paper.md").split())
+    assert f"{int(size):,} bytes ({seconds} s at 9600 baud, 7E2)" in paper and f"{ratio} times larger" in paper
+    assert f"of {int(quoted.split('raster points:')[1].split()[0]):,} points" in paper
+
+
+def test_paper_page_quotes_the_point_list_at_a_fine_step(tmp_path, run_cli):
+    status, out, err = run_cli("macro", str(EXAMPLES / "paper-example-4.json"), "--scale", "20", "--tool-diameter", "4",
+                               "--stepover", "0.5", "--step", "0.01", "--safe-z", "100", "--dialect", "fanuc",
+                               "-o", str(tmp_path / "O1000.nc"), "--stats")
+    assert status == 0, err
+    points = int(out.split("raster points:")[1].split()[0])
+    size = int(out.split("point-list program:")[1].split()[0])
+    hours = out.split("bytes, ")[2].split()[0]
+    macro = int(out.split("macro program:")[1].split()[0])
+    paper = " ".join(page("paper.md").split())
+    assert f"be {points:,} points, about {size / 1e6:.1f} MB ({hours} h at 9600 baud)" in paper and macro < 3000
 
 
 def test_dnc_page_line_times_of_the_window():

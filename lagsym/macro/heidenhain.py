@@ -9,6 +9,8 @@ runs at least once (every loop of a surface program does).  Blocks are numbered 
 
 from __future__ import annotations
 
+import re
+
 from ..errors import ProgramError
 from ..gcode.limits import check_axis, check_blocks, check_settings, variable_ranges
 from ..gcode.numbers import fixed
@@ -22,6 +24,20 @@ DEFAULT_BASE = 1
 MAX_LABEL = 254
 _FN = {"+": 1, "-": 2, "*": 3, "/": 4}
 SCRATCH = 6  # scratch Q parameters for the parts of an expression
+
+
+_STATEMENT = re.compile(r"^\s*\d*\s*(?:FN\s*\d+\s*:|LBL\s)")
+
+
+def is_statement(line: str) -> bool:
+    """Whether a line of a conversational program is a Q-parameter statement (``FN ..:``) or a label (``LBL``).
+
+    Examples
+    --------
+    >>> is_statement("12 LBL 1"), is_statement("13 FN 3: Q33 = +Q2 * +0.5"), is_statement("6 L Z+400.000 R0 FMAX M3")
+    (True, True, False)
+    """
+    return bool(_STATEMENT.match(line))
 
 
 def _reads(e, v: Var) -> bool:

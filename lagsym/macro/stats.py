@@ -10,12 +10,13 @@ few per cent of a plain one.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..gcode.program import macro_uses
 from ..machine import bits_per_char
+from . import heidenhain
 
 __all__ = ["ProgramStats", "point_list_size", "transfer_seconds", "program_stats", "frame_bytes", "BITS_PER_CHAR_7E2"]
 
@@ -81,13 +82,24 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 60:.1f} min" if seconds < 7200 else f"{seconds / 3600:.2f} h"
 
 
-_MACRO_LINE = re.compile(r"#|\bFN\b|\bLBL\b|\bWHILE\b|\bEND\d|\bendwhile\b|\bendif\b|^\s*o\d", re.I)
+def _gcode_statement(line: str) -> bool:
+    return bool(macro_uses(line))
 
 
-def frame_bytes(text: str, eol: str) -> int:
-    """Bytes of a program outside its macro part: the lines before the first and after the last macro statement."""
+_STATEMENTS = {"fanuc": _gcode_statement, "linuxcnc": _gcode_statement, "heidenhain": heidenhain.is_statement}
+"""How each macro language's statements are told from the program's framing: G-code through the one reader
+of blocks (:func:`~lagsym.gcode.program.macro_uses`), Heidenhain's conversational ``FN`` and ``LBL`` lines by
+its own module."""
+
+
+def frame_bytes(text: str, eol: str, language: str = "fanuc") -> int:
+    """Bytes of a program outside its macro part: the lines before the first and after the last macro statement.
+
+    ``language`` is the macro language the program is written in (a key of the control's ``macro``).
+    """
+    statement = _STATEMENTS[language]
     lines = text.split(eol)
-    marks = [n for n, line in enumerate(lines) if _MACRO_LINE.search(line)]
+    marks = [n for n, line in enumerate(lines) if statement(line)]
     if not marks:
         return len(text)
     keep = lines[:marks[0]] + lines[marks[-1] + 1:]
@@ -102,7 +114,7 @@ def program_stats(program, points: np.ndarray, settings, count: int | None = Non
     ``points`` is a sample of a raster of ``count`` points and the blocks are
     scaled from the sample's mean.
     """
-    frame = frame_bytes(program.text, settings.eol)
+    frame = frame_bytes(program.text, settings.eol, settings.control.macro.name)
     blocks = point_list_size(points, settings.digits, settings.eol)
     n = len(points) if count is None else int(count)
     if count is not None:
