@@ -98,6 +98,15 @@ def test_the_simulator_stops_at_the_closing_percent_as_the_point_list_reader():
     assert [m.x for m in sim.moves] == [1.0] == parse_moves(text).points_mm[:, 0].tolist()
 
 
+@pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
+def test_the_simulator_runs_a_deleted_block_as_the_point_list_reader(dialect):
+    """Block delete off, the switch's usual place: ``/G0 Z50.`` runs for both readers (the simulator had skipped it)."""
+    text = "G21\nG0 X1. Y2. Z3.\n/G0 Z50.\n G1 X4. F100.\n"
+    sim = simulate(text, dialect, 8)
+    assert [(m.x, m.z) for m in sim.moves] == [(1.0, 3.0), (1.0, 50.0), (4.0, 50.0)]
+    assert parse_moves(text).points_mm[:, [0, 2]].tolist() == [[1.0, 3.0], [1.0, 50.0], [4.0, 50.0]]
+
+
 def test_simulated_moves_are_the_one_moves_type():
     text = "O1\nG20\n#1=0.5\nG0 X1. Y2.\nG1 Z-#1 F10.\nX[#1*4.]\nM30\n"
     moves = simulate(text, "fanuc", 8).moves.to_moves(25.4, first_line_with(text, "Z"))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 from ..controls import Control, control, names
+from ..gcode.program import program_blocks
 from . import fanuc, heidenhain, linuxcnc
 from .alarms import BlockAlarm, ControlAlarm
 from .blocks import Block, Nop
@@ -36,10 +37,11 @@ def detect_dialect(text: str) -> str:
 
 
 def read_blocks(text: str, dialect: str | Control) -> list[Block]:
-    """The blocks of ``text`` in order, without blank, ``%`` and block-delete (``/``) lines.
+    """The blocks of ``text`` in order, as every reader of a program takes them (:func:`lagsym.gcode.program_blocks`).
 
-    The second ``%`` line ends the program, as for every reader of a program
-    (:func:`lagsym.gcode.program_blocks`): a control reads nothing after it.
+    Blank and ``%`` lines are passed over and the second ``%`` line ends the
+    program; a block-delete ``/`` is taken off and the block run, as a control
+    runs it with its block-delete switch off (and as ``verify`` reads it).
 
     Raises
     ------
@@ -50,20 +52,10 @@ def read_blocks(text: str, dialect: str | Control) -> list[Block]:
     limit = c.max_block
     parse = PARSERS[c.macro.name]
     blocks = []
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-    percent = 0
-    for n, raw in enumerate(lines, start=1):
-        t = raw.strip()
-        if t.startswith("%"):
-            percent += 1
-            if percent == 2:
-                break
-            continue
+    for n, raw, t in program_blocks(text):
         if len(raw) > limit:
             raise ControlAlarm("block", f"block of {len(raw)} characters, more than the {limit} the control reads",
                                n, raw)
-        if not t or t.startswith("/"):
-            continue
         try:
             b = parse(n, raw, t)
         except BlockAlarm as e:
