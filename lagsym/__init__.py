@@ -33,7 +33,7 @@ _EXPORTS = {
     "fit": ("SurfaceFit", "fit_surface"),
     "conditioning": ("require_conditioning", "amplification"),
     "evaluate": ("SurfaceEvaluator", "surface_evaluator", "evaluate_points", "evaluate_grid", "evaluate_curve",
-                 "lambdify_surface"),
+                 "lambdify_surface", "Engine", "use_engine"),
     "sampling": ("Sample", "SampleGrid", "sample", "sample_grid"),
     "export": ("write_sample",),
     "cad": ("BezierPatch", "BSplinePatch", "bezier_patch", "cad_patch"),
@@ -133,8 +133,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .errors import (ConditioningError, ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
     from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
-    from .evaluate import (SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
-                           surface_evaluator)
+    from .evaluate import (Engine, SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
+                           surface_evaluator, use_engine)
     from .export import write_sample
     from .export.cad import write_cad
     from .formula import Formula, parse_formula

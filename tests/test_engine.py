@@ -171,3 +171,26 @@ def test_the_policies_decide_by_size_and_by_what_was_spent():
     with pytest.raises(TypeError):
         with use_engine("numpy"):
             pass
+
+
+def test_the_command_line_names_the_engine_policies():
+    from lagsym.cli import ENGINE_POLICIES
+    from lagsym.evaluate.engine import POLICIES
+
+    assert ENGINE_POLICIES == POLICIES
+
+
+def _sample_command(out, chosen) -> str:
+    return ("import sys; from lagsym.cli import main; "
+            f"status = main({chosen + ['sample', str(EXAMPLES / 'paper-example-4.json')]!r} "
+            f"+ ['--nx', '700', '--ny', '700', '-o', {str(out)!r}, '-q']); "
+            "print(status, 'numba' in sys.modules)")
+
+
+@pytest.mark.parametrize("policy, loads", [("compiled", True), ("numpy", False), (None, False)])
+def test_engine_option_chooses_how_a_command_evaluates(tmp_path, policy, loads):
+    """``lagsym --engine compiled sample``: one large grid runs compiled (auto would not load), the same bytes."""
+    out, reference = tmp_path / f"{policy}.npy", tmp_path / "reference.npy"
+    assert _run(_sample_command(out, [] if policy is None else ["--engine", policy])) == ["0", str(loads)]
+    assert _run(_sample_command(reference, [])) == ["0", "False"]
+    assert np.array_equal(np.load(out), np.load(reference))

@@ -24,6 +24,7 @@ from ..errors import ExitStatus, LagsymError, Terminated
 __all__ = ["main", "build_parser", "COMMANDS", "command_module"]
 
 INTERNAL_ERROR = 70
+ENGINE_POLICIES = ("auto", "numpy", "compiled")  # lagsym.evaluate.POLICIES, named here so --version loads no NumPy
 
 
 class _Parser(argparse.ArgumentParser):
@@ -84,9 +85,12 @@ def command_module(name: str):
 
 
 def _chosen(argv: Sequence[str]) -> str | None:
-    """The command named on the command line: its first word that is not an option (global options take no value)."""
-    for word in argv:
-        if not word.startswith("-"):
+    """The command named on the command line: its first word that is neither an option nor ``--engine``'s value."""
+    words = iter(argv)
+    for word in words:
+        if word == "--engine":
+            next(words, None)
+        elif not word.startswith("-"):
             return word if word in COMMANDS else None
     return None
 
@@ -104,6 +108,11 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None
     common = Parser(add_help=False)
     common.add_argument("--traceback", action="store_true", default=argparse.SUPPRESS,
                         help="show the full traceback on an error")
+    common.add_argument("--engine", choices=ENGINE_POLICIES, default=argparse.SUPPRESS,
+                        help="how evaluation batches of 262,144 values or more run (sample, export, plot, verify): "
+                             "auto (NumPy until such batches have taken 0.5 s, then the compiled kernels; the "
+                             "default), numpy (never compiled), compiled (always); the values are the same "
+                             "bit for bit")
     parser = Parser(
         prog="lagsym",
         description="Exact Lagrange surfaces from a few control points, to the machine.",
@@ -166,7 +175,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
 
         in_program_units(args)
         check_paths(args)
-        with _signals_as_interrupts(), _notices(err):
+        with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)):
             return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
@@ -188,6 +197,18 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
             err.write(f"lagsym: internal error: {type(e).__name__}: {one_line(str(e))} "
                       f"(run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+@contextlib.contextmanager
+def _engine(policy: str | None):
+    """The evaluations of the command under an :class:`~lagsym.evaluate.Engine` of ``policy`` (None: the process's)."""
+    if policy is None:
+        yield
+        return
+    from ..evaluate import Engine, use_engine
+
+    with use_engine(Engine(policy)):
+        yield
 
 
 @contextlib.contextmanager
