@@ -1,21 +1,28 @@
-"""The size of an exact Lagrange polynomial, estimated from its nodes before it is computed.
+"""Exact work on large polynomials: its size estimated before it starts, its products in steps.
 
-Its rationals grow with the number of nodes and with their denominators and
-span; past a few hundred nodes along one axis they take gigabytes and minutes.
-:func:`check_exact_size` refuses such a polynomial with the figure and the
-option that raises the limit, before any of it is made.
+The rationals of an exact Lagrange polynomial grow with the number of nodes
+and with their denominators and span; past a few hundred nodes along one axis
+they take gigabytes and minutes.  :func:`check_exact_size` refuses such a
+polynomial with the figure and the option that raises the limit, before any
+of it is made.  :func:`stepped_product` multiplies exact matrices a few rows
+at a time: a signal (Ctrl-C, SIGTERM) is acted on between steps, where one
+call into FLINT would hold the interpreter until the whole product is done.
 """
 
 from __future__ import annotations
 
+import time
 from fractions import Fraction
 from math import gcd, log2
 
+import flint
+
 from .errors import InputError
 
-__all__ = ["MAX_EXACT_MB", "check_exact_size", "exact_size_mb"]
+__all__ = ["MAX_EXACT_MB", "check_exact_size", "exact_size_mb", "stepped_product"]
 
 MAX_EXACT_MB = 400  # estimated megabytes of exact rationals one polynomial may take (--max-exact-mb)
+STEP_SECONDS = 0.2  # about how long one step of a stepped product holds the interpreter: a signal waits no longer
 
 
 def _basis_bits(nodes: tuple[Fraction, ...]) -> float:
@@ -86,3 +93,31 @@ def check_exact_size(what: str, source, x_nodes, y_nodes, values, max_mb: float 
 
 def _mb(size: float) -> str:
     return f"{size / 1000:.3g} GB" if size >= 1000 else f"{size:.3g} MB"
+
+
+def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_SECONDS) -> flint.fmpq_mat:
+    """``a * b``, exact, computed a block of rows of ``a`` at a time, each block taking about ``seconds``.
+
+    The first block is one row; each next one as many rows as the last
+    block's pace fits in ``seconds`` (at most four times as many).  FLINT
+    shares a common denominator within a block, so blocks of several rows
+    cost no more than the whole product at once.  The result is the same
+    exact matrix whatever the blocks.
+
+    Examples
+    --------
+    >>> a, b = flint.fmpq_mat(3, 2, [1, 2, 3, 4, 5, 6]), flint.fmpq_mat(2, 2, [flint.fmpq(1, 2), 0, 0, 1])
+    >>> stepped_product(a, b) == a * b
+    True
+    """
+    n, k, m = a.nrows(), a.ncols(), b.ncols()
+    entries, out = a.entries(), []
+    i, rows = 0, 1
+    while i < n:
+        h = min(rows, n - i)
+        start = time.perf_counter()
+        out.extend((flint.fmpq_mat(h, k, entries[i * k:(i + h) * k]) * b).entries())
+        spent = time.perf_counter() - start
+        i += h
+        rows = max(1, min(4 * h, int(h * seconds / max(spent, 1e-6))))
+    return flint.fmpq_mat(n, m, out)

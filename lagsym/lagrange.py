@@ -22,6 +22,7 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
+import inspect
 import keyword
 from dataclasses import dataclass
 from fractions import Fraction
@@ -32,7 +33,7 @@ from typing import TYPE_CHECKING
 import flint
 
 from .errors import InputError
-from .exactsize import MAX_EXACT_MB, check_exact_size
+from .exactsize import MAX_EXACT_MB, check_exact_size, stepped_product
 from .values import as_exact
 
 from .grid import ControlGrid, CurvePoints
@@ -108,7 +109,11 @@ def _fmpq(v: Fraction) -> flint.fmpq:
 
 
 def _frac(v: flint.fmpq) -> Fraction:
-    return Fraction(int(v.p), int(v.q))
+    # FLINT keeps its rationals in lowest terms: Fraction need not find their gcd again (long for big ones).
+    return Fraction(int(v.p), int(v.q), _normalize=False) if _UNNORMALIZED else Fraction(int(v.p), int(v.q))
+
+
+_UNNORMALIZED = "_normalize" in inspect.signature(Fraction.__new__).parameters
 
 
 def _basis_polys(nodes: tuple[Fraction, ...]) -> list[flint.fmpq_poly]:
@@ -403,7 +408,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
     check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
-    c = b.transpose() * yv
+    c = stepped_product(b.transpose(), yv)
     return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())),
                          variable=_variable(x, "x"))
 
@@ -445,6 +450,6 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     bx = _basis_matrix(grid.x)
     by = _basis_matrix(grid.y)
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])
-    c = bx.transpose() * z * by
+    c = stepped_product(stepped_product(bx.transpose(), z), by)
     coeffs = tuple(tuple(_frac(c[a, b]) for b in range(m)) for a in range(n))
     return LagrangeSurface(grid=grid, coefficients=coeffs, variables=(sx, sy))

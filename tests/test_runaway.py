@@ -274,3 +274,30 @@ def test_a_job_on_too_large_a_grid_names_the_option_job_has(tmp_path, run_cli):
     status, _, err = run_cli("job", job, "-o", out, "--max-exact-mb", "0.001", "--accept-conditioning")
     assert status == 2 and "30 x 3 nodes" in err and "limit of 0.001 MB" in err and "--max-exact-mb" in err, err
     assert not out.exists()
+
+
+def test_sigterm_acts_within_seconds_during_the_exact_products(tmp_path):
+    """A 60x60 grid of decimal nodes: its exact products took one FLINT call of several seconds, deaf to signals.
+
+    Now they run a few rows at a time (``exactsize.stepped_product``): the
+    signal sent while they run stops the command within a few seconds, with
+    its one line, where it used to wait for the whole product.
+    """
+    import random
+    import signal
+    import time
+
+    rng = random.Random(5)
+    xs = [round(i * 0.337 + rng.random() * 0.1, 6) for i in range(60)]
+    path = tmp_path / "g60.csv"
+    path.write_text("x,y,z\n" + "\n".join(f"{a:.6f},{b * 1.0001:.6f},{rng.random():.4f}" for a in xs for b in xs))
+    proc = subprocess.Popen([sys.executable, "-m", "lagsym", "check", str(path)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)  # start-up and reading done; the exact products run for many seconds from here
+    assert proc.poll() is None
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    waited = time.monotonic() - sent
+    assert proc.returncode == 128 + signal.SIGTERM and "stopped by SIGTERM" in err
+    assert waited < 3.0, f"SIGTERM acted after {waited:.1f} s"

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
+from ..exactsize import stepped_product
 from .arguments import a_surface, broadcast_pair, coordinates
 from .bounds import chebyshev_error_bound
 from .cache import ObjectCache
@@ -418,7 +419,7 @@ def _make_evaluator(surface) -> SurfaceEvaluator:
     yo, yh, ay = chebyshev_transform(g.y)
     n, m = g.shape
     power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
-    cheb = ax * power * ay.transpose()
+    cheb = stepped_product(stepped_product(ax, power), ay.transpose())
     # int / int is correctly rounded, as float(Fraction) is, without reducing a Fraction first
     coeffs = np.array([[int(cheb[a, b].p) / int(cheb[a, b].q) for b in range(m)] for a in range(n)])
     return SurfaceEvaluator(
