@@ -118,6 +118,7 @@ def test_the_plane_is_stated_and_g17_comes_back(rs274, tmp_path):
     assert planes[-1] == "CANON_PLANE_XY" and "CANON_PLANE_XZ" in planes
 
 
+@pytest.mark.slow
 def test_grbl_arcs_leave_room_for_its_chords(rs274, tmp_path):
     """Grbl cuts an arc into chords up to $12 = 0.002 mm inside it: its arcs, so cut, stay above the path.
 

@@ -136,6 +136,7 @@ def bull_program(tmp_path_factory):
     return path, lift
 
 
+@pytest.mark.slow
 def test_the_bull_nose_toolpath_never_cuts_into_the_part(bull_program):
     """At every point of every feed move the tool lies on or above the surface (brute force, 0.1 mm lattice)."""
     bull_program, lift = bull_program
@@ -158,6 +159,7 @@ def test_the_bull_nose_toolpath_never_cuts_into_the_part(bull_program):
     assert 0.0 < lift < 0.1 and np.max(cl[:, 2] - fine) <= lift + 2e-3
 
 
+@pytest.mark.slow
 def test_the_bull_nose_program_reads_in_the_interpreter_and_verifies(run_cli, bull_program, rs274):
     from gcheck import interpret
 

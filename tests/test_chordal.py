@@ -97,6 +97,7 @@ def test_example1_program_does_not_gouge_at_the_corner(example1_corner):
 @settings(max_examples=10, derandomize=True)
 @given(surfaces(), st.floats(0.5, 3.0), st.sampled_from(["ball", "flat"]), st.sampled_from(["x", "y"]),
        st.sampled_from([None, 0.02]), st.integers(0, 2**31))
+@pytest.mark.slow
 def test_no_move_dips_below_the_cutter_path(surf, radius, shape, direction, tol, seed):
     _no_move_dips(surf, radius, shape, direction, tol, seed)
 

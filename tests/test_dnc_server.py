@@ -27,6 +27,7 @@ def docs_config() -> str:
     return block
 
 
+@pytest.mark.slow
 def test_the_server_end_to_end_on_two_ports(tmp_path):
     mill, lathe = PtyPair(), PtyPair()
     config = docs_config().replace("/dev/ttyUSB0", mill.near).replace("/dev/ttyUSB1", lathe.near)

@@ -193,6 +193,7 @@ def test_dnc_page_line_times_of_the_window():
     assert f"{profile('fanuc').chars_per_s:.1f} characters/s at 9600 baud" in text
 
 
+@pytest.mark.slow
 def test_the_macros_page_quotes_the_program_sizes():
     from test_macro import rough_grid
 
@@ -291,6 +292,7 @@ def arc_figures(name: str, rs274, tmp_path):
 
 
 @pytest.mark.parametrize("name, label", [("paper-example-2", "Example 2"), ("paper-example-4", "Example 4")])
+@pytest.mark.slow
 def test_the_toolpaths_page_quotes_the_arc_figures(rs274, tmp_path, name, label):
     before, after, arcs, low, high = arc_figures(name, rs274, tmp_path)
     assert low >= -0.1 and high <= 6.1  # never below; the tolerance and a unit of rounding above

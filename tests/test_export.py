@@ -253,6 +253,7 @@ def test_cli_warns_when_rounding_cannot_be_trusted(run_cli, tmp_path):
     assert any(f["name"] == "float_error" and f["warning"] for f in json.loads(out)["findings"])
 
 
+@pytest.mark.slow
 def test_cli_paper_example_samples_without_warnings(run_cli, tmp_path):
     status, _, err = run_cli("sample", EXAMPLE4, "--nx", "400", "--ny", "400", "-o", tmp_path / "i.csv")
     assert (status, err) == (0, "")

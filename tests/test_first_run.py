@@ -6,6 +6,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from conftest import EXAMPLES
 
 ARGS = ["toolpath", str(EXAMPLES / "paper-example-1.json"), "--scale", "10", "--step", "1", "--stepover", "2",
@@ -20,6 +22,7 @@ def _run(tmp_path, cache):
                           capture_output=True, text=True, timeout=600)
 
 
+@pytest.mark.slow
 def test_the_first_run_says_it_compiles_and_the_second_does_not(tmp_path):
     cache = tmp_path / "numba-cache"
     first = _run(tmp_path, cache)
@@ -33,6 +36,7 @@ def test_the_first_run_says_it_compiles_and_the_second_does_not(tmp_path):
     assert (tmp_path / "a.nc").read_text().count("\n") > 10
 
 
+@pytest.mark.slow
 def test_roughing_says_so_too(tmp_path):
     cache = tmp_path / "numba-cache"
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
@@ -44,6 +48,7 @@ def test_roughing_says_so_too(tmp_path):
     assert r.stderr.startswith("lagsym: rough T1: " + LINE[len("lagsym: "):]), r.stderr
 
 
+@pytest.mark.slow
 def test_the_first_command_leaves_the_kernel_compiled_for_the_first_plan(tmp_path):
     """The README's first command (lagsym equation) starts the compile in the background; the toolpath that follows
     loads the kernel from the cache and says nothing of compiling."""

@@ -101,6 +101,7 @@ def job_run(tmp_path_factory, rs274):
     return text, err.getvalue(), moves, [c[0] for c in calls]
 
 
+@pytest.mark.slow
 def test_the_job_program_changes_tools_in_order_with_speeds_and_coolant(job_run):
     text, printed, moves, calls = job_run
     assert [t for t in dict.fromkeys(m[0] for m in moves)] == [1, 2]
@@ -157,6 +158,7 @@ def machined(job_run):
     return fx, fy, f, left_rough, h - f
 
 
+@pytest.mark.slow
 def test_the_job_cuts_no_gouge(machined):
     """Rough then finish from the block: the roughing leaves its stock, nothing is cut below the surface."""
     _, _, _, left_rough, left = machined

@@ -141,6 +141,7 @@ def test_roughing_example_4_is_gouge_free_and_clears_the_block(rs274, program):
     assert excess.max() <= STEPDOWN + tol, excess.max()
 
 
+@pytest.mark.slow
 def test_raster_roughing_leaves_at_most_a_step_down_at_the_box_edges_too(rs274, program):
     """rs274's moves swept through a height map of the block (0.25 mm cells): nowhere, the start edge x = 20
     included, is more than one step-down left above what the flat end reaches from the rows (the lowest
@@ -229,6 +230,7 @@ def test_bad_roughing_requests_get_one_line_and_exit_2(run_cli, args, words):
     assert status == 2 and words in err and err.count("\n") == 1 and not out, err
 
 
+@pytest.mark.slow
 def test_offset_clearing_is_gouge_free_and_clears_the_block(rs274, run_cli, tmp_path):
     """Concentric rectangles at every level: the same checks as the raster's, with what the tool can reach
     taken over the centres the program's feed moves pass (every 0.5 mm along them)."""

@@ -97,6 +97,7 @@ def check_gouge_free(pts, shape, radius, corner, stock=0.3):
 
 
 @pytest.mark.parametrize("dialect, precision", [("fanuc", 8), ("linuxcnc", 15), ("heidenhain", 8)])
+@pytest.mark.slow
 def test_simulated_macro_never_goes_below_the_drop_cutter_height(dialect, precision):
     _, _, tool, _, _, rm, text = plan(dialect=dialect, precision=precision)
     sim = simulate(text, dialect, precision)

@@ -104,6 +104,7 @@ def test_stock_to_leave_raises_the_ball_by_the_stock_on_a_plane():
     np.testing.assert_allclose(b.points_mm[:, 2] - a.points_mm[:, 2], 0.25, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_a_fixed_step_is_the_longest_move_and_points_are_added_where_the_path_bends(example4):
     # Regression: with stepover 2 and step 1 the moves were lifted by up to 0.418 mm where the ball
     # starts to rest on the box edge, and elsewhere by the whole surface's curvature bound.
@@ -138,6 +139,7 @@ def test_boundary_sets_where_the_tool_axis_goes(example4, boundary, reach):
     assert np.hypot(dx, dy).max() <= max(reach, 0.0) + 1e-9
 
 
+@pytest.mark.slow
 def test_past_boundary_finishes_the_edges(example4):
     """Example 4 at scale 10 with a 6 mm ball: its flanks are steep at the box edges.
 

@@ -140,6 +140,7 @@ def test_a_piecewise_surface_is_refused_with_the_way_out():
                       strategy="steep-shallow")
 
 
+@pytest.mark.slow
 def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_than_a_raster_that_does():
     """Example 4 at scale 20, 6 mm ball, cusp 0.01 mm: what steep-and-shallow and the scallop raster leave normal to
     the surface outside hollows tighter than the ball (as docs/toolpaths.md states), no gouge, and fewer cutter
