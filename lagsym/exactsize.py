@@ -11,6 +11,7 @@ call into FLINT would hold the interpreter until the whole product is done.
 
 from __future__ import annotations
 
+import inspect
 import time
 from fractions import Fraction
 from math import gcd, log2
@@ -19,7 +20,7 @@ import flint
 
 from .errors import InputError
 
-__all__ = ["MAX_EXACT_MB", "check_exact_size", "exact_size_mb", "stepped_product"]
+__all__ = ["MAX_EXACT_MB", "check_exact_size", "exact_size_mb", "stepped_product", "to_fraction"]
 
 MAX_EXACT_MB = 400  # estimated megabytes of exact rationals one polynomial may take (--max-exact-mb)
 STEP_SECONDS = 0.2  # about how long one step of a stepped product holds the interpreter: a signal waits no longer
@@ -121,3 +122,15 @@ def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_
         i += h
         rows = max(1, min(4 * h, int(h * seconds / max(spent, 1e-6))))
     return flint.fmpq_mat(n, m, out)
+
+
+_UNNORMALIZED = "_normalize" in inspect.signature(Fraction.__new__).parameters
+
+
+def to_fraction(v: flint.fmpq) -> Fraction:
+    """``v`` as a Fraction: FLINT keeps rationals in lowest terms, so their gcd (long for big ones) is not sought again.
+
+    >>> to_fraction(flint.fmpq(6, 4))
+    Fraction(3, 2)
+    """
+    return Fraction(int(v.p), int(v.q), _normalize=False) if _UNNORMALIZED else Fraction(int(v.p), int(v.q))

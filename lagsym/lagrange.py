@@ -22,7 +22,6 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
-import inspect
 import keyword
 from dataclasses import dataclass
 from fractions import Fraction
@@ -34,6 +33,7 @@ import flint
 
 from .errors import InputError
 from .exactsize import MAX_EXACT_MB, check_exact_size, stepped_product
+from .exactsize import to_fraction as _frac
 from .values import as_exact
 
 from .grid import ControlGrid, CurvePoints
@@ -106,14 +106,6 @@ def _symbols_of(variables) -> tuple:
 
 def _fmpq(v: Fraction) -> flint.fmpq:
     return flint.fmpq(v.numerator, v.denominator)
-
-
-def _frac(v: flint.fmpq) -> Fraction:
-    # FLINT keeps its rationals in lowest terms: Fraction need not find their gcd again (long for big ones).
-    return Fraction(int(v.p), int(v.q), _normalize=False) if _UNNORMALIZED else Fraction(int(v.p), int(v.q))
-
-
-_UNNORMALIZED = "_normalize" in inspect.signature(Fraction.__new__).parameters
 
 
 def _basis_polys(nodes: tuple[Fraction, ...]) -> list[flint.fmpq_poly]:
