@@ -205,7 +205,8 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     (True, 1.5)
     """
     if spec.pattern == "offset":
-        drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator, max_samples, progress)
+        drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator=evaluator, max_samples=max_samples,
+                               progress=progress)
         x, y = offset_line(stock, drop.box, tool.radius_mm, spec)
         floors = floor_at(drop, [x], [y], progress=progress)
         x, y, floor, up = checked_line(drop, x, y, floors[0], sigma)
@@ -226,7 +227,7 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
-def _dropper(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, evaluator,
+def _dropper(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, *, evaluator,
              max_samples: int | None, progress):
     """The request checked, the drop-cutter of this cutter (its kernel loaded) and the sag bound ``sigma``."""
     ev = evaluator or evaluator_of(surface)
@@ -245,7 +246,8 @@ def raster_samples(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
                    progress: Progress | None = None):
     """The raster rows (``.cross``, ``.along`` increasing), each sample's floor (``CL + stock``, mm; ``-inf``
     where the tool touches nothing) and lift (keeping the moves between samples above the floor), and ``sigma``."""
-    drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator, max_samples, progress)
+    drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator=evaluator, max_samples=max_samples,
+                           progress=progress)
     rows = _rows(stock, drop.box, tool.radius_mm, spec)
     return (*_checked(rows, _floors(drop, rows, spec, progress), drop, spec, sigma, progress), sigma)
 
