@@ -27,7 +27,9 @@ from ..surfaces.piecewise import PiecewiseSurface
 from ..toolpath import plan_toolpath
 from ..toolpath.dropcutter import evaluator_of
 from ..toolpath.plan import MAX_PLAN_POINTS
+from ..toolpath.rest import rest_toolpath
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
+from .rest import stock_left
 from .spec import JobSpec, OperationSpec, ToolSpec
 
 __all__ = ["Operation", "plan_job", "job_stock", "job_surface", "PlannedJob"]
@@ -53,8 +55,8 @@ class Operation:
 
     @property
     def label(self) -> str:
-        """``rough T1`` and so on."""
-        return f"{self.spec.kind} T{self.tool.number}"
+        """``rough T1``, ``rough rest T3`` and so on."""
+        return f"{self.spec.kind}{' rest' if self.spec.options.get('rest') else ''} T{self.tool.number}"
 
 
 @dataclass(frozen=True)
@@ -127,8 +129,9 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     for i, op in enumerate(spec.operations):
         tool = spec.tools[op.tool]
         try:
-            ops.append(_plan(spec, op, tool, surface, ev, stock, limits=(max_points, max_samples),
-                             progress=prefixed(progress, f"{op.kind} T{tool.number}")))
+            ops.append(_plan(spec, op, tool, surface, ev, stock, limits=(max_points, max_samples), done=tuple(ops),
+                             progress=prefixed(progress, f"{op.kind}{' rest' if op.options.get('rest') else ''} "
+                                                         f"T{tool.number}")))
         except ToolpathError as e:
             raise InputError(f"{spec.source}: operations[{i}] ({op.kind}): {e}") from None
         planned.add(1)
@@ -137,7 +140,7 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
 
 
 def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: Stock, *, limits: tuple,
-          progress: Progress | None = None) -> Operation:
+          done: tuple = (), progress: Progress | None = None) -> Operation:
     o = op.options
     if op.kind == "rough":
         rs = RoughSpec(stepdown_mm=o.get("stepdown", 2.0), stepover_mm=o.get("stepover", tool.tool.diameter_mm / 2),
@@ -154,6 +157,10 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
             kinds = np.full(len(rm.points_mm), FEED, dtype=np.int8)
             kinds[0] = PLUNGE
             return Operation(op, tool, rm.points_mm, kinds, rm)
+        if o.get("rest"):  # the stock the operations before leave, not the block
+            rp = rest_toolpath(surface, tool.tool, stock, stock_left(done, stock), rs, _settings(spec, op),
+                               evaluator=ev, max_points=limits[0], max_samples=limits[1], progress=progress)
+            return Operation(op, tool, rp.points_mm, rp.kinds, rp)
         rp = rough_toolpath(surface, tool.tool, stock, rs, _settings(spec, op), evaluator=ev, max_points=limits[0],
                             max_samples=limits[1], progress=progress)
         return Operation(op, tool, rp.points_mm, rp.kinds, rp)

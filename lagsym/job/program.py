@@ -88,7 +88,8 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
     out.append(f.comment(iso_comment(f"STOCK X{st.x0:g}/{st.x1:g} Y{st.y0:g}/{st.y1:g} TOP Z{st.top_mm:g} MM")))
     for i, (op, m) in enumerate(zip(job.operations, minutes), 1):
         t = op.tool
-        kind = op.spec.kind + (" MACRO" if isinstance(op.path, RoughMacro) else "")
+        kind = op.spec.kind + (" MACRO" if isinstance(op.path, RoughMacro) else "") + (
+            " REST" if op.spec.options.get("rest") else "")
         out.append(f.comment(iso_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN")))
         if isinstance(op.path, RoughMacro):
             out.append(f.comment(iso_comment(f"{i} PLUNGES INTO MATERIAL: A CENTRE-CUTTING TOOL")))

@@ -57,7 +57,7 @@ _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float,
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
-       "pattern": str}
+       "pattern": str, "rest": bool}
 _REQUIRED_OP = ("kind", "tool")
 
 
@@ -219,6 +219,9 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
     ops = tuple(_operation(i, op, tools, source) for i, op in enumerate(data["operations"]))
     if not ops:
         raise InputError(f"{source}: operations is empty")
+    if ops[0].options.get("rest"):
+        raise InputError(f"{source}: operations[0].rest = true: no earlier operation leaves a stock to rest-rough; "
+                         "rest = true goes on a later roughing")
     ranks = [KINDS.index(op.kind) for op in ops]
     for i in range(1, len(ops)):
         if ranks[i] < ranks[i - 1]:
@@ -349,7 +352,7 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
     kind = _choice(table["kind"], KINDS, where + "kind", source)
     _choice(table["tool"], tuple(tools), where + "tool", source)
     allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling", "macro",
-               "precision", "pattern"} if kind == "rough" else \
+               "precision", "pattern", "rest"} if kind == "rough" else \
         {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction"}
     opts = {}
     for key, value in table.items():
@@ -362,7 +365,7 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
             opts[key] = _choice(value, DIRECTIONS, where + key, source)
         elif key == "milling":
             opts[key] = _choice(value, MILLING, where + key, source)
-        elif key == "macro":
+        elif key in ("macro", "rest"):
             opts[key] = value
         elif key == "pattern":
             opts[key] = _choice(value, PATTERNS, where + key, source)
@@ -378,6 +381,9 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
         if opts.get("milling") == "zigzag":
             raise InputError(f"{source}: {where}milling = 'zigzag': offset clearing cuts every rectangle one way, "
                              "climb or conventional")
+    if opts.get("rest") and (opts.get("macro") or opts.get("pattern") == "offset"):
+        raise InputError(f"{source}: {where}rest = true: rest roughing runs point-list raster rows, not "
+                         f"{'a roughing macro (macro = true)' if opts.get('macro') else 'pattern = offset'}")
     if "precision" in opts and not opts.get("macro"):
         raise InputError(f"{source}: {where}precision applies to a roughing macro only (macro = true)")
     return OperationSpec(

@@ -15,12 +15,9 @@ and after a level the block is cut down to ``z_k`` wherever the tool fits
 that low: the material left is at most one step-down above what the cutter
 can reach, plus the stock.
 
-Beyond the control points' box there is no part.  A tool centred outside the
-box but within its radius of it is given the height at the nearest point of
-the box, which is never lower than the true one (the disc under the tool,
-cut to the box, lies inside the disc about that nearest point), and the
-samples include the box edges and the points where the tool stops touching
-the box, so no move spans a corner of that rule.
+Beyond the control points' box there is no part: a tool centred outside it
+but within its radius rests on what lies under it inside the box
+(:func:`floor_at`).
 
 Every row starts and ends outside the block by the tool radius plus a
 clearance, so the tool goes down to each level in the air beside the block
@@ -54,7 +51,7 @@ from .plan import MAX_PLAN_POINTS
 from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
 
 __all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
-           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points"]
+           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points", "raster_samples", "rough_levels", "ramp_slope"]
 
 MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (the slow part): minutes at most
 
@@ -207,31 +204,17 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
     >>> bool((rp.points_mm[:, 2] >= rp.floor_mm).all()), round(float(rp.points_mm[:, 2].min()), 6)
     (True, 1.5)
     """
-    ev = evaluator or evaluator_of(surface)
-    place = settings.placement
-    box = place.box_mm(ev.bounds)
-    check_rough_request(tool, stock, spec, ev, place, max_points=max_samples, option="--max-samples")
-    sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
-    drop = _Drop(surface, ev, place, tool, box, spec.stock_to_leave_mm)
-    with telling_compiles(progress):  # the kernel loaded (the first time, compiled) before any stage reports
-        floor_at(drop, [np.array([box[0]])], [np.array([box[2]])])
     if spec.pattern == "offset":
-        x, y = offset_line(stock, box, tool.radius_mm, spec)
+        drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator=evaluator, max_samples=max_samples,
+                               progress=progress)
+        x, y = offset_line(stock, drop.box, tool.radius_mm, spec)
         floors = floor_at(drop, [x], [y], progress=progress)
         x, y, floor, up = checked_line(drop, x, y, floors[0], sigma)
         floors, lifts = [floor], [up]
     else:
-        rows = _rows(stock, box, tool.radius_mm, spec)
-        rows, floors, lifts = _checked(rows, _floors(drop, rows, spec, progress), drop, spec, sigma, progress)
-    reachable = np.concatenate([f for f in floors])
-    low = float(reachable[np.isfinite(reachable)].min()) + sigma
-    count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
-    check_points(stock, tool, spec, count, max_points, "--max-points")
-    z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
-    depth = stock.top_mm - float(z_levels[-1])
-    if spec.reach_mm is not None and depth > spec.reach_mm:
-        raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
-                            f"the tool reaches {spec.reach_mm:g} mm below its holder")
+        rows, floors, lifts, sigma = raster_samples(surface, tool, stock, spec, settings, evaluator=evaluator,
+                                                    max_samples=max_samples, progress=progress)
+    z_levels = rough_levels(floors, sigma, stock, (tool, spec), max_points)
     ramp = dict(radius=tool.radius_mm, tan_a=ramp_slope(tool))
     if spec.pattern == "offset":
         pts, kinds, floor = assemble_offset(x, y, floors[0], lifts[0], z_levels, stock=stock, spec=spec, **ramp)
@@ -242,6 +225,47 @@ def rough_toolpath(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings:
                             f"points, more than the limit of {max_points:.3g}; use larger steps, a steeper "
                             "--plunge-angle or raise the limit (--max-points)")
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
+
+
+def _dropper(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, *, evaluator,
+             max_samples: int | None, progress):
+    """The request checked, the drop-cutter of this cutter (its kernel loaded) and the sag bound ``sigma``."""
+    ev = evaluator or evaluator_of(surface)
+    place = settings.placement
+    box = place.box_mm(ev.bounds)
+    check_rough_request(tool, stock, spec, ev, place, max_points=max_samples, option="--max-samples")
+    sigma = 2.0 * ev.curvature_bound() / place.mm_per_unit * spec.step_mm ** 2 / 8.0
+    drop = _Drop(surface, ev, place, tool, box, spec.stock_to_leave_mm)
+    with telling_compiles(progress):  # the kernel loaded (the first time, compiled) before any stage reports
+        floor_at(drop, [np.array([box[0]])], [np.array([box[2]])])
+    return drop, sigma
+
+
+def raster_samples(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: MachineSettings, *,
+                   evaluator: SurfaceEvaluator | None = None, max_samples: int | None = MAX_ROUGH_SAMPLES,
+                   progress: Progress | None = None):
+    """The raster rows (``.cross``, ``.along`` increasing), each sample's floor (``CL + stock``, mm; ``-inf``
+    where the tool touches nothing) and lift (keeping the moves between samples above the floor), and ``sigma``."""
+    drop, sigma = _dropper(surface, tool, stock, spec, settings, evaluator=evaluator, max_samples=max_samples,
+                           progress=progress)
+    rows = _rows(stock, drop.box, tool.radius_mm, spec)
+    return (*_checked(rows, _floors(drop, rows, spec, progress), drop, spec, sigma, progress), sigma)
+
+
+def rough_levels(floors, sigma: float, stock: Stock, cut: tuple, max_points: int | None) -> np.ndarray:
+    """The z levels (mm): the block's top down by the step-down to the lowest floor plus ``sigma``; a path of
+    more than ``max_points`` and a cut deeper than the reach of ``cut = (tool, spec)`` refused."""
+    tool, spec = cut
+    reachable = np.concatenate(list(floors))
+    low = float(reachable[np.isfinite(reachable)].min()) + sigma
+    count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
+    check_points(stock, tool, spec, count, max_points, "--max-points")
+    z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
+    depth = stock.top_mm - float(z_levels[-1])
+    if spec.reach_mm is not None and depth > spec.reach_mm:
+        raise ToolpathError(f"the tool cannot reach: the cut goes {depth:.3f} mm below the stock top, "
+                            f"the tool reaches {spec.reach_mm:g} mm below its holder")
+    return z_levels
 
 
 def ramp_slope(tool: Tool) -> float:

@@ -32,7 +32,7 @@ import numpy as np
 from .pattern import levels as spaced
 
 __all__ = ["FEED", "RAPID", "PLUNGE", "PATTERNS", "along_samples", "assemble_raster", "offset_line",
-           "assemble_offset", "ramped", "clear_of_block"]
+           "assemble_offset", "ramped", "clear_of_block", "kept_visits", "climb_forward"]
 
 FEED, RAPID, PLUNGE = 0, 1, 2
 """How the tool moves into a point: at the cutting feed, at rapid, or at the plunge feed."""
@@ -195,7 +195,7 @@ def offset_line(stock, box, radius: float, spec) -> tuple[np.ndarray, np.ndarray
     return np.concatenate(xs), np.concatenate(ys)
 
 
-def _kept_visits(idx, z, x=None, y=None) -> np.ndarray:
+def kept_visits(idx, z, x=None, y=None) -> np.ndarray:
     """Indices into the visits to emit: the middle of three at one height, on one straight line and passed one
     way, is on a straight move (a turn back over the same samples is kept)."""
     idx, z = np.asarray(idx), np.asarray(z)
@@ -239,7 +239,7 @@ def assemble_offset(x, y, floor, up, z_levels, *, stock, spec, radius: float = 0
         pts.append((x[0], y[0], float(z[0])))
         kinds.append(PLUNGE)
         floors.append(-np.inf)
-        for j in _kept_visits(idx, z, x, y)[1:]:
+        for j in kept_visits(idx, z, x, y)[1:]:
             i = idx[j]
             pts.append((float(x[i]), float(y[i]), float(z[j])))
             kinds.append(FEED)
@@ -250,7 +250,7 @@ def assemble_offset(x, y, floor, up, z_levels, *, stock, spec, radius: float = 0
     return pts, kinds, floors
 
 
-def _climb_forward(direction: str, progress: int) -> bool:
+def climb_forward(direction: str, progress: int) -> bool:
     """Whether a row cut forwards (along increasing coordinates) is climb milling, rows advancing by ``progress``.
 
     With the spindle turning clockwise, climb milling keeps the uncut
@@ -294,7 +294,7 @@ def assemble_raster(rows, floors, lifts, z_levels, stock, spec, *, radius: float
                 fwd = toggle % 2 == 0
                 toggle += 1
             else:
-                fwd = _climb_forward(spec.direction, progress) == (spec.milling == "climb")
+                fwd = climb_forward(spec.direction, progress) == (spec.milling == "climb")
             a, ff, uu, mm = (r.along, f, up, mats[i]) if fwd else (r.along[::-1], f[::-1], up[::-1], mats[i][::-1])
             visits, low = ramped(np.abs(np.diff(a)), np.maximum(zl, ff + uu), mm, tan_a)
             low = np.where(np.isfinite(mm), low, -np.inf)
@@ -314,7 +314,7 @@ def assemble_raster(rows, floors, lifts, z_levels, stock, spec, *, radius: float
                 if zl + spec.clearance_mm < top:
                     add(a[0], r.cross, zl + spec.clearance_mm, RAPID)
                 add(a[0], r.cross, float(z[0]), PLUNGE)
-            for j in _kept_visits(idx, z)[1:]:
+            for j in kept_visits(idx, z)[1:]:
                 add(float(a[idx[j]]), r.cross, float(z[j]), FEED, float(ff[idx[j]]))
     last = pts[-1]
     add(last[0] if along_x else last[1], last[1] if along_x else last[0], top, RAPID)
