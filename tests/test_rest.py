@@ -161,6 +161,9 @@ def test_with_the_rest_stage_the_finishing_ball_takes_at_most_half_a_millimetre(
     assert round(float(without.max()), 2) == 5.58, without.max()
     assert round(float(vertical_without.max()), 2) == 17.17, vertical_without.max()
     assert round(100 * float((without > 0.5).mean()), 1) == 40.5, (without > 0.5).mean()
+    page = " ".join((Path(__file__).parents[1] / "docs" / "roughing.md").read_text().split())
+    assert ("up to 17.17 mm vertically (5.58 mm normal to the surface" in page
+            and "more than 0.5 mm normal over 40.5 % of the box" in page and "at most 0.46 mm normal" in page)
 
 
 def test_rest_rapids_go_through_no_material(rest_run, maps):
