@@ -78,8 +78,9 @@ def material_under(left: StockMap, x, y, tool: Tool) -> np.ndarray:
     >>> m = StockMap(np.arange(5.0), np.arange(5.0), np.where(np.arange(5.0)[:, None] == 2, 3.0, 1.0) + 0 * np.arange(5.0))
     >>> material_under(m, [0.0, 2.0, 9.0], [2.0, 2.0, 2.0], Tool("flat", 2.0)).tolist()
     [1.0, 3.0, -inf]
-    >>> material_under(m, [0.5], [2.0], Tool("ball", 2.0)).round(3).tolist()  # the cell at x 2 is 1.5 off the axis
-    [1.0]
+    >>> # the ball's rim rises 1 - sqrt(1 - 0.5**2) = 0.134 over the cells 0.5 off its axis; the row x = 2 is 1.5 off
+    >>> material_under(m, [0.5], [2.0], Tool("ball", 2.0)).round(3).tolist()
+    [0.866]
     """
     x, y = np.asarray(x, float), np.asarray(y, float)
     xs, ys, h = left.xs_mm, left.ys_mm, left.heights_mm
