@@ -67,38 +67,43 @@ def test_bad_job_files_get_one_line_naming_the_file_and_exit_2(run_cli, tmp_path
     assert not out.exists()
 
 
-def _calls(rs274, text: str):
+def _calls(rs274, text: str, tools: str = TOOLS):
     """rs274's canonical calls of the program, in order: (name, arguments)."""
     import tempfile
 
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "part.ngc"
         p.write_text(text)
-        r = rs274.run(p, tool_table=TOOLS)
+        r = rs274.run(p, tool_table=tools)
     assert r.returncode == 0 and "PROGRAM_END" in r.stdout, r.stderr[-500:]
     return [(m.group(1), m.group(2)) for m in map(_LINE.match, r.stdout.splitlines()) if m]
 
 
-@pytest.fixture(scope="module")
-def job_run(tmp_path_factory, rs274):
-    """The example job's program, what the command printed, and rs274's moves tagged with the tool in the spindle."""
+def run_job(d: Path, job_text: str, rs274, tools: str = TOOLS):
+    """``lagsym job`` on ``job_text`` in ``d``: the program, what it printed, rs274's moves tagged with the tool in
+    the spindle ``(tool, feed?, x, y, z)``, and the names of rs274's calls."""
     import io
 
     from lagsym.cli import main
 
-    d = tmp_path_factory.mktemp("job")
     job = d / "job.toml"
-    job.write_text(job_text())
+    job.write_text(job_text)
     err = io.StringIO()
     assert main(["job", str(job), "-o", str(d / "part.ngc")], io.StringIO(), err) == 0, err.getvalue()
     text = (d / "part.ngc").read_text()
-    tool, moves, calls = 0, [], _calls(rs274, text)
+    tool, moves, calls = 0, [], _calls(rs274, text, tools)
     for name, argv in calls:
         if name == "CHANGE_TOOL":
             tool = int(argv)
         elif name in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE"):
             moves.append((tool, name == "STRAIGHT_FEED", *map(float, argv.split(",")[:3])))
     return text, err.getvalue(), moves, [c[0] for c in calls]
+
+
+@pytest.fixture(scope="module")
+def job_run(tmp_path_factory, rs274):
+    """The example job's program, what the command printed, and rs274's moves tagged with the tool in the spindle."""
+    return run_job(tmp_path_factory.mktemp("job"), job_text(), rs274)
 
 
 @pytest.mark.slow

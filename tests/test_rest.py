@@ -17,14 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_job import EX4, _densified, stamp_ball
+from test_job import EX4, _densified, run_job, stamp_ball
 from test_rough import exact_heights, sweep_flat
 
 ROOT = Path(__file__).resolve().parent.parent
 REST_JOB = ROOT / "examples" / "example-4-rest-job.toml"
 TOOLS = "T1 P1 Z0 D10 ;rougher\nT2 P2 Z0 D6 ;ball\nT3 P3 Z0 D4 ;rest\n"
 R_FLAT, R_FINISH, R_REST, REST_STOCK = 5.0, 3.0, 2.0, 0.15
-_LINE = re.compile(r"^\s*\d+\s+N\S*\s+(\w+)\((.*)\)\s*$")
 CELL = 0.25
 
 
@@ -41,24 +40,8 @@ def rest_text(**changes) -> str:
 @pytest.fixture(scope="module")
 def rest_run(tmp_path_factory, rs274):
     """The program, what the command printed, and rs274's moves: (tool, feed?, x, y, z)."""
-    import io
-
-    from lagsym.cli import main
-
-    d = tmp_path_factory.mktemp("rest")
-    job = d / "job.toml"
-    job.write_text(rest_text())
-    err = io.StringIO()
-    assert main(["job", str(job), "-o", str(d / "part.ngc")], io.StringIO(), err) == 0, err.getvalue()
-    r = rs274.run(d / "part.ngc", tool_table=TOOLS)
-    assert r.returncode == 0 and "PROGRAM_END" in r.stdout, r.stderr[-500:]
-    tool, moves = 0, []
-    for m in map(_LINE.match, r.stdout.splitlines()):
-        if m and m.group(1) == "CHANGE_TOOL":
-            tool = int(m.group(2))
-        elif m and m.group(1) in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE"):
-            moves.append((tool, m.group(1) == "STRAIGHT_FEED", *map(float, m.group(2).split(",")[:3])))
-    return (d / "part.ngc").read_text(), err.getvalue(), moves
+    text, printed, moves, _ = run_job(tmp_path_factory.mktemp("rest"), rest_text(), rs274, TOOLS)
+    return text, printed, moves
 
 
 def _cut(h, gx, gy, moves, shape, radius):
