@@ -17,7 +17,6 @@ refused before it starts: more cells than ``max_cells``
 from __future__ import annotations
 
 import math
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -44,7 +43,10 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
     Moves are split into segments no longer sideways than ``_PIECE_CELLS``
     cells, and each segment lowers every cell centre its tool can reach by
     the exact lowest point over it (:mod:`lagsym.verify.swept`).  With
-    ``workers`` threads (default: up to 2, one a core) the cells the moves
+    ``workers`` threads (default 1: each NumPy call here gathers and scatters
+    a few thousand cells, which holds the interpreter lock about as long as it
+    computes, so a second thread gained nothing on a finishing program and
+    lost half the speed on a bull nose's bisections) the cells the moves
     reach are cut into ``2 * workers`` stripes across X, each at least a
     footprint wide: the even ones are swept at the same time, then the odd
     ones, so no two threads ever write the same cell.  ``progress`` is told
@@ -57,7 +59,7 @@ def sweep(cut, a_all, b_all, xs, ys, *, r, corner, workers: int | None = None, p
     piece = _PIECE_CELLS * max(hx, hy)
     lowest = _kernel(r, corner)
     kx, ky = int(math.ceil((r + piece / 2) / hx)) + 1, int(math.ceil((r + piece / 2) / hy)) + 1
-    workers = min(os.cpu_count() or 1, 2) if workers is None else max(int(workers), 1)
+    workers = 1 if workers is None else max(int(workers), 1)
     count = 0
     swept = Tally(progress, "sweeping moves", segments(a_all, b_all, piece) if progress is not None else None)
     swept.start()
@@ -122,10 +124,11 @@ def segments(a, b, piece: float) -> int:
 def _kernel(r, corner):
     """The closed-form lowest point of the tool over a cell along a segment (:mod:`lagsym.verify.swept`)."""
     if corner <= 0.0:
-        return lambda ca, ce, seg: lowest_flat(ca, ce, seg, r)
+        return lambda ca, ce, seg, above: lowest_flat(ca, ce, seg, r)
     if corner >= r:
-        return lambda ca, ce, seg: lowest_ball(ca, ce, seg, r)
-    return lambda ca, ce, seg: lowest_bull(ca, ce, seg, r, corner)
+        return lambda ca, ce, seg, above: lowest_ball(ca, ce, seg, r)
+    # The bull nose is searched, not solved: it skips the cells it cannot lower (``above``, their heights so far).
+    return lambda ca, ce, seg, above: lowest_bull(ca, ce, seg, r, corner, above=above)
 
 
 def _pieces(a, b, piece):
@@ -203,7 +206,7 @@ def _sweep_chunk(chunk, geometry, lowest):
         for j in range(-span, span + 1):
             view = flat[lo + di * stride + j:]
             cur = view[base]
-            v = lowest(ax + ay[j + ky], ex + ey[j + ky], seg)
+            v = lowest(ax + ay[j + ky], ex + ey[j + ky], seg, cur)
             if wflat is not None:
                 won = v < cur
                 if won.any():
@@ -229,9 +232,10 @@ def _sweep_few(chunk, geometry, lowest):
         wx, wy = bx[g, None] + di * hx, by[g, None] + dj * hy
         ca = (wx * ux[g, None])[:, :, None] + (wy * uy[g, None])[:, None, :]
         ce = (-wx * uy[g, None])[:, :, None] + (wy * ux[g, None])[:, None, :]
-        v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)))
+        every = base[g, None, None] + offsets
+        v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)), flat[every])
         under = ~np.isnan(v)
-        cells = (base[g, None, None] + offsets)[under]
+        cells = every[under]
         np.fmin.at(flat, cells, v[under])
         if wflat is not None:
             # Any move whose value is the cell's new lowest reaches it there.

@@ -78,15 +78,30 @@ def lowest_flat(a, e, seg, r):
     return np.where(ok, az + m * tau, np.nan)
 
 
-def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS):
-    """Lowest height of a bull nose's lower surface over the cells at ``(a, e)`` (by bisection); NaN where none."""
+def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS, above=None):
+    """Lowest height of a bull nose's lower surface over the cells at ``(a, e)`` (by bisection); NaN where none.
+
+    ``above``, if given (broadcast with ``a``), are the cells' heights so
+    far: where the tool cannot come below them (its height at the first
+    position over the cell, plus the profile at the nearest the axis passes,
+    is already as high) the answer is NaN and no bisection is spent.
+    """
     az, _, length, m, _ = seg
     flat = r - corner
+    shape = np.broadcast_shapes(np.shape(a), np.shape(e), *(np.shape(v) for v in (az, length, m)))
+    a, e, az, length, m = (np.broadcast_to(v, shape) for v in (a, e, az, length, m))
     e2 = e * e
     half = np.sqrt(r * r - e2)
     lo = np.maximum(a - half, 0.0)
+    ok = lo <= np.minimum(a + half, length)
+    if above is not None:
+        q = np.minimum(np.maximum(np.abs(e) - flat, 0.0), corner)
+        ok &= az + m * lo + (corner - np.sqrt(corner * corner - q * q)) < np.broadcast_to(above, shape)
+    out = np.full(shape, np.nan)
+    if not ok.any():
+        return out
+    a, e2, az, length, m, lo, half = (v[ok] for v in (a, e2, az, length, m, lo, half))
     hi = np.minimum(a + half, length)
-    ok = lo <= hi
     m2 = m * m
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
@@ -101,7 +116,8 @@ def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS):
         lo = np.where(rising, lo, mid)
     s = a - lo
     q = np.minimum(np.maximum(np.sqrt(s * s + e2) - flat, 0.0), corner)
-    return np.where(ok, az + m * lo + corner - np.sqrt(corner * corner - q * q), np.nan)
+    out[ok] = az + m * lo + corner - np.sqrt(corner * corner - q * q)
+    return out
 
 
 def bull_resolution(corner: float, longest_mm: float, steps: int = BISECTIONS) -> float:
