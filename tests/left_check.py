@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from swept_check import GOLDEN, polynomial_heights
+from swept_check import ball_heights, golden_lowest, polynomial_heights
 
 
 def swept_lowest(points_mm, radius, qx, qy, iterations=48):
@@ -44,22 +44,8 @@ def swept_lowest(points_mm, radius, qx, qy, iterations=48):
         mi, qi = np.nonzero(ex * ex + ey * ey <= radius * radius)
         if not mi.size:
             continue
-        A, B = ma[mi], mb[mi]
-        px, py = qx[qi], qy[qi]
-
-        def height(t):
-            cx, cy, cz = (A[:, k] + t * (B[:, k] - A[:, k]) for k in range(3))
-            d2 = (px - cx) ** 2 + (py - cy) ** 2
-            return np.where(d2 <= radius * radius, cz + radius - np.sqrt(np.maximum(radius * radius - d2, 0.0)),
-                            cz + radius + (np.sqrt(d2) - radius) * 1e6)
-
-        lo, hi = np.zeros(len(mi)), np.ones(len(mi))
-        for _ in range(iterations):
-            m1, m2 = hi - GOLDEN * (hi - lo), lo + GOLDEN * (hi - lo)
-            left = height(m1) <= height(m2)
-            hi, lo = np.where(left, m2, hi), np.where(left, lo, m1)
-        best = np.minimum.reduce([height(lo), height(hi), height(np.zeros(len(mi))), height(np.ones(len(mi)))])
-        best = np.where(best < np.inf, best, np.inf)
+        height, _ = ball_heights(ma[mi], mb[mi], radius, qx[qi], qy[qi])
+        best, _ = golden_lowest(height, len(mi), iterations)
         np.minimum.at(out, qi, best)
     return out
 

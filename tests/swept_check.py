@@ -23,6 +23,53 @@ def polynomial_heights(surface, mm_per_unit, x_mm, y_mm):
     return P.polyval2d(np.asarray(x_mm) / mm_per_unit, np.asarray(y_mm) / mm_per_unit, c) * mm_per_unit
 
 
+def golden_lowest(height, n, iterations):
+    """The least of ``height(t)`` over ``t`` in [0, 1] for ``n`` convex functions at once, by golden sections.
+
+    Each turn keeps one of the two inner points and evaluates one new one;
+    the ends of the last bracket and of the move are looked at too.
+    Returns the least height and the ``t`` where it was found.
+    """
+    lo, hi = np.zeros(n), np.ones(n)
+    c, d = hi - GOLDEN, lo + GOLDEN
+    fc, fd = height(c), height(d)
+    for _ in range(iterations):
+        left = fc <= fd  # the least lies in [lo, d]: c becomes the upper inner point; else d the lower
+        hi, lo = np.where(left, d, hi), np.where(left, lo, c)
+        keep, fkeep = np.where(left, c, d), np.where(left, fc, fd)
+        new = np.where(left, hi - GOLDEN * (hi - lo), lo + GOLDEN * (hi - lo))
+        fnew = height(new)
+        c, fc = np.where(left, new, keep), np.where(left, fnew, fkeep)
+        d, fd = np.where(left, keep, new), np.where(left, fkeep, fnew)
+    ts = (lo, hi, c, d, np.zeros(n), np.ones(n))
+    values = np.array([height(lo), height(hi), fc, fd, height(ts[4]), height(ts[5])])
+    k = np.argmin(values, axis=0)
+    return values[k, np.arange(n)], np.choose(k, ts)
+
+
+def ball_heights(a, b, radius, px, py):
+    """``height(t)``: the ball's lower surface over ``(px, py)`` with its tip at ``a + t (b - a)`` (rows paired).
+
+    Outside the ball's shadow the height rises steeply, so a search still finds the covered part.
+    """
+    a, b = np.broadcast_to(a, (len(px), 3)), np.broadcast_to(b, (len(px), 3))
+    rx, ry, az = px - a[:, 0], py - a[:, 1], a[:, 2] + radius
+    dx, dy, dz = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1], b[:, 2] - a[:, 2]
+    r2 = radius * radius
+
+    def height(t):
+        ex, ey = rx - t * dx, ry - t * dy
+        d2 = ex * ex + ey * ey
+        return np.where(d2 <= r2, az + t * dz - np.sqrt(np.maximum(r2 - d2, 0.0)),
+                        az + t * dz + (np.sqrt(d2) - radius) * 1e6)
+
+    def reach2(t):  # squared plan distance from the point to the tip
+        ex, ey = rx - t * dx, ry - t * dy
+        return ex * ex + ey * ey
+
+    return height, reach2
+
+
 def swept_ball_window(moves_a, moves_b, radius, gx, gy, iterations=60):
     """Lowest height of a ball's lower surface (tip positions ``a -> b``) over every point ``(gx[i], gy[j])``.
 
@@ -40,27 +87,9 @@ def swept_ball_window(moves_a, moves_b, radius, gx, gy, iterations=60):
         if not near.any():
             continue
         qx, qy = px[near], py[near]
-
-        def height(t):
-            cx, cy = a[k, 0] + t * (b[k, 0] - a[k, 0]), a[k, 1] + t * (b[k, 1] - a[k, 1])
-            cz = a[k, 2] + t * (b[k, 2] - a[k, 2])
-            d2 = (qx - cx) ** 2 + (qy - cy) ** 2
-            # Outside the ball's shadow the height rises steeply, so the search still finds the covered part.
-            return np.where(d2 <= radius * radius, cz + radius - np.sqrt(np.maximum(radius * radius - d2, 0.0)),
-                            cz + radius + (np.sqrt(d2) - radius) * 1e6)
-
-        lo, hi = np.zeros(len(qx)), np.ones(len(qx))
-        for _ in range(iterations):
-            m1, m2 = hi - GOLDEN * (hi - lo), lo + GOLDEN * (hi - lo)
-            left = height(m1) <= height(m2)
-            hi, lo = np.where(left, m2, hi), np.where(left, lo, m1)
-        best = np.minimum(np.minimum(height(lo), height(hi)), np.minimum(height(np.zeros(len(qx))),
-                                                                         height(np.ones(len(qx)))))
-        d2best = np.full(len(qx), np.inf)
-        for t in (lo, hi, np.zeros(len(qx)), np.ones(len(qx))):
-            cx, cy = a[k, 0] + t * (b[k, 0] - a[k, 0]), a[k, 1] + t * (b[k, 1] - a[k, 1])
-            d2best = np.minimum(d2best, (qx - cx) ** 2 + (qy - cy) ** 2)
-        best = np.where(d2best <= radius * radius, best, np.inf)
+        height, reach2 = ball_heights(a[k], b[k], radius, qx, qy)
+        best, t = golden_lowest(height, len(qx), iterations)
+        best = np.where(reach2(t) <= radius * radius, best, np.inf)
         out[near] = np.minimum(out[near], best)
     return out.reshape(X.shape)
 
