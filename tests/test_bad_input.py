@@ -303,7 +303,7 @@ def test_line_options_are_checked_before_the_port_opens(run_cli, prog, argv, nee
     start = time.monotonic()
     status, out, err = run_cli(*[a.format(prog=prog) for a in argv])
     one_line_error(status, out, err, needle)
-    assert time.monotonic() - start < 10  # refused, not waited on (receive --timeout inf waited for ever)
+    assert time.monotonic() - start < 120  # refused, not waited on (receive --timeout inf waited for ever)
     assert not out
 
 
@@ -344,14 +344,14 @@ def test_a_log_lost_part_way_is_not_a_transfer_done(prog, tmp_path):
 @pytest.mark.parametrize("argv", [
     ["sample", "{flat}", "--nx", "3", "-o", "{flat}/out.csv"], ["toolpath", "{flat}", "-o", "{flat}/x.nc"],
     ["export", "{flat}", "-o", "{flat}/x.step"], ["equation", "{flat}", "-o", "{flat}/x.txt"],
-    ["receive", "--port", "loop://", "--timeout", "30", "-o", "{flat}/x.nc"],
+    ["receive", "--port", "loop://", "--timeout", "600", "-o", "{flat}/x.nc"],
 ])
 def test_an_output_under_a_file_is_one_line(run_cli, flat, argv):
     import time
 
     start = time.monotonic()
     one_line_error(*run_cli(*[a.format(flat=flat) for a in argv]), "flat.json is not a folder")
-    assert time.monotonic() - start < 20  # receive says so before it waits for the control
+    assert time.monotonic() - start < 120  # receive says so before it waits (600 s) for the control
 
 
 # 4 and 6 for rough and job: their numbers checked as toolpath's are, their work estimated first.

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import signal
@@ -54,6 +55,18 @@ def lagsym_process(*argv):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def wait_until_open(proc, device, timeout=60.0):
+    """Whether ``proc`` opened ``device`` (its /proc fd table names it) within ``timeout`` seconds."""
+    target = os.path.realpath(device)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None:
+        with contextlib.suppress(OSError):  # an fd closed between the listing and the look
+            if any(os.readlink(f"/proc/{proc.pid}/fd/{fd}") == target for fd in os.listdir(f"/proc/{proc.pid}/fd")):
+                return True
+        time.sleep(0.02)
+    return False
+
+
 # -- 6: SIGTERM and SIGHUP are handled as Ctrl-C is ---------------------------------------------------------
 
 
@@ -75,7 +88,9 @@ def test_a_signal_stops_a_receive_with_exit_3_and_nothing_saved(tmp_path):
     with PtyPair() as pair:
         target = tmp_path / "got.nc"
         proc = lagsym_process("receive", "--port", pair.near, "--timeout", "60", "-o", target)
-        time.sleep(1.5)
+        # Signalled once it listens on the port (its handlers are in place before it opens it), not after
+        # a guessed delay that a loaded machine overruns while the command still imports.
+        assert wait_until_open(proc, pair.near)
         proc.send_signal(signal.SIGTERM)
         out, err = proc.communicate(timeout=20)
     assert proc.returncode == 3, err

@@ -66,12 +66,13 @@ def test_interrupted_while_waiting_the_call_raises_at_once_stops_the_blocks_and_
         if lo == 1:  # the helper, once the calling thread waits for it, interrupts it and runs on
             time.sleep(0.1)
             signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
-            time.sleep(0.4)
+            time.sleep(5.0)
 
     t = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
         threads.run_parts(work, [(0, 1), (1, 2)], stop)
-    assert time.perf_counter() - t < 0.4 and stop == [True]
+    # Raised before the helper's part ends (5 s after the interrupt), however late a loaded machine runs it.
+    assert time.perf_counter() - t < 4.0 and stop == [True]
     assert len(_idents(2)) == 2  # fresh helpers
 
 
