@@ -16,7 +16,7 @@ from collections.abc import Iterator
 
 from ..errors import InputError
 
-__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "read_bytes", "read_text", "read_program", "event_log",
+__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "read_bytes", "read_text", "read_program", "event_log",
            "EventLog"]
 
 MAX_BYTES = 64 * 1024 * 1024
@@ -27,6 +27,12 @@ STDIN_NAMES = ("-", "/dev/stdin")
 STDIN_SILENCE_S = 10.0  # standard input that sends nothing for this long is refused, not waited on forever
 
 
+def display_name(path: str | os.PathLike) -> str:
+    """``path`` as a message shows it: control characters (a newline, a tab) escaped, so a message stays one line."""
+    name = str(path)
+    return name if name.isprintable() else name.encode("unicode_escape", "backslashreplace").decode("ascii")
+
+
 def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
     """The bytes of ``path`` (``-``: standard input), at most ``limit``; every failure is one InputError naming it.
 
@@ -34,13 +40,13 @@ def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> by
     could hand over endless bytes or none, so it is refused with a line that
     says what it is.
     """
-    name = str(path)
-    if name in STDIN_NAMES:
+    if str(path) in STDIN_NAMES:
         return _read_stdin(what, limit)
-    if "\x00" in name:
-        raise InputError(f"{name!r}: a file name cannot hold a NUL character")
+    if "\x00" in str(path):
+        raise InputError(f"{str(path)!r}: a file name cannot hold a NUL character")
+    name = display_name(path)
     try:
-        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
+        fd = os.open(str(path), os.O_RDONLY | os.O_NONBLOCK)  # non-blocking: opening a FIFO must not hang
     except FileNotFoundError:
         raise InputError(f"{name}: no such file") from None
     except PermissionError:
@@ -89,7 +95,8 @@ def _read_stdin(what: str, limit: int) -> bytes:
 
 
 def read_text(path: str | os.PathLike) -> tuple[str, str]:
-    name = str(path)
+    """The text of a UTF-8 file and its name as messages show it (:func:`display_name`)."""
+    name = display_name(path)
     raw = read_bytes(path, "a points file")
     try:
         text = raw.decode("utf-8-sig")
@@ -111,7 +118,7 @@ def read_program(path: str | os.PathLike) -> str:
     InputError
         For a missing or unreadable file, a directory, or a byte that is not ASCII.
     """
-    name = str(path)
+    name = display_name(path)
     raw = read_bytes(path, "a program")
     try:
         return raw.decode("ascii")

@@ -78,7 +78,7 @@ def lowest_flat(a, e, seg, r):
     return np.where(ok, az + m * tau, np.nan)
 
 
-def lowest_bull(a, e, seg, r, corner, steps: int = BISECTIONS, above=None):
+def lowest_bull(a, e, seg, r, corner, *, steps: int = BISECTIONS, above=None):
     """Lowest height of a bull nose's lower surface over the cells at ``(a, e)`` (by bisection); NaN where none.
 
     ``above``, if given (broadcast with ``a``), are the cells' heights so
