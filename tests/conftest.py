@@ -27,26 +27,6 @@ settings.load_profile("ci" if os.environ.get("CI") else "dev")
 from systempackages import SYSTEM_PACKAGES, missing_system_package, need_opengl  # noqa: E402,F401
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config, items):
-    """The notebooks are slow, and draw their figures: without an OpenGL they skip with one line naming the packages.
-
-    (A session-wide hook, so it reaches the notebooks outside tests/; first, so that ``-m "not slow"``
-    sees the mark.)  Under LAGSYM_TEST_REQUIRE_ALL they run, and fail, instead.
-    """
-    notebooks = [item for item in items if item.path.suffix == ".ipynb"]
-    for item in notebooks:
-        item.add_marker(pytest.mark.slow)
-    if not notebooks or os.environ.get("LAGSYM_TEST_REQUIRE_ALL"):
-        return
-    from systempackages import can_render, missing_line
-
-    if not can_render():
-        line = missing_line("libegl1 libegl-mesa0 libgl1-mesa-dri", "an offscreen OpenGL (EGL or OSMesa) for the notebooks' figures")
-        for item in notebooks:
-            item.add_marker(pytest.mark.skip(reason=line))
-
-
 @pytest.fixture(scope="session", autouse=True)
 def _cutter_kernel_compiled():
     """The cutter kernel compiled into Numba's cache before any test runs.
