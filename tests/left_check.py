@@ -9,7 +9,8 @@ move), for every move that passes within the ball's radius of the point.  A
 line of points a few micrometres apart crosses the cusps between passes, so
 their peaks are seen; the material left is the height of the swept ball's
 lower surface above the surface, times the cosine of the slope (normal to
-the surface).
+the surface).  Moves that cannot come lower than a height the ball surely
+reaches over a point are not searched for it.
 """
 
 from __future__ import annotations
@@ -19,10 +20,40 @@ import numpy as np
 from swept_check import ball_heights, golden_lowest, polynomial_heights
 
 
+def _pairs(a, b, radius, qx, qy):
+    """Per group of up to 64 moves: the pairs of move and point within the radius of the move's plan line.
+
+    Yields the moves' ends of each pair, the point's index, and the lower and
+    upper bounds of the ball's lowest height over the point along the move:
+    at least the lower end's height with the ball's profile at the plan
+    distance, and at most the height over the point where the axis passes
+    nearest (a real position on the move).
+    """
+    r2 = radius * radius
+    for s in range(0, len(a), 64):
+        ma, mb = a[s:s + 64], b[s:s + 64]
+        d = mb[:, :2] - ma[:, :2]
+        dd = np.maximum((d * d).sum(axis=1), 1e-300)
+        rx, ry = qx[None, :] - ma[:, 0:1], qy[None, :] - ma[:, 1:2]
+        t0 = np.clip((rx * d[:, 0:1] + ry * d[:, 1:2]) / dd[:, None], 0.0, 1.0)
+        ex, ey = rx - t0 * d[:, 0:1], ry - t0 * d[:, 1:2]
+        e2 = ex * ex + ey * ey
+        mi, qi = np.nonzero(e2 <= r2)
+        if not mi.size:
+            continue
+        rise = radius - np.sqrt(r2 - e2[mi, qi])
+        low = np.minimum(ma[mi, 2], mb[mi, 2]) + rise
+        high = ma[mi, 2] + t0[mi, qi] * (mb[mi, 2] - ma[mi, 2]) + rise
+        yield ma[mi], mb[mi], qi, low, high
+
+
 def swept_lowest(points_mm, radius, qx, qy, iterations=48):
     """The lowest height a ball's lower surface reaches over each ``(qx[i], qy[i])`` following ``points_mm``.
 
-    ``inf`` where no move passes within the radius.
+    ``inf`` where no move passes within the radius.  A first pass puts over
+    each point the height the ball surely reaches there (where some axis
+    passes nearest); the golden-section search then runs only for the moves
+    whose lower bound is below that.
     """
     p = np.asarray(points_mm, dtype=float)
     a, b = p[:-1], p[1:]
@@ -33,20 +64,15 @@ def swept_lowest(points_mm, radius, qx, qy, iterations=48):
     near = ((np.maximum(a[:, 0], b[:, 0]) >= lo_x) & (np.minimum(a[:, 0], b[:, 0]) <= hi_x)
             & (np.maximum(a[:, 1], b[:, 1]) >= lo_y) & (np.minimum(a[:, 1], b[:, 1]) <= hi_y))
     a, b = a[near], b[near]
-    for s in range(0, len(a), 64):
-        ma, mb = a[s:s + 64], b[s:s + 64]
-        d = mb[:, :2] - ma[:, :2]
-        dd = np.maximum((d * d).sum(axis=1), 1e-300)
-        # Pairs of move and point within the radius of the move's plan line.
-        rx, ry = qx[None, :] - ma[:, 0:1], qy[None, :] - ma[:, 1:2]
-        t0 = np.clip((rx * d[:, 0:1] + ry * d[:, 1:2]) / dd[:, None], 0.0, 1.0)
-        ex, ey = rx - t0 * d[:, 0:1], ry - t0 * d[:, 1:2]
-        mi, qi = np.nonzero(ex * ex + ey * ey <= radius * radius)
-        if not mi.size:
+    for _, _, qi, _, high in _pairs(a, b, radius, qx, qy):
+        np.minimum.at(out, qi, high)
+    for ma, mb, qi, low, _ in _pairs(a, b, radius, qx, qy):
+        keep = low < out[qi]
+        if not keep.any():
             continue
-        height, _ = ball_heights(ma[mi], mb[mi], radius, qx[qi], qy[qi])
-        best, _ = golden_lowest(height, len(mi), iterations)
-        np.minimum.at(out, qi, best)
+        height, _ = ball_heights(ma[keep], mb[keep], radius, qx[qi[keep]], qy[qi[keep]])
+        best, _ = golden_lowest(height, int(keep.sum()), iterations)
+        np.minimum.at(out, qi[keep], best)
     return out
 
 
