@@ -305,6 +305,10 @@ class _Control:
                 except ProcessLookupError:
                     pass
 
+    def dead(self) -> bool:
+        """Past ``discard_after_bytes``: the control takes what comes and answers nothing."""
+        return self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes
+
     def run(self) -> None:
         line_t = 0.0  # when the wire will have delivered everything read so far
         was_pending = False
@@ -364,7 +368,9 @@ class _Control:
                         self.cut()
                         return
                 self.count.value = len(self.received)
-                if crossed:
+                # A control that died in this read (past discard_after_bytes) sends no DC3 for it: this simulation
+                # answers after it has taken the whole read, a real control when the mark was crossed.
+                if crossed and not self.dead():
                     self.port.write(self.xoff_byte)
                     self.pending_now, self.tail = self.port.in_waiting, self.after
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
@@ -379,7 +385,7 @@ class _Control:
                         drop_at = time.monotonic() + self.drop_settle_s
                 if self.xoff:
                     self.max_after_xoff = max(self.max_after_xoff, self.after)
-            if self.xoff and not self.ignore_xon and drop_at is None and self.buffered <= self.low:
+            if self.xoff and not self.ignore_xon and drop_at is None and not self.dead() and self.buffered <= self.low:
                 self.close_episode()
                 self.xoff = False
                 self.port.write(self.xon_byte)
