@@ -40,6 +40,7 @@ def _faults(mode: str, **env) -> int:
     return int(done.stdout.split()[-1])
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not GLIBC, reason="glibc's malloc only")
 def test_freed_arrays_are_reused_without_fresh_page_faults():
     plain, kept = _faults("plain"), _faults("keep")

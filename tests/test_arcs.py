@@ -84,6 +84,7 @@ def deviations(name, arcs, tessellation=400):
     return pick[:, 2] - cl
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, direction, dialect", [("example-2", "x", "linuxcnc"), ("example-2", "y", "fanuc"),
                                                       ("example-4", "x", "fanuc"), ("example-4", "y", "linuxcnc")])
 def test_arcs_pass_rs274_and_stay_between_the_cutter_path_and_the_tolerance(rs274, tmp_path, name, direction, dialect):

@@ -10,6 +10,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script, base, rows", [("bench_startup.py", "lagsym --version", 5),
                                                 ("bench_equation.py", "lagsym equation", 3)])
 def test_a_start_up_benchmark_prints_its_ratios(script, base, rows, tmp_path):

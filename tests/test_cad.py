@@ -294,6 +294,7 @@ def test_import_lagsym_loads_no_cad_kernel():
     assert out.stdout.strip() == "[]"
 
 
+@pytest.mark.slow
 @given(grids(), st.randoms(use_true_random=False))
 def test_lowest_height_of_any_grid(g, rnd):
     s = lagrange_surface(g)

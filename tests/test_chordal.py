@@ -55,6 +55,7 @@ def example1_corner():
     return surf, tp
 
 
+@pytest.mark.slow
 def test_moves_stay_above_the_cutter_path_where_the_tool_meets_an_edge(example1_corner):
     # Regression: on the row y = 39.024 the ball starts to rest on the corner region between two
     # cutter locations 0.22 mm apart, and the move between them cut 0.29 mm below the true path.
@@ -72,6 +73,7 @@ def test_moves_stay_above_the_cutter_path_where_the_tool_meets_an_edge(example1_
     assert abs(level[nearest] - 39.0244) < 0.2 and row.sum() > 2  # cutter locations were added where the path bends
 
 
+@pytest.mark.slow
 def test_moves_along_the_rows_in_the_middle_stay_above_the_cutter_path(example1_corner):
     surf, tp = example1_corner
     rng = np.random.default_rng(7)
@@ -80,6 +82,7 @@ def test_moves_along_the_rows_in_the_middle_stay_above_the_cutter_path(example1_
     assert above.max() <= 1e-6
 
 
+@pytest.mark.slow
 def test_example1_program_does_not_gouge_at_the_corner(example1_corner):
     from lagsym.gcode import parse_moves
     from lagsym.post.program import point_program, write_program

@@ -171,6 +171,7 @@ def test_the_simulator_keeps_to_the_haas_variables():
         simulate(program, "haas")  # a Haas keeps #700-#799 for itself
 
 
+@pytest.mark.slow
 def test_haas_is_reachable_from_every_command(run_cli, tmp_path):
     points = str(EXAMPLES / "paper-example-4.json")
     rough = tmp_path / "rough.nc"

@@ -137,6 +137,7 @@ def line():
         pair.close()
 
 
+@pytest.mark.slow
 @needs_socat
 def test_large_drip_feed_arrives_byte_exact(line):
     baud = 115200
@@ -156,6 +157,7 @@ def test_large_drip_feed_arrives_byte_exact(line):
     assert result.max_in_flight_at_xoff <= settings.overrun_chars
 
 
+@pytest.mark.slow
 def test_xoff_stops_the_sender_within_its_limit(line):
     # A kernel pty pair: socat's relay can take 100 ms to pass the DC3 back on a loaded machine, which a
     # real UART does not, and that delay would be charged to the sender.
@@ -180,6 +182,7 @@ def test_xoff_stops_the_sender_within_its_limit(line):
     # not starved), a test cannot promise it.
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("late_s", [0.0, 0.02], ids=["prompt", "late-writes"])
 def test_what_passes_a_dc3_stays_within_the_headroom_with_a_wide_window(line, monkeypatch, late_s):
     # What the sender promises with a wide window: at most its window on the way when it reads a DC3, and
@@ -291,6 +294,7 @@ def _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path):
     return start
 
 
+@pytest.mark.slow
 @needs_socat
 def test_a_feed_hold_stalls_with_exit_3_and_a_resume_block_that_allows_for_the_buffer(line, run_cli, tmp_path):
     # The control's buffer fills, it says DC3, the machine stops (feed hold) and no DC1 comes: what sits
@@ -321,6 +325,7 @@ def test_a_feed_hold_stalls_with_exit_3_and_a_resume_block_that_allows_for_the_b
     assert start < last and f"blocks {start} to {held} are repeated if they had already run" in err
 
 
+@pytest.mark.slow
 @needs_socat
 def test_a_control_that_drops_the_line_half_way_then_a_resume_completes_it(line, run_cli, tmp_path):
     # The control drains at a fifth of the line rate, so it says XOFF even when a loaded machine slows
@@ -433,6 +438,7 @@ def test_ctrl_c_names_the_block_to_resume_at():
     assert f"--start-block {fault.start_block}" in str(fault)
 
 
+@pytest.mark.slow
 @needs_socat
 def test_the_line_end_after_a_closing_percent_read_late_does_not_start_a_program(tmp_path):
     # A control punches "...%" then "\r\n" and DC4; where those come in a read of their own, after the

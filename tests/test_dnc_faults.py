@@ -70,6 +70,7 @@ def wait_until_open(proc, device, timeout=60.0):
 # -- 6: SIGTERM and SIGHUP are handled as Ctrl-C is ---------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_a_signal_stops_a_drip_feed_with_the_resume_block_and_exit_3(line, tmp_path, sig):
     # The control runs slower than the line, so it answers XOFF/XON: what it took before is known.
@@ -131,6 +132,7 @@ def test_a_missing_dc1_and_a_silent_receive_are_not_called_lost_lines(line, run_
 # -- 1: rfc2217:// works, through a real RFC 2217 server ----------------------------------------------------
 
 
+@pytest.mark.slow
 def test_send_over_rfc2217_arrives_byte_exact(line):
     baud = 38400
     pair, sim = line(baud=baud)
@@ -146,6 +148,7 @@ def test_send_over_rfc2217_arrives_byte_exact(line):
         server.close()
 
 
+@pytest.mark.slow
 def test_a_drip_feed_over_rfc2217_hears_the_controls_xoff_and_xon(line):
     # Both directions at once through the RFC 2217 server: the program out, DC3 and DC1 back.
     baud = 9600
@@ -187,6 +190,7 @@ def test_receive_over_rfc2217(run_cli, tmp_path):
 # -- 4: delivery, and a dropped line seen through the carrier ----------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_control_that_stops_taking_the_program_is_not_reported_as_delivered(line, run_cli, tmp_path):
     pair, sim = line(baud=38400, discard_after_bytes=1000)
     text = program_text(200)
@@ -216,6 +220,7 @@ def test_the_flow_control_setting_reaches_the_port_and_the_kernel(flow):
     assert ispeed == termios.B9600 and cflag & termios.CSTOPB  # the rest of the set-up reached it too
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("flow, signal_name", [("rtscts", "cts"), ("dtrdsr", "dsr")])
 def test_a_low_cts_or_dsr_pauses_the_send_until_it_rises(line, flow, signal_name):
     # The RFC 2217 server reports the modem lines the test sets, as a serial server reports its port's.
@@ -251,6 +256,7 @@ def test_a_low_cts_or_dsr_pauses_the_send_until_it_rises(line, flow, signal_name
     assert result.confirmed
 
 
+@pytest.mark.slow
 def test_a_dropped_dsr_is_a_lost_line_within_a_second(line):
     baud = 9600
     pair, sim = line(baud=baud)
@@ -292,6 +298,7 @@ def test_a_macro_program_is_refused_for_a_drip_feed(run_cli, tmp_path):
     assert status == 2 and "block 3 (WHILE[#1LT3]DO1) loops or jumps" in err and "--mode upload" in err
 
 
+@pytest.mark.slow
 def test_stall_timeout_forever_waits_out_a_long_hold(line, run_cli, tmp_path):
     pair, sim = line(baud=38400, xon_after_s=1.5)
     status, _, err = run_cli("send", write(tmp_path, PROGRAM), "--port", pair.near, "--baud", 38400,
@@ -301,6 +308,7 @@ def test_stall_timeout_forever_waits_out_a_long_hold(line, run_cli, tmp_path):
     assert status == 2 and "forever" in err
 
 
+@pytest.mark.slow
 def test_an_upload_larger_than_the_memory_is_refused(run_cli, tmp_path):
     text = program_text(100)
     size = len(b"".join(b for _, b in transfer_segments(parse_program(text), profile("fanuc"))))

@@ -77,6 +77,7 @@ def framed(number, body="G0 X1.\nM30"):
     return f"%\nO{number}\n{body}\n%\n"
 
 
+@pytest.mark.slow
 def test_two_ports_sharing_one_folder_punching_at_once_lose_nothing(tmp_path):
     pairs = [PtyPair(), PtyPair()]
     server = Server(tmp_path, [p.near for p in pairs])
@@ -105,6 +106,7 @@ def test_two_ports_sharing_one_folder_punching_at_once_lose_nothing(tmp_path):
     assert len(set(names)) == 60 and {n for n in names} == {path.name for path in received.glob("*.nc")}
 
 
+@pytest.mark.slow
 def test_a_burst_of_300_small_punches_saves_all_300(tmp_path):
     pair = PtyPair()
     server = Server(tmp_path, [pair.near])
@@ -120,6 +122,7 @@ def test_a_burst_of_300_small_punches_saves_all_300(tmp_path):
     assert all((received / f"{7000 + k}.nc").read_text() == texts[k] for k in range(300))
 
 
+@pytest.mark.slow
 def test_a_punch_all_is_split_and_odd_numbers_are_saved_not_lost(tmp_path):
     pair = PtyPair()
     server = Server(tmp_path, [pair.near])
@@ -173,6 +176,7 @@ def test_a_link_in_the_received_folder_is_never_written_through(tmp_path):
     assert not server.lines("p0", "sent")
 
 
+@pytest.mark.slow
 def test_failed_punches_are_kept_with_their_reason(tmp_path):
     pair = PtyPair()
     server = Server(tmp_path, [pair.near], extra="max_punch_bytes = 2000\n")
@@ -202,6 +206,7 @@ def test_failed_punches_are_kept_with_their_reason(tmp_path):
     assert len(server.lines("p0", "failed punch")) == 2
 
 
+@pytest.mark.slow
 def test_sigterm_mid_punch_keeps_what_arrived(tmp_path):
     pair = PtyPair()
     (tmp_path / "programs").mkdir()
@@ -317,6 +322,7 @@ def test_soak_two_ports_punching_and_requesting_at_random_with_faults(tmp_path):
         assert len(server.lines(port, "sent O1234 (upload)")) == requests[int(port[1])]
 
 
+@pytest.mark.slow
 def test_a_punch_that_starts_during_a_send_is_saved(tmp_path):
     # The server uploads a long program; before it ends the control starts punching (the operator pressed
     # PUNCH): the send stops and the punch is saved, not read as the send's flow control and lost.

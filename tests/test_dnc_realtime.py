@@ -37,6 +37,7 @@ def _granted() -> bool:
     return True
 
 
+@pytest.mark.slow
 def test_the_send_runs_at_real_time_priority_and_gives_it_back():
     baud = 38400
     prog = parse_program(program_text(150))

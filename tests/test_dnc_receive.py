@@ -54,6 +54,7 @@ def test_a_file_that_appears_while_receive_waits_is_never_replaced(tmp_path):
     assert f"{target} appeared while lagsym waited and was kept; the program is saved as {beside}" in err.decode()
 
 
+@pytest.mark.slow
 def test_a_line_lost_mid_program_counts_the_bytes_that_arrived(tmp_path):
     data = b"\x12" + program_text(400).encode()
     with PtyPair() as pair:
@@ -72,6 +73,7 @@ def test_a_line_lost_mid_program_counts_the_bytes_that_arrived(tmp_path):
     assert not (tmp_path / "x.nc").exists()
 
 
+@pytest.mark.slow
 def test_receive_shows_characters_blocks_and_rate_on_a_terminal(tmp_path):
     text = program_text(200)
     master, slave = os.openpty()

@@ -96,6 +96,7 @@ def test_the_server_end_to_end_on_two_ports(tmp_path):
         lathe.close()
 
 
+@pytest.mark.slow
 def test_a_port_that_fails_does_not_stop_the_others(tmp_path):
     good = PtyPair()
     config = docs_config().replace("/dev/ttyUSB0", str(tmp_path / "no-such-port")).replace("/dev/ttyUSB1", good.near)

@@ -42,6 +42,7 @@ def whole_blocks(received: bytes) -> int:
     return max(0, len(received.replace(b"\x00", b"").split(b"\n")) - 2)
 
 
+@pytest.mark.slow
 def test_a_drip_feed_the_control_never_answered_is_exit_3(line, run_cli, tmp_path):
     # The control stops taking the program after 1500 characters while the line stays up, and it reads
     # faster than the line, so it never says XOFF: nothing ever showed that it took anything.
@@ -68,6 +69,7 @@ def test_no_handshake_expected_accepts_a_silent_control_and_says_nothing_is_conf
     assert sim.wait_for(len(expected)) and bytes(sim.received) == expected
 
 
+@pytest.mark.slow
 def test_a_control_that_dies_after_answering_is_never_credited_past_its_last_answer(line, run_cli, tmp_path):
     # The control runs slower than the line and says XOFF/XON, then stops taking the program while the
     # line stays up: it takes everything and answers nothing.  The summary credits it only with what had
@@ -86,6 +88,7 @@ def test_a_control_that_dies_after_answering_is_never_credited_past_its_last_ans
     assert 1 <= int(m[1]) <= held < 603
 
 
+@pytest.mark.slow
 def test_a_fault_after_a_silent_death_resumes_within_what_the_control_holds(line):
     # Stopped (as by SIGTERM) long after the control silently stopped taking the program: the resume block
     # comes from what surely arrived, never from what only left the port.

@@ -54,6 +54,7 @@ def test_theory_and_sampling_lebesgue_constants():
     assert f"give {lebesgue_constant(extrema(7)):.3g} and {lebesgue_constant(extrema(20)):.3g}" in theory
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("nodes", [[1.1**k for k in range(40)], [2.0**k for k in range(30)], list(range(20))],
                          ids=["geometric-1.1", "geometric-2", "equispaced-20"])
 def test_lebesgue_constant_agrees_with_60_digit_arithmetic(nodes):
@@ -171,6 +172,7 @@ def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_c
     assert f"of {int(quoted.split('raster points:')[1].split()[0]):,} points" in paper
 
 
+@pytest.mark.slow
 def test_paper_page_quotes_the_point_list_at_a_fine_step(tmp_path, run_cli):
     status, out, err = run_cli("macro", str(EXAMPLES / "paper-example-4.json"), "--scale", "20", "--tool-diameter", "4",
                                "--stepover", "0.5", "--step", "0.01", "--safe-z", "100", "--dialect", "fanuc",
@@ -222,6 +224,7 @@ def test_sampling_page_float64_basis_bound_ratio(monkeypatch):
     assert f"the same bound counted in float64 units is {ratio:.1f} times larger" in page("sampling.md")
 
 
+@pytest.mark.slow
 def test_the_roughing_page_quotes_the_roughing_macro(tmp_path, run_cli):
     """Sizes, the clearance tables' range and the extra height over the point-list roughing, recomputed."""
     import re
@@ -309,6 +312,7 @@ def test_the_toolpaths_page_quotes_the_planning_figures():
     assert "STL mesh of 360 cells a side, fine enough to come within about 5 um" in text
 
 
+@pytest.mark.slow
 def test_the_planning_benchmark_mesh_comes_within_5_um():
     """OpenCAMLib on the 360-cell mesh against the exact drop-cutter, at positions over the box."""
     ocl = pytest.importorskip("opencamlib")

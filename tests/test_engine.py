@@ -187,6 +187,7 @@ def _sample_command(out, chosen) -> str:
             "print(status, 'numba' in sys.modules)")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("policy, loads", [("compiled", True), ("numpy", False), (None, False)])
 def test_engine_option_chooses_how_a_command_evaluates(tmp_path, policy, loads):
     """``lagsym --engine compiled sample``: one large grid runs compiled (auto would not load), the same bytes."""

@@ -215,6 +215,7 @@ def test_the_compensated_basis_is_the_exact_value_rounded_once(offset, scale, lo
     assert wrong == 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shape, spread", [((5, 5), 0.25), ((7, 3), 1.5), ((2, 9), 0.0), ((14, 11), 0.1)])
 def test_a_large_batch_runs_compiled_with_the_bits_of_small_ones(shape, spread):
     load_compiled()  # large batches run compiled from here on (lagsym.evaluate.engine)

@@ -59,6 +59,7 @@ def test_a_part_may_itself_share_work_among_threads():
     assert sorted(inner) == [(0, 0), (0, 1), (1, 0), (1, 1)]
 
 
+@pytest.mark.slow
 def test_interrupted_while_waiting_the_call_raises_at_once_stops_the_blocks_and_the_next_call_works():
     stop = []
 

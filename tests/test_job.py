@@ -196,6 +196,7 @@ def _tight_hollows(f, cell, radius):
     return half + np.sqrt(np.maximum(half ** 2 - (a * d - b * c), 0)) >= 1 / radius, np.sqrt(w2)
 
 
+@pytest.mark.slow
 def test_the_job_leaves_at_most_the_finishing_guarantee(machined, job_run):
     """What the finish leaves is at most the cusp it states for its rows, plus its chordal tolerance.
 

@@ -10,7 +10,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from hypothesis import given, settings as hsettings, strategies as st
+from hypothesis import assume, given, settings as hsettings, strategies as st
 
 from conftest import EXAMPLES
 from lagsym.errors import InputError, ProgramError, ToolpathError
@@ -128,7 +128,13 @@ def test_any_grid_runs_through_rs274_or_the_simulator_onto_the_pc_raster(rs274, 
     x0, x1, y0, y1 = (float(v) * scale for v in s.grid.bounds)
     raster = RasterSpec(direction, max(x1 - x0, y1 - y0) / 7, max(x1 - x0, y1 - y0) / 11)
     settings = machine(dialect=dialect, mm_per_unit=scale, origin_mm=(3.0, -4.0, 1.5), safe_z_mm=9e4)
-    program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
+    try:
+        program = macro_program(s, settings, raster, FLAT, precision=15, tolerance_mm=1e-3)
+    except (ProgramError, ToolpathError) as e:
+        # A grid whose polynomial swings between its points past what the control reads or past the safe
+        # height is refused, in one line that says so; the property is about the programs written.
+        assert "\n" not in str(e) and (" control reads " in str(e) or str(e).startswith("safe Z")), e
+        assume(False)
     if dialect == "linuxcnc":
         path = tmp_path_factory.mktemp("any") / "any.ngc"
         path.write_text(program.text)
@@ -535,6 +541,7 @@ def _tightest_radius_ex4() -> tuple[float, float, float]:
     return 1.0 / best[0], best[1], best[2]
 
 
+@pytest.mark.slow
 def test_the_largest_ball_is_stated_from_the_safe_side_and_never_contradicts_the_refusal():
     """Example 4's tightest hollow, 2.5971 mm by brute force at the box edge, lies between the 1001 x 1001
     samples (2.61 mm there): the ball allowed is 2 x 2.5971 rounded down, a 5.2 mm ball is refused, and the
@@ -767,6 +774,7 @@ def test_a_surface_macro_computes_z_at_the_position_the_control_goes_to(rs274, t
     assert got[:, :2].min() >= 1 / 3 and got[:, :2].max() <= 7 / 3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
 def test_a_ball_end_macro_never_goes_below_the_cutter_location_where_the_control_goes(rs274, tmp_path, dialect):
     """The README's 4 mm ball on Example 4 (scale 20): Z at or above a brute-force drop-cutter at the rounded X, Y.
@@ -833,6 +841,7 @@ def test_a_heidenhain_surface_macro_stays_above_the_surface_where_the_tnc_goes()
     assert np.all(got[:200, 2] - plain >= lift - 2e-6)  # every Z raised by the bound
 
 
+@pytest.mark.slow
 def test_a_heidenhain_ball_macro_stays_above_the_cutter_location_where_the_tnc_goes():
     """The README's 4 mm ball on Example 4 (scale 20) as a Heidenhain macro: above a brute-force drop-cutter
     at every position within a unit of the one computed, Z truncated to the last decimal."""

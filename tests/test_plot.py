@@ -392,6 +392,7 @@ def test_figures_leave_the_global_theme_alone(surface2):
     assert pv.global_theme.to_dict() == before
 
 
+@pytest.mark.slow
 def test_jupyter_shows_a_static_image_headless(tmp_path):
     """A notebook run headless, as CI runs one, gets the figure inline as a PNG."""
     import nbclient
@@ -457,6 +458,7 @@ print(status, dict(os.environ) == before, backend.rendering_backend(), window, c
 """
 
 
+@pytest.mark.slow
 def test_a_figure_leaves_the_process_environment_as_it_was(tmp_path):
     """The offscreen backend is handed to VTK while it makes a window, not written into the process's environment:
     after a picture, the variables (and those a child process inherits) are those the process started with."""
@@ -486,6 +488,7 @@ def test_the_rendering_environment_is_restored_after_an_error(monkeypatch):
     assert os.environ["DISPLAY"] == ":5" and "LAGSYM_TEST_WINDOW" not in os.environ
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux", reason="Xvfb is the Linux fallback")
 def test_the_xvfb_fallback_leaves_the_process_environment_as_it_was(tmp_path):
     """Where neither EGL nor OSMesa works: the private server's DISPLAY is seen by VTK's window alone."""
@@ -501,6 +504,7 @@ def test_the_xvfb_fallback_leaves_the_process_environment_as_it_was(tmp_path):
     assert (tmp_path / "a.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_pictures_without_ipython(tmp_path):
     """A plain install has no IPython: pictures are drawn all the same (pyvista's notebook setting is skipped)."""
     code = (

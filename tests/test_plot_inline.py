@@ -270,6 +270,7 @@ def test_ipython_without_a_shell_is_left_alone():
     assert out == "None False"
 
 
+@pytest.mark.slow
 def test_a_notebook_shows_the_surface_as_the_last_expression(opengl, tmp_path):
     """In a real kernel, importing lagsym is enough: the cell's result carries the HTML and the LaTeX."""
     import nbclient

@@ -124,6 +124,7 @@ def small_surfaces(draw):
     return lagrange_surface(grid_from_table(xs, ys, zs))
 
 
+@pytest.mark.slow
 @settings(max_examples=12)
 @given(small_surfaces(), st.sampled_from(POINT_DIALECTS), st.sampled_from(["mm", "inch"]),
        st.floats(0.0, 12.0), st.sampled_from(["ball", "flat"]), st.floats(-50.0, 50.0), st.integers(1, 9999))

@@ -67,6 +67,7 @@ def test_dprnt_output_received_as_probe_results_then_fitted(tmp_path):
     assert at.max() <= stated + TOLERANCE + 5e-4, (at.max(), stated)
 
 
+@pytest.mark.slow
 def test_a_dprnt_stream_cut_mid_line_is_refused_naming_the_node(tmp_path):
     lines = _printed()
     data = "".join(line + "\r\n" for line in lines).encode("ascii")
@@ -83,6 +84,7 @@ def test_a_dprnt_stream_cut_mid_line_is_refused_naming_the_node(tmp_path):
     assert not target.exists()
 
 
+@pytest.mark.slow
 def test_the_dnc_server_keeps_probe_results_and_refuses_a_missing_node(tmp_path):
     """A DPRNT punch to ``lagsym dnc serve``: kept as probe-results.txt; one with a node missing in failed/."""
     import os

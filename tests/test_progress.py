@@ -113,6 +113,7 @@ def test_nobody_listening_costs_nothing_and_prefixes_name_the_stage():
     assert prefixed(None, "x") is None
 
 
+@pytest.mark.slow
 def test_plan_toolpath_reports_the_fine_samples_then_the_checks(surface):
     from lagsym.machine import Placement, RasterSpec, Tool
     from lagsym.toolpath import plan_toolpath
@@ -128,6 +129,7 @@ def test_plan_toolpath_reports_the_fine_samples_then_the_checks(surface):
     assert np.array_equal(tp.points_mm, quiet.points_mm) and np.array_equal(tp.rows, quiet.rows)
 
 
+@pytest.mark.slow
 def test_rough_toolpath_reports_the_samples_then_the_rows(surface):
     from lagsym.machine import MachineSettings, Tool
     from lagsym.toolpath.rough import RoughSpec, Stock, rough_toolpath
@@ -142,6 +144,7 @@ def test_rough_toolpath_reports_the_samples_then_the_rows(surface):
     assert np.array_equal(rp.points_mm, rough_toolpath(*args).points_mm)
 
 
+@pytest.mark.slow
 def test_simulate_cut_reports_every_segment_swept(surface):
     from lagsym.gcode import parse_moves
     from lagsym.machine import MachineSettings, RasterSpec, Tool
@@ -209,6 +212,7 @@ step = 1
     return job
 
 
+@pytest.mark.slow
 def test_plan_job_reports_each_operation_and_its_stages(tmp_path, points_file):
     from lagsym.job import job_program, plan_job, read_job
     from lagsym.machined import machine_job
@@ -272,6 +276,7 @@ def workdir(points_file):
     return points_file.parent
 
 
+@pytest.mark.slow
 def test_toolpath_on_a_terminal_draws_a_bar_on_stderr_and_leaves_stdout_alone(workdir):
     status, out, err = _run(TOOLPATH, tty=True, cwd=workdir)
     assert status == 0, err
@@ -283,6 +288,7 @@ def test_toolpath_on_a_terminal_draws_a_bar_on_stderr_and_leaves_stdout_alone(wo
     assert piped_err == b""  # piped: nothing at all, as before bars
 
 
+@pytest.mark.slow
 def test_toolpath_piped_or_on_a_dumb_terminal_writes_only_its_summary(workdir):
     argv = TOOLPATH + ["-o", "dome.nc"]
     status, _, err = _run(argv, tty=False, cwd=workdir)
@@ -294,6 +300,7 @@ def test_toolpath_piped_or_on_a_dumb_terminal_writes_only_its_summary(workdir):
     assert dumb.replace(b"\r\n", b"\n") == err  # the terminal's own line ending apart
 
 
+@pytest.mark.slow
 def test_simulate_on_a_terminal_counts_the_blocks(workdir):
     (workdir / "loop.nc").write_text("%\nO1234\n" + MACRO + "%\n")
     status, out, err = _run(["simulate", "loop.nc"], tty=True, cwd=workdir)
@@ -302,6 +309,7 @@ def test_simulate_on_a_terminal_counts_the_blocks(workdir):
     assert _run(["simulate", "loop.nc"], tty=False, cwd=workdir)[1] == out
 
 
+@pytest.mark.slow
 def test_a_command_writing_to_a_pipe_does_not_load_rich(points_file):
     code = ("import io, sys; from lagsym.cli import main; "
             f"main({TOOLPATH[:1] + [str(points_file)] + TOOLPATH[2:]!r}, io.StringIO(), io.StringIO()); "

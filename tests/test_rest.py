@@ -72,6 +72,7 @@ def maps(rest_run):
     return dict(f=f, w=w, rough=rough, rest=rest, finished=h, plain=plain, fx=fx, fy=fy)
 
 
+@pytest.mark.slow
 def test_the_rest_job_runs_its_three_tools_in_order_and_says_which_is_rest(rest_run):
     text, printed, moves = rest_run
     assert [t for t in dict.fromkeys(m[0] for m in moves)] == [1, 3, 2]
@@ -100,6 +101,7 @@ def _above_tip(h, gx, pts, radius):
     return out
 
 
+@pytest.mark.slow
 def test_rest_roughing_leaves_its_stock_and_cuts_where_the_rough_left_material(rest_run, maps):
     """No gouge: the rest ball leaves its stock everywhere.  Every run of its feed moves (from coming down to going
     up) has material the rough left above it under the ball, and most of the box the rough had cleared already.
@@ -129,6 +131,7 @@ def test_rest_roughing_leaves_its_stock_and_cuts_where_the_rough_left_material(r
     assert round(100 * float((took > 0.5).mean())) == 47, (took > 0.5).mean()
 
 
+@pytest.mark.slow
 def test_with_the_rest_stage_the_finishing_ball_takes_at_most_half_a_millimetre(maps):
     """docs/roughing.md: what the 6 mm ball takes in one go, normal to the surface, with and without the rest.
 
@@ -149,6 +152,7 @@ def test_with_the_rest_stage_the_finishing_ball_takes_at_most_half_a_millimetre(
             and "more than 0.5 mm normal over 40.5 % of the box" in page and "at most 0.46 mm normal" in page)
 
 
+@pytest.mark.slow
 def test_rest_rapids_go_through_no_material(rest_run, maps):
     """Each run of the rest tool's rapids, pressed into the map as the moves before it left it, removes nothing."""
     _, _, moves = rest_run

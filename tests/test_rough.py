@@ -105,6 +105,7 @@ def program():
         return out.read_text(), err.getvalue()
 
 
+@pytest.mark.slow
 def test_roughing_example_4_is_gouge_free_and_clears_the_block(rs274, program):
     """No cut below surface + stock; everywhere the block is down to one step-down above what the tool reaches."""
     text, _ = program
@@ -174,6 +175,7 @@ def test_raster_roughing_leaves_at_most_a_step_down_at_the_box_edges_too(rs274, 
     assert left.min() >= STOCK - 0.002
 
 
+@pytest.mark.slow
 def test_every_roughing_position_is_above_the_flat_drop_cutter_height(rs274, program):
     """Each feed end point over the box is at least stock above the dense lattice drop-cutter height (a lower bound)."""
     text, _ = program

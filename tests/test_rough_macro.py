@@ -108,6 +108,7 @@ def test_simulated_macro_never_goes_below_the_drop_cutter_height(dialect, precis
     check_gouge_free(feed_points_between(pts), "flat", 5.0, None)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shape, diameter, corner", [("ball", 6.0, None), ("bull", 8.0, 1.0)])
 def test_ball_and_bull_macros_are_gouge_free(shape, diameter, corner):
     _, _, tool, _, _, rm, text = plan(shape, diameter, corner, dialect="linuxcnc", precision=15, step=1.5,
@@ -116,6 +117,7 @@ def test_ball_and_bull_macros_are_gouge_free(shape, diameter, corner):
     check_gouge_free(feed_points_between(pts)[::3], shape, diameter / 2, corner)
 
 
+@pytest.mark.slow
 def test_macro_is_at_or_above_the_point_list_roughing(rs274):
     """Through rs274: at every level the tip is no lower than the point-list roughing's there, to 2 um."""
     surface, settings, tool, spec, stock, rm, text = plan(dialect="linuxcnc", precision=15)
@@ -132,6 +134,7 @@ def test_macro_is_at_or_above_the_point_list_roughing(rs274):
     assert (p[near, 2] - floor[near]).min() >= -TOL
 
 
+@pytest.mark.slow
 def test_macro_clears_the_block(rs274):
     """A swept flat end over a height map: no cut into the stock, no rapid or plunge through material, and the
     block is down to the last level's tips everywhere (each at most ``K`` plus ``R |grad F|`` above ``F``)."""
@@ -180,6 +183,7 @@ def test_one_way_milling_is_refused_for_the_macro(milling):
                     MachineSettings(dialect="fanuc", mm_per_unit=20.0), precision=8)
 
 
+@pytest.mark.slow
 def test_a_job_with_a_roughing_macro_runs_in_rs274(rs274, tmp_path, run_cli):
     """The example job with its roughing as a macro: rs274 runs the loops, then the finish, as planned."""
     from test_job import job_text
@@ -294,6 +298,7 @@ def test_rough_macro_is_refused_where_the_control_cannot_hold_its_variables(run_
     assert status == 2 and "--variables small applies to a macro only" in err
 
 
+@pytest.mark.slow
 def test_a_job_file_variables_profile_is_checked_for_its_roughing_macro(run_cli, tmp_path):
     from test_job import job_text
 

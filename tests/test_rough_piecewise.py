@@ -92,6 +92,7 @@ def above_surface(ref, a, b, radius, step=0.2):
     return flat_cut(a, b, radius, gx, gy) - ref(X, Y)
 
 
+@pytest.mark.slow
 def test_rough_leaves_the_stock_on_the_pieces(tmp_path, ref, pieces):
     from lagsym.cli import main
 
@@ -105,6 +106,7 @@ def test_rough_leaves_the_stock_on_the_pieces(tmp_path, ref, pieces):
     assert STOCK_MM - 0.001 <= float(left.min()) <= STOCK_MM + 0.01
 
 
+@pytest.mark.slow
 def test_rough_macro_is_refused_in_one_line(tmp_path, pieces):
     from lagsym.cli import main
 

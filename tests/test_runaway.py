@@ -206,6 +206,7 @@ def test_the_formula_limit_docs_formats_quotes_is_in_force():
 ARC = "G02 X30. Y30. I80000. J0.\n"  # most of a circle of 80 m radius: about 145,000 pieces
 
 
+@pytest.mark.slow
 def test_a_program_of_long_arcs_is_refused_as_it_is_read_with_the_count(tmp_path, run_cli):
     # Before, 300 such lines (7 KB) exhausted memory in verify (MemoryError, exit 70).
     from lagsym.gcode import parse_moves
@@ -276,6 +277,7 @@ def test_a_job_on_too_large_a_grid_names_the_option_job_has(tmp_path, run_cli):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_sigterm_acts_within_seconds_during_the_exact_products(tmp_path):
     """A 60x60 grid of decimal nodes: its exact products took one FLINT call of several seconds, deaf to signals.
 

@@ -91,6 +91,7 @@ def _expressions(variables):
 _FANUC_VARS = ["#1", "#2", "#3", "#0", "#100", "#[#1]", "#[#1+99.]", "##1", "[#3*0.]"]  # the last: -0
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.tuples(st.sampled_from(["#1", "#2", "#100", "#101", "#[#1]", "#1", "#100", "#34"]),
                           _expressions(_FANUC_VARS),

@@ -32,6 +32,7 @@ def plan(surf, tool=Tool("ball", 6.0), raster=RasterSpec("x", 2.0, 1.0), **kw):
     return plan_toolpath(surf, tool, raster, settings.placement, settings.program, stock_to_leave_mm=settings.stock_to_leave_mm)
 
 
+@pytest.mark.slow
 def test_toolpath_is_a_frozen_value_with_read_only_arrays(example4):
     tp = plan(example4)
     assert isinstance(tp, Toolpath)
@@ -42,6 +43,7 @@ def test_toolpath_is_a_frozen_value_with_read_only_arrays(example4):
             a[0] = 0
 
 
+@pytest.mark.slow
 def test_zig_zag_rows_alternate_and_stay_in_the_box(example4):
     tp = plan(example4, raster=RasterSpec("y", 2.0, 1.0, boundary="centre"), origin_mm=(5.0, -3.0, 1.0))
     p = tp.points_mm
@@ -53,6 +55,7 @@ def test_zig_zag_rows_alternate_and_stay_in_the_box(example4):
     assert np.all(row0[:, 0] == row0[0, 0]) and row1[0, 0] - row0[0, 0] <= 2.0 + 1e-9
 
 
+@pytest.mark.slow
 def test_point_tool_path_lies_on_the_surface(example4):
     tp = plan(example4, tool=Tool("ball", 0.0), raster=RasterSpec("x", 10.0, 5.0))
     for x, y, z in tp.points_mm[::7]:
@@ -60,6 +63,7 @@ def test_point_tool_path_lies_on_the_surface(example4):
         assert z >= float(example4.exact_value(Fraction(x / 20), Fraction(y / 20))) * 20 - 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=12)
 @given(surfaces(), st.floats(0.5, 8.0), st.sampled_from(["ball", "flat"]), st.floats(0.005, 0.2),
        st.sampled_from(["x", "y"]))
@@ -87,6 +91,7 @@ def test_planned_points_between_exact_value_and_tolerance_above(surf, diameter, 
     assert np.all(p[over, 2] <= exact[over] + tp.lift_mm[over] + 1e-4)
 
 
+@pytest.mark.slow
 def test_scallop_and_tolerance_choose_the_steps(example4):
     tp = plan(example4, raster=RasterSpec("x", None, None, 0.1, 0.01), scale=4.0)
     # On Example 4's flanks the rows close up to well under the flat floor's side step.
@@ -126,6 +131,7 @@ def test_a_fixed_step_is_the_longest_move_and_points_are_added_where_the_path_be
         assert mid[2] >= brute(example4, mid[0] / 20, mid[1] / 20, 3.0 / 20) * 20 - 1e-9  # the move stays above
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("boundary, reach", [("inside", -3.0), ("centre", 0.0), ("past", 3.0)])
 def test_boundary_sets_where_the_tool_axis_goes(example4, boundary, reach):
     tp = plan(example4, tool=Tool("flat", 6.0), raster=RasterSpec("x", 4.0, 2.0, boundary=boundary))
@@ -230,6 +236,7 @@ def test_a_scallop_height_holds_normal_to_the_surface_on_a_steep_flank():
     assert 0 <= tp.cusp_at_mm[0] <= 6 and 0 <= tp.cusp_at_mm[1] <= 6
 
 
+@pytest.mark.slow
 def test_a_fixed_side_step_states_the_cusp_of_its_rows_on_a_saddle():
     """A ball's fixed side step is given the cusp predicted for its rows, and on a saddle it is what is left.
 
@@ -260,6 +267,7 @@ def test_a_fixed_side_step_states_the_cusp_of_its_rows_on_a_saddle():
     assert tp.cusp_mm >= predicted
 
 
+@pytest.mark.slow
 def test_the_command_and_the_program_header_state_the_worst_predicted_cusp(run_cli, tmp_path):
     import json
 

@@ -38,6 +38,7 @@ def ex2_program():
     return surf, tp, s, write_program(point_program(tp, s))
 
 
+@pytest.mark.slow
 def test_lagsyms_program_does_not_gouge(ex2_program):
     surf, tp, _, text = ex2_program
     report = simulate_cut(surf, parse_moves(text), tp.tool, Placement(10.0), cell_mm=0.25)
@@ -51,6 +52,7 @@ def test_lagsyms_program_does_not_gouge(ex2_program):
         report.cut_mm[0, 0] = 0.0
 
 
+@pytest.mark.slow
 def test_a_lowered_point_is_found(ex2_program):
     surf, tp, s, _ = ex2_program
     p = np.array(tp.points_mm)
@@ -63,6 +65,7 @@ def test_a_lowered_point_is_found(ex2_program):
     assert np.hypot(report.gouge_at[0] - p[k, 0], report.gouge_at[1] - p[k, 1]) <= 3.0
 
 
+@pytest.mark.slow
 def test_normal_offset_gouges_where_the_valley_is_tighter_than_the_tool():
     """The textbook offset (tip = surface point + R n - R z) against drop-cutter.
 
@@ -118,6 +121,7 @@ def test_moves_before_the_first_z_do_not_cut():
     assert report.gouge_mm == 0.0 and report.unreached_mm2 > 0.0
 
 
+@pytest.mark.slow
 def test_verify_command_exit_statuses(run_cli, tmp_path, ex2_program):
     _, _, _, text = ex2_program
     good = tmp_path / "good.ngc"
@@ -156,6 +160,7 @@ def test_toolpath_command_writes_a_program_the_interpreter_accepts(run_cli, tmp_
     assert status == 0 and out.startswith("(PAPER-EXAMPLE-2.JSON)")
 
 
+@pytest.mark.slow
 def test_a_5_um_gouge_at_one_point_fails_under_the_default_limit(ex2_program):
     # Regression: the default limit was the program's rounding plus the simulation's resolution, 5.5 um here.
     surf, tp, s, _ = ex2_program
@@ -187,6 +192,7 @@ def test_program_resolution_and_limit():
     assert gouge_limit(0.0005, 0.0) == 0.0005
 
 
+@pytest.mark.slow
 def test_a_rapid_into_the_part_is_a_rapid_crash_with_its_line(ex2_program, run_cli, tmp_path):
     surf, tp, s, text = ex2_program
     lines = text.splitlines()
@@ -205,6 +211,7 @@ def test_a_rapid_into_the_part_is_a_rapid_crash_with_its_line(ex2_program, run_c
     assert status == 1 and "RAPID CRASH" in out and f"(line {report.rapid_line})" in out
 
 
+@pytest.mark.slow
 def test_material_left_is_reported_apart_from_the_gouge(run_cli, tmp_path):
     surf = lagrange_surface(read_points(EX2))
     s = MachineSettings(dialect="linuxcnc", mm_per_unit=10.0, safe_z_mm=60.0, stock_to_leave_mm=0.3)
@@ -274,6 +281,7 @@ def test_readme_finishing_example(run_cli, tmp_path):
         assert edge.max() <= height + 0.01
 
 
+@pytest.mark.slow
 def test_verify_simulates_a_program_with_arcs(run_cli, tmp_path):
     """An arc program (G18 arcs) is simulated: no gouge, and its cut within the tolerance of the same plan's lines."""
     surf = lagrange_surface(read_points(EX2))
@@ -294,6 +302,7 @@ def test_verify_simulates_a_program_with_arcs(run_cli, tmp_path):
     assert np.abs(arcs.cut_mm - lines.cut_mm)[both].max() <= 0.005 + 0.001
 
 
+@pytest.mark.slow
 def test_a_finishing_program_with_a_subprogram_call_is_refused_not_verified(run_cli, tmp_path, ex2_program, rs274):
     """``M98 P2000`` inserted into a good program: the call moves the tool (rs274 runs the subprogram after the
     end), so verify refuses it in one line naming the block instead of passing the program without it."""

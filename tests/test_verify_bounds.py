@@ -61,6 +61,7 @@ def test_polynomial_reference_is_the_surface():
         assert abs(polynomial_heights(surf, 20.0, x, y) - exact) < 1e-9
 
 
+@pytest.mark.slow
 def test_a_4_um_gouge_between_the_cells_is_found(ex2_plan):
     """A point 4.5 um below its cutter location, off the cell centres: reported at least as deep as it is."""
     surf, tp = ex2_plan
@@ -80,6 +81,7 @@ def test_a_4_um_gouge_between_the_cells_is_found(ex2_plan):
     assert report.gouge_mm <= ref["gouge"] + 2e-4
 
 
+@pytest.mark.slow
 def test_a_deleted_row_shows_as_material_left(ex2_plan):
     surf, tp = ex2_plan
     p, rows = np.array(tp.points_mm), np.asarray(tp.rows)
@@ -99,6 +101,7 @@ def test_a_deleted_row_shows_as_material_left(ex2_plan):
     assert ref["left_normal"] > 2 * full["left_normal"]
 
 
+@pytest.mark.slow
 def test_a_rapid_through_the_part_is_not_understated(ex2_plan):
     surf, tp = ex2_plan
     p = np.array(tp.points_mm)

@@ -44,6 +44,7 @@ def _dome():
     return lagrange_surface(grid_from_table(nodes, nodes, z))
 
 
+@pytest.mark.slow
 def test_waterline_on_a_steep_flank_leaves_the_cusp_and_tolerance_at_most_and_never_gouges():
     """On the 67-76 degree flank, contours spaced for a 0.02 mm cusp leave at most that plus the chordal tolerance."""
     surf, _ = steep_flank()
@@ -62,6 +63,7 @@ def test_waterline_on_a_steep_flank_leaves_the_cusp_and_tolerance_at_most_and_ne
     assert left.min() >= -1e-4, left.min()  # below the checks' own error: no gouge
 
 
+@pytest.mark.slow
 def test_contours_run_climb_or_conventional_around_a_boss():
     """With the spindle clockwise, climb milling runs clockwise around a boss seen from above, conventional the
     other way (the signed area of each closed contour, by the shoelace formula)."""
@@ -81,6 +83,7 @@ def test_contours_run_climb_or_conventional_around_a_boss():
     assert (areas["climb"] < 0).mean() > 0.9 and (areas["conventional"] > 0).mean() > 0.9
 
 
+@pytest.mark.slow
 def test_steep_shallow_program_passes_rs274_and_states_its_threshold(run_cli, rs274, tmp_path):
     """The program rs274 runs is the plan, and it finishes the flank within the cusp and tolerance."""
     surf, _ = steep_flank()

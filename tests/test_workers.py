@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from lagsym.evaluate import surface_evaluator
 from lagsym.io import read_points
@@ -29,6 +30,7 @@ def _fresh(code: str, tmp_path, stderr: bool = False):
     return (done.stdout, done.stderr) if stderr else done.stdout
 
 
+@pytest.mark.slow
 def test_worker_processes_give_the_same_values_as_one_process(tmp_path):
     out = _fresh(
         "import numpy as np\n"
@@ -63,6 +65,7 @@ def test_one_process_runs_the_chunks_here():
         assert workers.map(lambda e, a: (e is ev, a), [(1,), (2,)]) == [(True, 1), (True, 2)]
 
 
+@pytest.mark.slow
 def test_a_script_without_a_main_guard_runs_with_workers(tmp_path):
     # A worker that imported the caller's main module again would run this script once more, without end.
     out = _fresh(
@@ -100,6 +103,7 @@ def test_with_another_thread_running_the_chunks_run_here(tmp_path):
     assert out.split() == ["False", "True"]
 
 
+@pytest.mark.slow
 def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
     # The command's SIGTERM handler raised in each worker when the pool ended it: a traceback per worker.
     out, err = _fresh(
