@@ -299,17 +299,20 @@ def _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path):
 def test_a_feed_hold_stalls_with_exit_3_and_a_resume_block_that_allows_for_the_buffer(line, run_cli, tmp_path):
     # The control's buffer fills, it says DC3, the machine stops (feed hold) and no DC1 comes: what sits
     # in its 3000-character buffer has arrived but not run, and a reset would clear it.  The machine runs at
-    # a fifth of the line rate, so the buffer fills even when a loaded computer slows the sender down.
+    # a fifth of the line rate and the program is 600 blocks (about five buffers); the control has 200
+    # characters of room above its DC3 mark, so the sender keeps up to 32 on their way (--overrun-chars), as
+    # docs/dnc.md advises, and stays well above a fifth of the line rate on a loaded computer: the buffer fills.
     baud = 38400
-    text = program_text(300)
+    text = program_text(600)
     path = write(tmp_path, text)
     # The buffer is large enough that the machine has run past the program's set-up when it fills, however
     # fast the sender: a resume then starts after it (a fault within the set-up asks for the whole program,
     # test_dnc_resume.test_a_fault_within_the_set_up_asks_for_the_program_from_the_start).
     pair, sim = line(baud=baud, ignore_xon=True, hold_on_xoff=True, drain_cps=0.2 * chars_per_s(baud),
-                     buffer_chars=3000, high_water=2800, low_water=200)
+                     buffer_chars=3000, high_water=2800, low_water=200, tolerance=200)
     status, out, err = run_cli("send", path, "--port", pair.near, "--profile", "fanuc", "--baud", baud,
-                               "--mode", "drip", "--stall-timeout", "1", "--buffer-chars", "3000", "--quiet")
+                               "--mode", "drip", "--stall-timeout", "1", "--buffer-chars", "3000",
+                               "--overrun-chars", "32", "--quiet")
     assert status == 3, err
     assert "held XOFF (DC3) for more than 1 s" in err
     assert "the line was lost" not in err and "reconnect" not in err  # a stall, told as a stall

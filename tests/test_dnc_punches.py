@@ -246,7 +246,7 @@ def test_soak_two_ports_punching_and_requesting_at_random_with_faults(tmp_path):
     # names a file that holds what it says.  LAGSYM_SOAK_S lengthens it.
     import random
 
-    duration = float(os.environ.get("LAGSYM_SOAK_S", "120"))
+    duration = float(os.environ.get("LAGSYM_SOAK_S", "60"))
     (tmp_path / "programs").mkdir()
     (tmp_path / "programs" / "1234.nc").write_text(framed(1234, "G0 X5.\nM30"))
     pairs = [PtyPair(), PtyPair()]
