@@ -368,8 +368,23 @@ class _Control:
                         self.cut()
                         return
                 self.count.value = len(self.received)
-                # A control that died in this read (past discard_after_bytes) sends no DC3 for it: this simulation
-                # answers after it has taken the whole read, a real control when the mark was crossed.
+                if crossed and self.drop_after_bytes is None:
+                    # A real control's DC3 goes out as its mark is crossed; this one goes out after the whole read,
+                    # late by however long that took on a loaded machine.  What the line brought meanwhile is
+                    # taken first, so the DC3 vouches only for what this control then holds.
+                    more = min(self.port.in_waiting, int((time.monotonic() - line_t) * self.cps))
+                    if more > 0:
+                        extra = self.port.read(more)
+                        line_t += len(extra) / self.cps
+                        self.last_byte_at = time.monotonic()
+                        for byte in extra:
+                            self.count_in += 1
+                            if self.discard_after_bytes is None or self.count_in <= self.discard_after_bytes:
+                                self.received.append(byte)
+                                self.buffered += 1
+                                self.after += 1
+                        self.count.value = len(self.received)
+                # A control that died in this read (past discard_after_bytes) sends no DC3 for it.
                 if crossed and not self.dead():
                     self.port.write(self.xoff_byte)
                     self.pending_now, self.tail = self.port.in_waiting, self.after

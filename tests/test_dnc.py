@@ -286,7 +286,8 @@ def _resume_and_check(line, run_cli, path, text, baud, first, err, tmp_path):
     assert status == 0, err2
     setup = list(resume_setup(parse_program(text), start))
     tail = blocks[start - 1:]
-    assert sim.wait_for(len("\n".join(["%"] + setup + tail + ["%"])))
+    # Everything up to the closing % and its line end, after the leader's NULs (sim.lines() ends the control).
+    assert sim.wait_for(len(profile("fanuc").leader) + len("\n".join(["%"] + setup + tail + ["%"])) + 1)
     second = sim.lines()
     assert second == ["%"] + setup + tail + ["%"]
     assert blocks[:start - 1] + second[1 + len(setup):-1] == blocks

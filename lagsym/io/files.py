@@ -16,8 +16,8 @@ from collections.abc import Iterator
 
 from ..errors import InputError
 
-__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "read_bytes", "read_text", "read_program", "event_log",
-           "EventLog"]
+__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "read_bytes", "read_text", "read_program",
+           "event_log", "EventLog"]
 
 MAX_BYTES = 64 * 1024 * 1024
 
