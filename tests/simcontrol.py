@@ -305,6 +305,36 @@ class _Control:
                 except ProcessLookupError:
                     pass
 
+    def answer(self, byte: bytes, line_t: float) -> float:
+        """Send DC3 or DC1, then take what the line had brought by then; the new ``line_t``.
+
+        A real control answers from what it holds the moment it answers;
+        this simulation runs late now and then on a loaded machine, so what
+        arrived (by the line's clock) before its answer went out is taken
+        after it and counted as held then.  A control that stops taking the
+        program (``discard_after_bytes``) stops only after its last answer:
+        an answer vouches for everything that had come before it.
+        """
+        self.port.write(byte)
+        sent = time.monotonic()
+        if self.drop_after_bytes is not None:
+            return line_t
+        more = min(self.port.in_waiting, int((sent - line_t) * self.cps))
+        if more > 0:
+            extra = self.port.read(more)
+            line_t += len(extra) / self.cps
+            self.last_byte_at = time.monotonic()
+            for value in extra:
+                self.count_in += 1
+                self.received.append(value)
+                self.buffered += 1
+                if self.xoff:
+                    self.after += 1
+            if self.discard_after_bytes is not None:
+                self.discard_after_bytes = max(self.discard_after_bytes, self.count_in)
+            self.count.value = len(self.received)
+        return line_t
+
     def dead(self) -> bool:
         """Past ``discard_after_bytes``: the control takes what comes and answers nothing."""
         return self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes
@@ -368,25 +398,9 @@ class _Control:
                         self.cut()
                         return
                 self.count.value = len(self.received)
-                if crossed and self.drop_after_bytes is None:
-                    # A real control's DC3 goes out as its mark is crossed; this one goes out after the whole read,
-                    # late by however long that took on a loaded machine.  What the line brought meanwhile is
-                    # taken first, so the DC3 vouches only for what this control then holds.
-                    more = min(self.port.in_waiting, int((time.monotonic() - line_t) * self.cps))
-                    if more > 0:
-                        extra = self.port.read(more)
-                        line_t += len(extra) / self.cps
-                        self.last_byte_at = time.monotonic()
-                        for byte in extra:
-                            self.count_in += 1
-                            if self.discard_after_bytes is None or self.count_in <= self.discard_after_bytes:
-                                self.received.append(byte)
-                                self.buffered += 1
-                                self.after += 1
-                        self.count.value = len(self.received)
                 # A control that died in this read (past discard_after_bytes) sends no DC3 for it.
                 if crossed and not self.dead():
-                    self.port.write(self.xoff_byte)
+                    line_t = self.answer(self.xoff_byte, line_t)
                     self.pending_now, self.tail = self.port.in_waiting, self.after
                     # Time the simulation lost between its previous look and this DC3 (descheduled before
                     # or after the read) is its own lateness, not the sender's: excuse what came in then.
@@ -403,7 +417,7 @@ class _Control:
             if self.xoff and not self.ignore_xon and drop_at is None and not self.dead() and self.buffered <= self.low:
                 self.close_episode()
                 self.xoff = False
-                self.port.write(self.xon_byte)
+                line_t = self.answer(self.xon_byte, line_t)
             time.sleep(_LOOP_S)
 
 

@@ -80,10 +80,14 @@ def test_a_control_that_dies_after_answering_is_never_credited_past_its_last_ans
     text = program_text(603)
     status, out, err = run_cli("send", write(tmp_path, text), "--port", pair.near, "--baud", baud, "--mode", "drip",
                                "--stall-timeout", "20")
-    assert status == 0, err
-    m = re.search(r"the last after block (\d+): block \1 surely reached it; the blocks after it left the port but "
-                  r"nothing shows that the control holds them", out)
-    assert m, out
+    if status == 3:  # it stopped inside an XOFF (when depends on the machine's load): a stall, told truly
+        assert "the control held XOFF (DC3) for more than 20 s" in err, err
+        m = re.search(r"block (\d+) surely reached the control", err)
+    else:
+        assert status == 0, err
+        m = re.search(r"the last after block (\d+): block \1 surely reached it; the blocks after it left the port "
+                      r"but nothing shows that the control holds them", out)
+    assert m, out + err
     held = whole_blocks(sim.stop()["received"])
     assert 1 <= int(m[1]) <= held < 603
 
