@@ -47,7 +47,7 @@ def png_size(data: str) -> tuple[int, int]:
 
 
 def outputs(nb) -> list[list[tuple]]:
-    """What each code cell printed and displayed: text exactly, each picture as its size.
+    """What each code cell printed and displayed: text exactly (a stream whole), each picture as its size.
 
     A picture is compared by its size only: the same scene rendered by
     another OpenGL driver differs in a few pixels.
@@ -59,7 +59,11 @@ def outputs(nb) -> list[list[tuple]]:
         seen = []
         for out in cell.get("outputs", []):
             if out.output_type == "stream":
-                seen.append(("stream", out.name, out.text))
+                # A stream arrives in pieces as the kernel flushes it, which timing decides: compare it whole.
+                if seen and seen[-1][:2] == ("stream", out.name):
+                    seen[-1] = ("stream", out.name, seen[-1][2] + out.text)
+                else:
+                    seen.append(("stream", out.name, out.text))
             elif out.output_type == "error":
                 seen.append(("error", out.ename, out.evalue))
             else:
