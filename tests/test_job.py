@@ -126,25 +126,18 @@ def stamp_ball(h, gx, gy, pts, radius):
     ix0 = np.rint((pts[:, 0] - gx[0]) / cell).astype(int)
     iy0 = np.rint((pts[:, 1] - gy[0]) / cell).astype(int)
     flat = h.reshape(-1)
-    if len(pts) * (2 * k + 1) ** 2 <= 2_000_000:  # a few points: every offset at once
-        off = np.arange(-k, k + 1)
-        ix, iy = ix0[:, None, None] + off[None, :, None], iy0[:, None, None] + off[None, None, :]
-        ix, iy = np.broadcast_arrays(ix, iy)
+    off = np.arange(-k, k + 1)
+    step = max(1, 2_000_000 // (2 * k + 1) ** 2)  # points at a time, every offset of each at once
+    for s in range(0, len(pts), step):
+        p = pts[s:s + step]
+        ix, iy = np.broadcast_arrays(ix0[s:s + step, None, None] + off[None, :, None],
+                                     iy0[s:s + step, None, None] + off[None, None, :])
         ok = (ix >= 0) & (ix < len(gx)) & (iy >= 0) & (iy < len(gy))
-        d2 = ((gx[np.clip(ix, 0, len(gx) - 1)] - pts[:, 0, None, None]) ** 2
-              + (gy[np.clip(iy, 0, len(gy) - 1)] - pts[:, 1, None, None]) ** 2)
+        d2 = ((gx[np.clip(ix, 0, len(gx) - 1)] - p[:, 0, None, None]) ** 2
+              + (gy[np.clip(iy, 0, len(gy) - 1)] - p[:, 1, None, None]) ** 2)
         ok &= d2 <= radius * radius
-        z = np.broadcast_to(pts[:, 2, None, None], d2.shape)[ok] + radius - np.sqrt(radius * radius - d2[ok])
+        z = np.broadcast_to(p[:, 2, None, None], d2.shape)[ok] + radius - np.sqrt(radius * radius - d2[ok])
         np.minimum.at(flat, ix[ok] * len(gy) + iy[ok], z)
-        return
-    for i in range(-k, k + 1):
-        for j in range(-k, k + 1):
-            ix, iy = ix0 + i, iy0 + j
-            ok = (ix >= 0) & (ix < len(gx)) & (iy >= 0) & (iy < len(gy))
-            d2 = (gx[np.clip(ix, 0, len(gx) - 1)] - pts[:, 0]) ** 2 + (gy[np.clip(iy, 0, len(gy) - 1)] - pts[:, 1]) ** 2
-            ok &= d2 <= radius * radius
-            z = pts[ok, 2] + radius - np.sqrt(radius * radius - d2[ok])
-            np.minimum.at(flat, ix[ok] * len(gy) + iy[ok], z)
 
 
 def _densified(moves, spacing):
