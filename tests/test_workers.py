@@ -144,3 +144,40 @@ def test_a_chunk_reaches_the_kernel_as_a_worker_receives_it(monkeypatch):
         # What a worker receives is a pickled task; the evaluator's coefficients it inherits by the fork.
         there = here[:1] + [numba.typeof(pickle.loads(pickle.dumps(a))) for a in args[1:]]
         assert here == there
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
+def test_a_signal_to_the_whole_process_group_stops_a_parallel_plan_at_once(tmp_path, sig):
+    # A closed terminal (SIGHUP), `timeout` or a service manager (SIGTERM) signal the whole group: the workers die
+    # with the command, one of them perhaps while it holds the result queue's lock, on which Pool.terminate
+    # waited for ever (4 stops in 6 hung).  Four stops at random moments of the plan, each within seconds.
+    import random
+    import signal
+    import time
+
+    signum = getattr(signal, sig)
+    rng = random.Random(sig)
+    out = tmp_path / "tp.nc"
+    cmd = [sys.executable, "-m", "lagsym", "toolpath", str(EXAMPLES / "paper-example-4.json"), "--scale", "20",
+           "--tool-diameter", "6", "--stepover", "0.1", "--step", "0.05", "--safe-z", "80", "-o", str(out)]
+    for _ in range(4):
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                start_new_session=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+        children = f"/proc/{proc.pid}/task/{proc.pid}/children"
+        deadline = time.monotonic() + 120
+        while len(open(children).read().split()) < 2:  # the plan's workers run
+            assert proc.poll() is None and time.monotonic() < deadline, "the plan started no workers"
+            time.sleep(0.02)
+        time.sleep(rng.uniform(0.1, 1.5))
+        os.killpg(proc.pid, signum)
+        try:
+            _, err = proc.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+            pytest.fail(f"{sig} to the process group: the command still ran 30 s later")
+        assert proc.returncode == 128 + signum and f"stopped by {sig}" in err and err.count("\n") == 1, err
+        assert not out.exists()
+        with pytest.raises(ProcessLookupError):  # no worker outlives the command
+            os.killpg(proc.pid, 0)

@@ -16,6 +16,7 @@ result is the same whichever process computes it.
 from __future__ import annotations
 
 import multiprocessing
+import multiprocessing.pool as mp_pool
 import signal
 import threading
 
@@ -48,6 +49,29 @@ def _start(evaluator) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _abandon(pool) -> None:
+    """End a pool that an error or a signal stops: its workers killed, its queues left alone.
+
+    A signal sent to the whole process group (a closed terminal's SIGHUP,
+    ``timeout``, a service manager's SIGTERM) also kills the workers, and one
+    killed while it wrote a result still holds the result queue's lock:
+    ``Pool.terminate`` then waits for that lock for ever (4 stops in 6 hung
+    so).  So the handler threads are told to stop (the worker handler would
+    fork replacements), every worker is killed and reaped, and the pool's
+    own clean-up at exit, which takes the same lock, is cancelled.  Pool
+    offers no public call for this; the attributes used are those of
+    CPython's ``multiprocessing.pool`` since 3.8.
+    """
+    for handler in (pool._worker_handler, pool._task_handler, pool._result_handler):
+        handler._state = mp_pool.TERMINATE
+    pool._state = mp_pool.TERMINATE
+    for process in pool._pool:
+        process.kill()
+    for process in pool._pool:
+        process.join()
+    pool._terminate.cancel()
+
+
 def _call(task):
     fn, args = task
     return fn(_EVALUATOR, *args)
@@ -73,11 +97,15 @@ class Workers:
             self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator,))
         return self
 
-    def __exit__(self, *exc) -> None:
-        if self._pool is not None:
-            self._pool.terminate()
-            self._pool.join()
-            self._pool = None
+    def __exit__(self, exc_type, *exc) -> None:
+        pool, self._pool = self._pool, None
+        if pool is None:
+            return
+        if exc_type is None:
+            pool.terminate()
+            pool.join()
+        else:
+            _abandon(pool)
 
     @property
     def parallel(self) -> bool:
