@@ -27,6 +27,24 @@ settings.load_profile("ci" if os.environ.get("CI") else "dev")
 from systempackages import SYSTEM_PACKAGES, missing_system_package, need_opengl  # noqa: E402,F401
 
 
+def pytest_configure(config):
+    """Fill Numba's cache once, before pytest-xdist starts its workers, when it holds no cutter kernel.
+
+    On a fresh clone every worker would otherwise compile the same kernels at
+    the same time, each for itself; compiled once here (every cutter shape and
+    the evaluation kernels, in a process of its own so this one loads no
+    Numba), the workers load them.
+    """
+    if hasattr(config, "workerinput"):
+        return
+    from lagsym.toolpath.warmup import cache_folder, kernel_cached
+
+    if cache_folder() is not None and not kernel_cached():
+        import subprocess
+
+        subprocess.run([sys.executable, "-m", "lagsym.toolpath.warmup"], check=False)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _cutter_kernel_compiled():
     """The cutter kernel compiled into Numba's cache before any test runs.
