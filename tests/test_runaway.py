@@ -19,6 +19,8 @@ from lagsym import LagsymError, curve_from_points, grid_from_table, lagrange_cur
 from lagsym.evaluate import chebyshev_transform
 from lagsym.exactsize import MAX_EXACT_MB, exact_size_mb
 
+from conftest import EXAMPLES
+
 MEMORY = 2 * 1024**3
 
 
@@ -303,3 +305,26 @@ def test_sigterm_acts_within_seconds_during_the_exact_products(tmp_path):
     waited = time.monotonic() - sent
     assert proc.returncode == 128 + signal.SIGTERM and "stopped by SIGTERM" in err
     assert waited < 3.0, f"SIGTERM acted after {waited:.1f} s"
+
+
+def test_a_tolerance_finer_than_the_written_positions_is_refused_at_once(tmp_path, run_cli):
+    """A job's ``tolerance = 0.000001`` planned for minutes inside the workers (8.8 million samples, under the
+    point limit); it cannot be held at 3 decimals anyway.  Every strategy refuses it in one line naming the figures,
+    and more decimals let it through."""
+    import time
+
+    job = (EXAMPLES / "example-4-job.toml").read_text().replace("step = 0.2", "step = 0.2\ntolerance = 0.000001")
+    (tmp_path / "paper-example-4.json").write_text((EXAMPLES / "paper-example-4.json").read_text())
+    (tmp_path / "job.toml").write_text(job)
+    started = time.monotonic()
+    status, out, err = run_cli("job", str(tmp_path / "job.toml"), "-o", str(tmp_path / "job.ngc"))
+    assert status == 2 and err.count("\n") == 1, err
+    assert "job.toml: operations[1] (finish): a chordal tolerance of 1e-06 mm is finer than the 0.001 mm" in err
+    assert time.monotonic() - started < 60 and not (tmp_path / "job.ngc").exists()
+    points = str(EXAMPLES / "paper-example-4.json")
+    for extra in ([], ["--strategy", "waterline", "--scallop", "0.05"]):
+        status, _, err = run_cli("toolpath", points, "--tolerance", "0.0005", *extra, "-o", str(tmp_path / "a.nc"))
+        assert status == 2 and "a chordal tolerance of 0.0005 mm is finer than the 0.001 mm" in err, err
+    status, _, err = run_cli("toolpath", points, "--tolerance", "0.0005", "--decimals", "4", "--stepover", "0.5",
+                             "-o", str(tmp_path / "a.nc"))
+    assert status == 0, err

@@ -46,8 +46,8 @@ import numpy as np
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator
 
-__all__ = ["tolerance_step", "forward_steps", "bends", "semi_convex_sag", "move_sags", "move_rises", "crosses_box_edge",
-           "bent_moves", "check_moves", "lift"]
+__all__ = ["tolerance_step", "check_tolerance", "forward_steps", "bends", "semi_convex_sag", "move_sags", "move_rises",
+           "crosses_box_edge", "bent_moves", "check_moves", "lift"]
 
 _CHECK_SAMPLES = 6  # interior samples of a checked move, at least
 _CHECK_SPLITS = 40  # at most this many rounds of splitting
@@ -298,6 +298,18 @@ def lift(sag: np.ndarray) -> np.ndarray:
     return out
 
 
+def check_tolerance(tolerance_mm: float, program) -> None:
+    """Refuse a chordal tolerance finer than the positions the program writes: it cannot be held there.
+
+    Such a tolerance also asks for samples far closer than the written
+    positions can tell apart (1e-6 mm planned for minutes before).
+    """
+    if tolerance_mm < program.resolution_mm:
+        raise ToolpathError(f"a chordal tolerance of {tolerance_mm:g} mm is finer than the {program.resolution_mm:g} mm "
+                            f"the program writes positions in (decimals {program.digits}), so it cannot be held: "
+                            f"give a tolerance of at least {program.resolution_mm:g} mm, or more decimals (--decimals)")
+
+
 def forward_steps(ev: SurfaceEvaluator, tolerance_mm: float, step_mm: float | None, mm_per_unit: float,
                   program) -> tuple[float, float]:
     """A raster's longest move (mm) and the finer sampling step the filter chooses points from (mm).
@@ -306,7 +318,7 @@ def forward_steps(ev: SurfaceEvaluator, tolerance_mm: float, step_mm: float | No
     quarter of the tolerance, and with a fixed step at most half of it.  A
     program (:class:`~lagsym.machine.ProgramFormat`) that writes positions
     as far apart as the sampling step or further is refused: its samples would fall
-    on one another.
+    on one another, and so is a tolerance finer than the positions it writes.
     """
     fine = tolerance_step(ev, tolerance_mm, mm_per_unit)
     step, fine = (fine, fine) if step_mm is None else (step_mm, min(step_mm / 2.0, fine))
@@ -314,4 +326,5 @@ def forward_steps(ev: SurfaceEvaluator, tolerance_mm: float, step_mm: float | No
         raise ToolpathError(f"decimals {program.digits} write positions {program.resolution_mm:g} mm apart, not finer "
                             f"than the sampling step of {fine:.3g} mm: give more decimals (--decimals), or a "
                             f"larger --step and --tolerance")
+    check_tolerance(tolerance_mm, program)
     return step, fine

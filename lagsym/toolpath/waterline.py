@@ -150,6 +150,7 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     ev = evaluator or surface_evaluator(surface)
     mpu = placement.mm_per_unit
     tol = raster.chordal_tolerance_mm
+    chordal.check_tolerance(tol, program)
     cl, past, reach = cutter_and_reach(surface, ev, tool, raster, placement, program,
                                        stock_to_leave_mm=stock_to_leave_mm)
     nx, ny = (math.ceil((reach[k + 1] - reach[k]) * mpu / GRID_MM) + 1 for k in (0, 2))
