@@ -57,12 +57,19 @@ def test_the_first_command_leaves_the_kernel_compiled_for_the_first_plan(tmp_pat
     cache = tmp_path / "numba-cache"
     env = {k: v for k, v in os.environ.items() if k != "LAGSYM_NO_BACKGROUND_COMPILE"}
     env["NUMBA_CACHE_DIR"] = str(cache)
-    eq = subprocess.run([sys.executable, "-m", "lagsym", "equation", str(EXAMPLES / "paper-example-1.json")], env=env,
-                        capture_output=True, text=True, timeout=120)
+    # Run where the README runs it: in a clone, whose sources are another lagsym than the one installed (here a
+    # decoy).  The background process used to import the clone's (``-m`` looks in the working folder first) and
+    # fill its cache, so the installed kernel compiled again in the first plan.
+    clone = tmp_path / "clone"
+    (clone / "lagsym").mkdir(parents=True)
+    (clone / "lagsym" / "__init__.py").write_text("open(__file__ + '.imported', 'w').close()\n")
+    eq = subprocess.run([sys.executable, "-P", "-m", "lagsym", "equation", str(EXAMPLES / "paper-example-1.json")],
+                        env=env, cwd=clone, capture_output=True, text=True, timeout=120)
     assert eq.returncode == 0 and eq.stderr == "", eq.stderr
     # the background process compiles the cutter kernel, then the evaluation kernels: wait for the last index
     deadline = time.monotonic() + 600
     while not (any(cache.rglob("kernel.drop_chunk-*.nbi")) and any(cache.rglob("compiled.points_kernel-*.nbi"))):
+        assert not (clone / "lagsym" / "__init__.py.imported").exists(), "the background compile took the clone's"
         assert time.monotonic() < deadline, "the background compile left no kernel in the cache"
         time.sleep(0.5)
     r = _run(tmp_path, cache)

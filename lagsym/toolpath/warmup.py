@@ -65,9 +65,11 @@ def start_in_background() -> bool:
     if os.environ.get(OFF) == "1" or cache_folder() is None or kernel_cached():
         return False
     try:
+        # Run from the folder that holds this lagsym: ``-m`` looks in the working folder first, and a user's
+        # working folder may be a clone with the sources of another (whose cache would be filled instead).
         subprocess.Popen([sys.executable, "-m", "lagsym.toolpath.warmup"], stdin=subprocess.DEVNULL,
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
-                         close_fds=True)
+                         close_fds=True, cwd=_KERNEL.parents[2])
     except OSError:
         return False
     return True
