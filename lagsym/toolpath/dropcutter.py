@@ -301,19 +301,22 @@ class _Lattice(NamedTuple):
 def telling_compiles(progress: Progress | None):
     """A block in which a compilation of the kernel that keeps the caller waiting over two seconds is reported to
     ``progress`` as the stage :data:`~lagsym.progress.COMPILING` (a first run after an install); numba is loaded.
+    Where the background process started after the install is compiling it, the block waits for it first.
 
     Keep the block to one small drop: the report comes from a timer thread,
     and no other report may be made meanwhile.
     """
     from .compiling import told_if_compiling
+    from .kernelcache import wait_for_background
 
     told = []
 
     def tell() -> None:
-        told.append(True)
-        if progress is not None:
+        if not told and progress is not None:
             progress(0, None, COMPILING)
+        told.append(True)
 
+    wait_for_background(tell)  # a plan just after an install: the kernel is being compiled in the background
     with told_if_compiling(tell):
         yield
     if told and progress is not None:

@@ -9,10 +9,13 @@ cutter kernel yet, :func:`start_in_background` starts a detached process at
 low priority that runs the kernels once on a tiny surface, filling the cache:
 the README's first command (``lagsym equation``) leaves the kernels ready for
 the ``toolpath`` that follows (and the large evaluations of ``sample`` and
-``verify``).  A command that plans before the cache is
-filled compiles the kernel itself and says so (:mod:`.compiling`).
+``verify``).  The process holds a lock in the cache while it compiles, so
+no second one starts beside it, and a plan that starts meanwhile waits for
+the kernel rather than compiling it a second time (both say so,
+:mod:`.kernelcache`); a plan with no kernel cached and none compiling
+compiles it itself and says so (:mod:`.compiling`).
 
-Nothing here imports Numba: the check is a look for the cache's index file.
+Nothing here imports Numba: the checks look for the cache's index file and lock (:mod:`.kernelcache`).
 ``LAGSYM_NO_BACKGROUND_COMPILE=1`` turns the background process off.  Where
 the cache would not be beside the modules or under ``NUMBA_CACHE_DIR`` (a
 read-only install), nothing is started, so no command starts a process
@@ -21,38 +24,15 @@ that cannot leave its work behind.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import subprocess
 import sys
-from pathlib import Path
+
+from .kernelcache import KERNEL_FILE, cache_folder, compiling_in_background, holding_lock, kernel_cached
 
 __all__ = ["OFF", "cache_folder", "kernel_cached", "start_in_background", "compile_kernels"]
 
 OFF = "LAGSYM_NO_BACKGROUND_COMPILE"
-_KERNEL = Path(__file__).resolve().with_name("kernel.py")
-
-
-def cache_folder(module: Path = _KERNEL) -> Path | None:
-    """Where Numba keeps the machine code of ``module``: under ``NUMBA_CACHE_DIR`` or beside it (None: elsewhere).
-
-    The same rule as Numba's own cache locators: ``NUMBA_CACHE_DIR`` holds a
-    folder named after the module's folder and a SHA-1 of its path; else the
-    ``__pycache__`` beside the module, if it can be written.
-    """
-    root = os.environ.get("NUMBA_CACHE_DIR")
-    folder = module.parent
-    if root:
-        return Path(root) / f"{folder.name}_{hashlib.sha1(str(folder).encode()).hexdigest()}"
-    cache = folder / "__pycache__"
-    writable = os.access(cache, os.W_OK) if cache.exists() else os.access(folder, os.W_OK)
-    return cache if writable else None
-
-
-def kernel_cached(folder: Path | None = None) -> bool:
-    """Whether the cache already holds an index of the cutter kernel's machine code."""
-    folder = cache_folder() if folder is None else folder
-    return folder is not None and any(folder.glob(f"{_KERNEL.stem}.drop_chunk-*.nbi"))
 
 
 def start_in_background() -> bool:
@@ -62,14 +42,14 @@ def start_in_background() -> bool:
     at low priority, reads and writes nothing the user sees, and a failure
     to start it is not an error: the next plan compiles as before.
     """
-    if os.environ.get(OFF) == "1" or cache_folder() is None or kernel_cached():
+    if os.environ.get(OFF) == "1" or cache_folder() is None or kernel_cached() or compiling_in_background():
         return False
     try:
         # Run from the folder that holds this lagsym: ``-m`` looks in the working folder first, and a user's
         # working folder may be a clone with the sources of another (whose cache would be filled instead).
         subprocess.Popen([sys.executable, "-m", "lagsym.toolpath.warmup"], stdin=subprocess.DEVNULL,
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
-                         close_fds=True, cwd=_KERNEL.parents[2])
+                         close_fds=True, cwd=KERNEL_FILE.parents[2])
     except OSError:
         return False
     return True
@@ -101,4 +81,6 @@ if __name__ == "__main__":
         os.nice(10)  # behind whatever the user runs next
     except OSError:
         pass
-    compile_kernels()
+    with holding_lock(cache_folder()) as mine:
+        if mine:
+            compile_kernels()
