@@ -30,6 +30,7 @@ _EXPORTS = {
     "io": ("read_points", "read_curve_points", "read_any_points"),
     "grid": ("ControlGrid", "CurvePoints", "grid_from_points", "grid_from_table", "curve_from_points"),
     "lagrange": ("LagrangeCurve", "LagrangeSurface", "lagrange_curve", "lagrange_surface", "lagrange_basis"),
+    "exactsize": ("exact_time_limit",),
     "fit": ("SurfaceFit", "fit_surface"),
     "conditioning": ("require_conditioning", "amplification"),
     "evaluate": ("SurfaceEvaluator", "surface_evaluator", "evaluate_points", "evaluate_grid", "evaluate_curve",
@@ -133,6 +134,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .errors import (ConditioningError, ExitStatus, FormulaError, GridError, InputError, LagsymError, ProgramError, RenderError,
                          ToolpathError, TransferError)
     from .cad import BezierPatch, BSplinePatch, bezier_patch, cad_patch
+    from .exactsize import exact_time_limit
     from .evaluate import (Engine, SurfaceEvaluator, evaluate_curve, evaluate_grid, evaluate_points, lambdify_surface,
                            surface_evaluator, use_engine)
     from .export import write_sample

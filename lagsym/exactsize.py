@@ -7,10 +7,21 @@ polynomial with the figure and the option that raises the limit, before any
 of it is made.  :func:`stepped_product` multiplies exact matrices a few rows
 at a time: a signal (Ctrl-C, SIGTERM) is acted on between steps, where one
 call into FLINT would hold the interpreter until the whole product is done.
+
+The size says little of the time: digits of many nodes' decimals cost far
+more than those of small integers.  So each exact computation (a polynomial's
+coefficients; the change of basis its numeric evaluation uses) is timed as
+its products run: once a product has run for :data:`FORESEE_SECONDS`, the
+pace of its rows gives the time the computation will take on this machine,
+and one that would take more than :func:`exact_time_limit` allows
+(:data:`MAX_EXACT_S` unless set; ``--max-exact-s``) is refused with that
+figure, a second or so into it.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import inspect
 import time
 from fractions import Fraction
@@ -20,10 +31,53 @@ import flint
 
 from .errors import InputError
 
-__all__ = ["MAX_EXACT_MB", "check_exact_size", "exact_size_mb", "stepped_product", "to_fraction"]
+__all__ = ["MAX_EXACT_MB", "MAX_EXACT_S", "ExactClock", "check_exact_size", "exact_size_mb", "exact_time_limit",
+           "stepped_product", "to_fraction"]
 
 MAX_EXACT_MB = 400  # estimated megabytes of exact rationals one polynomial may take (--max-exact-mb)
 STEP_SECONDS = 0.2  # about how long one step of a stepped product holds the interpreter: a signal waits no longer
+MAX_EXACT_S = 15.0  # seconds one exact computation may take here, foreseen from its first rows (--max-exact-s)
+FORESEE_SECONDS = 0.5  # how long a product runs before its pace foretells the whole computation's time
+_LIMIT_S: contextvars.ContextVar[float | None] = contextvars.ContextVar("exact_time_limit", default=MAX_EXACT_S)
+
+
+@contextlib.contextmanager
+def exact_time_limit(seconds: float | None):
+    """Within the block, an exact computation foreseen to take more than ``seconds`` is refused (None: no limit).
+
+    Examples
+    --------
+    >>> with exact_time_limit(60.0):
+    ...     pass
+    """
+    token = _LIMIT_S.set(None if seconds is None else float(seconds))
+    try:
+        yield
+    finally:
+        _LIMIT_S.reset(token)
+
+
+class ExactClock:
+    """The time one exact computation (``what``, from ``source``) has taken; refuses it once it foresees too long."""
+
+    def __init__(self, what: str, source=None):
+        self.what, self.source = what, source
+        self.limit = _LIMIT_S.get()
+        self.started = time.perf_counter()
+
+    def foresee(self, done: int, total: int, spent: float, products_after: int) -> None:
+        """Refuse if the computation, its current product ``done`` of ``total`` rows in after ``spent`` seconds and
+        ``products_after`` as long to follow, would end past the limit."""
+        if self.limit is None or spent < FORESEE_SECONDS or done >= total:
+            return
+        rest = spent / done * (total - done) + products_after * spent / done * total
+        foreseen = time.perf_counter() - self.started + rest
+        if foreseen > self.limit:
+            where = f"{self.source}: " if self.source else ""
+            raise InputError(f"{where}the exact {self.what} would take about {foreseen:.0f} s here (foreseen from "
+                             f"its first {done} of {total} rows), more than the limit of {self.limit:g} s; use fewer "
+                             f"points (a large grid: 'lagsym piecewise') or raise the limit (--max-exact-s, "
+                             f"exact_time_limit() in Python)")
 
 
 def _basis_bits(nodes: tuple[Fraction, ...]) -> float:
@@ -96,14 +150,18 @@ def _mb(size: float) -> str:
     return f"{size / 1000:.3g} GB" if size >= 1000 else f"{size:.3g} MB"
 
 
-def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_SECONDS) -> flint.fmpq_mat:
+def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_SECONDS, *,
+                    clock: ExactClock | None = None, products_after: int = 0) -> flint.fmpq_mat:
     """``a * b``, exact, computed a block of rows of ``a`` at a time, each block taking about ``seconds``.
 
     The first block is one row; each next one as many rows as the last
     block's pace fits in ``seconds`` (at most four times as many).  FLINT
     shares a common denominator within a block, so blocks of several rows
     cost no more than the whole product at once.  The result is the same
-    exact matrix whatever the blocks.
+    exact matrix whatever the blocks.  With a ``clock``, the computation is
+    refused once its pace foresees it past the limit
+    (:meth:`ExactClock.foresee`; ``products_after``: products as long still
+    to come).
 
     Examples
     --------
@@ -113,7 +171,7 @@ def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_
     """
     n, k, m = a.nrows(), a.ncols(), b.ncols()
     entries, out = a.entries(), []
-    i, rows = 0, 1
+    i, rows, began = 0, 1, time.perf_counter()
     while i < n:
         h = min(rows, n - i)
         start = time.perf_counter()
@@ -121,6 +179,8 @@ def stepped_product(a: flint.fmpq_mat, b: flint.fmpq_mat, seconds: float = STEP_
         spent = time.perf_counter() - start
         i += h
         rows = max(1, min(4 * h, int(h * seconds / max(spent, 1e-6))))
+        if clock is not None:
+            clock.foresee(i, n, time.perf_counter() - began, products_after)
     return flint.fmpq_mat(n, m, out)
 
 

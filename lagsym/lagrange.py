@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 import flint
 
 from .errors import InputError
-from .exactsize import MAX_EXACT_MB, check_exact_size, stepped_product
+from .exactsize import MAX_EXACT_MB, ExactClock, check_exact_size, stepped_product
 from .exactsize import to_fraction as _frac
 from .values import as_exact
 
@@ -400,7 +400,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
     check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
-    c = stepped_product(b.transpose(), yv)
+    c = stepped_product(b.transpose(), yv, clock=ExactClock(f"curve through {len(points.x)} points", points.source))
     return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())),
                          variable=_variable(x, "x"))
 
@@ -442,6 +442,7 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     bx = _basis_matrix(grid.x)
     by = _basis_matrix(grid.y)
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])
-    c = stepped_product(stepped_product(bx.transpose(), z), by)
+    clock = ExactClock(f"surface through {n} x {m} nodes", grid.source)
+    c = stepped_product(stepped_product(bx.transpose(), z, clock=clock, products_after=1), by, clock=clock)
     coeffs = tuple(tuple(_frac(c[a, b]) for b in range(m)) for a in range(n))
     return LagrangeSurface(grid=grid, coefficients=coeffs, variables=(sx, sy))

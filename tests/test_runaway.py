@@ -6,6 +6,7 @@ with a memory limit and a timeout, so that this suite itself never runs away.
 
 from __future__ import annotations
 
+import re
 import resource
 import subprocess
 import sys
@@ -17,7 +18,7 @@ import pytest
 
 from lagsym import LagsymError, curve_from_points, grid_from_table, lagrange_curve, lagrange_surface
 from lagsym.evaluate import chebyshev_transform
-from lagsym.exactsize import MAX_EXACT_MB, exact_size_mb
+from lagsym.exactsize import MAX_EXACT_MB, MAX_EXACT_S, exact_size_mb, exact_time_limit
 
 from conftest import EXAMPLES
 
@@ -168,6 +169,8 @@ def test_the_docs_quote_the_limit_and_the_figures_in_force():
     assert f"`--max-exact-mb` ({MAX_EXACT_MB} MB)" in cli and f"at most {MAX_EXACT_MB} MB (`--max-exact-mb`)" in formats
     assert "points 0.1 apart: 2.7 GB; of 500 points: 306 MB" in cli.replace("\n", " ")
     assert "a curve of 1000 points 0.1 apart (2.7 GB)" in formats
+    assert f"`--max-exact-s` ({MAX_EXACT_S:g} s)" in cli.replace("\n", " ")
+    assert f"to take more than {MAX_EXACT_S:g} s here (`--max-exact-s`)" in formats
 
 
 def test_a_power_of_powers_in_a_formula_is_refused_with_its_size_before_it_is_computed(tmp_path):
@@ -295,7 +298,8 @@ def test_sigterm_acts_within_seconds_during_the_exact_products(tmp_path):
     xs = [round(i * 0.337 + rng.random() * 0.1, 6) for i in range(60)]
     path = tmp_path / "g60.csv"
     path.write_text("x,y,z\n" + "\n".join(f"{a:.6f},{b * 1.0001:.6f},{rng.random():.4f}" for a in xs for b in xs))
-    proc = subprocess.Popen([sys.executable, "-m", "lagsym", "check", str(path)], stdout=subprocess.DEVNULL,
+    proc = subprocess.Popen([sys.executable, "-m", "lagsym", "check", str(path), "--max-exact-s", "1e6"],
+                            stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True)
     time.sleep(3.0)  # start-up and reading done; the exact products run for many seconds from here
     assert proc.poll() is None
@@ -328,3 +332,50 @@ def test_a_tolerance_finer_than_the_written_positions_is_refused_at_once(tmp_pat
     status, _, err = run_cli("toolpath", points, "--tolerance", "0.0005", "--decimals", "4", "--stepover", "0.5",
                              "-o", str(tmp_path / "a.nc"))
     assert status == 0, err
+
+
+def _decimal_grid(n: int, seed: int) -> list[tuple[str, str, str]]:
+    import random
+
+    rng = random.Random(seed)
+    xs = [f"{i}.{rng.randint(100, 999)}" for i in range(n)]
+    ys = [f"{i}.{rng.randint(100, 999)}" for i in range(n)]
+    return [(x, y, f"{rng.randint(0, 9999) / 1000:.3f}") for x in xs for y in ys]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["check", "sample"])
+def test_an_exact_computation_foreseen_past_the_time_limit_is_refused_a_few_seconds_in(tmp_path, command):
+    """'check' and 'sample' on a 100x100 grid of nodes with three decimals: 35 KB, 32 MB estimated (under the size
+    limit), over a minute of exact products.  Refused with the foreseen time, within seconds, nothing written."""
+    import time
+
+    path = tmp_path / "g100.csv"
+    path.write_text("x,y,z\n" + "".join(",".join(row) + "\n" for row in _decimal_grid(100, 3)))
+    extra = ["--nx", "20", "--ny", "20", "-o", str(tmp_path / "s.csv")] if command == "sample" else []
+    started = time.monotonic()
+    r = subprocess.run([sys.executable, "-m", "lagsym", command, str(path), *extra], capture_output=True, text=True,
+                       timeout=120)
+    waited = time.monotonic() - started
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    m = re.search(r"g100.csv: the exact surface through 100 x 100 nodes would take about (\d+) s here .* more than "
+                  r"the limit of 15 s; .*--max-exact-s", r.stderr)
+    assert m and int(m[1]) > MAX_EXACT_S, r.stderr
+    assert waited < MAX_EXACT_S, f"refused after {waited:.1f} s"
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_the_time_limit_is_the_callers_in_python():
+    grid = grid_from_table(*_table(_decimal_grid(60, 4)))
+    with exact_time_limit(1.0), pytest.raises(LagsymError, match=r"60 x 60 nodes would take about .* limit of 1 s"):
+        lagrange_surface(grid)  # about 2 s of products on an idle machine, more on a busy one
+    small = grid_from_table(*_table(_decimal_grid(4, 5)))
+    with exact_time_limit(None):
+        assert lagrange_surface(small).coefficients == lagrange_surface(small).coefficients
+
+
+def _table(rows):
+    xs = sorted({Fraction(r[0]) for r in rows})
+    ys = sorted({Fraction(r[1]) for r in rows})
+    z = {(Fraction(a), Fraction(b)): Fraction(c) for a, b, c in rows}
+    return xs, ys, [[z[(a, b)] for b in ys] for a in xs]

@@ -175,7 +175,8 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
 
         in_program_units(args)
         check_paths(args)
-        with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)):
+        with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)), \
+                _exact_time(getattr(args, "max_exact_s", None)):
             return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
@@ -197,6 +198,18 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
             err.write(f"lagsym: internal error: {type(e).__name__}: {one_line(str(e))} "
                       f"(run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+@contextlib.contextmanager
+def _exact_time(seconds: float | None):
+    """The command's exact computations under its ``--max-exact-s`` (None: a command without it, the default)."""
+    if seconds is None:
+        yield
+        return
+    from ..exactsize import exact_time_limit
+
+    with exact_time_limit(seconds):
+        yield
 
 
 @contextlib.contextmanager

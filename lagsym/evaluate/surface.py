@@ -22,7 +22,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
-from ..exactsize import stepped_product
+from ..exactsize import ExactClock, stepped_product
 from .arguments import a_surface, broadcast_pair, coordinates
 from .bounds import chebyshev_error_bound
 from .cache import ObjectCache
@@ -419,7 +419,9 @@ def _make_evaluator(surface) -> SurfaceEvaluator:
     yo, yh, ay = chebyshev_transform(g.y)
     n, m = g.shape
     power = flint.fmpq_mat(n, m, [fmpq(c) for row in surface.coefficients for c in row])
-    cheb = stepped_product(stepped_product(ax, power), ay.transpose())
+    clock = ExactClock(f"change of basis of the surface through {n} x {m} nodes (for its numeric evaluation)",
+                       g.source)
+    cheb = stepped_product(stepped_product(ax, power, clock=clock, products_after=1), ay.transpose(), clock=clock)
     # int / int is correctly rounded, as float(Fraction) is, without reducing a Fraction first
     coeffs = np.array([[int(cheb[a, b].p) / int(cheb[a, b].q) for b in range(m)] for a in range(n)])
     return SurfaceEvaluator(
