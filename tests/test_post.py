@@ -223,7 +223,9 @@ def test_every_written_z_is_at_or_above_the_cutter_location_at_the_written_x_y(r
 
     surf, f = steep_flank()
     s = MachineSettings(units=units, safe_z_mm=60.0)
-    tp = plan_toolpath(surf, Tool("ball", 2.0), RasterSpec("y", 0.35, None, None, 0.002), s.placement, s.program, stock_to_leave_mm=s.stock_to_leave_mm)
+    tol = 0.002 if units == "mm" else 0.003  # at least the 0.00254 mm an inch program writes positions in
+    tp = plan_toolpath(surf, Tool("ball", 2.0), RasterSpec("y", 0.35, None, None, tol), s.placement, s.program,
+                       stock_to_leave_mm=s.stock_to_leave_mm)
     feeds, _ = interpret(rs274, write_program(point_program(tp, s)))
     unit = 10.0 ** -s.digits / s.unit_factor
     assert np.abs(feeds[:, :2] / unit - np.rint(feeds[:, :2] / unit)).max() < 1e-6  # on the grid: nothing to round
