@@ -379,3 +379,15 @@ def _table(rows):
     ys = sorted({Fraction(r[1]) for r in rows})
     z = {(Fraction(a), Fraction(b)): Fraction(c) for a, b, c in rows}
     return xs, ys, [[z[(a, b)] for b in ys] for a in xs]
+
+
+@pytest.mark.parametrize("command", ["compare", "simulate"])
+def test_compare_and_simulate_take_the_time_limit_too(tmp_path, run_cli, command):
+    """Both build the exact surface from a points file; the limit they are refused by is one they take."""
+    path = tmp_path / "g60.csv"
+    path.write_text("x,y,z\n" + "".join(",".join(row) + "\n" for row in _decimal_grid(60, 6)))
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1000\nG21 G90\nG01 X1. Y1. Z1. F100.\nM30\n%\n")
+    args = [str(path)] if command == "compare" else [str(program), "--surface", str(path)]
+    status, _, err = run_cli(command, *args, "--max-exact-s", "0.5")
+    assert status == 2 and "60 x 60 nodes would take about" in err and "limit of 0.5 s" in err, err

@@ -64,11 +64,18 @@ def add_points_arguments(p) -> None:
 def add_exact_limit(p) -> None:
     """``--max-exact-mb`` and ``--max-exact-s``: the limits on an exact polynomial's size and time, checked before
     it is made and as its first rows show their pace."""
-    from ..exactsize import MAX_EXACT_MB, MAX_EXACT_S
+    from ..exactsize import MAX_EXACT_MB
 
     p.add_argument("--max-exact-mb", type=number(0.001, 1e9), default=MAX_EXACT_MB, metavar="MB",
                    help=f"refuse an exact polynomial whose rationals are estimated at more than MB megabytes, "
                         f"before computing it (default {MAX_EXACT_MB})")
+    add_exact_time_limit(p)
+
+
+def add_exact_time_limit(p) -> None:
+    """``--max-exact-s``: the limit on the time of each exact computation, foreseen from the pace of its first rows."""
+    from ..exactsize import MAX_EXACT_S
+
     p.add_argument("--max-exact-s", type=number(0.001, 1e9), default=MAX_EXACT_S, metavar="S",
                    help=f"refuse an exact computation (the polynomial, or the change of basis its evaluation uses) "
                         f"that its first rows show would take more than S seconds here (default {MAX_EXACT_S:g})")

@@ -7,7 +7,7 @@ from ..io import read_program
 from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, detect_dialect,
                         moves_csv, simulate)
 from ..simulate.runaway import check_lines
-from ._common import count, emit, exact
+from ._common import add_exact_time_limit, count, emit, exact
 from ._progress import progress_bar
 
 MAX_BLOCKS_LIMIT = 100_000_000  # the moves of a run this long take at most 3.7 GB
@@ -61,6 +61,7 @@ def add_arguments(p) -> None:
                         f"each takes about 11 KB while read and compiled)")
     p.add_argument("--max-idle-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_IDLE_BLOCKS, metavar="N",
                    help=f"stop after N blocks in a row without a move as a runaway loop (default {MAX_IDLE_BLOCKS})")
+    add_exact_time_limit(p)
     p.add_argument("--surface", metavar="FORMULA|FILE",
                    help="what probing moves touch: a formula in x and y, or a points or surface file (named by its "
                         "extension: .json, .csv, ...)")

@@ -81,6 +81,9 @@ if __name__ == "__main__":
         os.nice(10)  # behind whatever the user runs next
     except OSError:
         pass
-    with holding_lock(cache_folder()) as mine:
+    folder = cache_folder()
+    if folder is None:  # nowhere to keep the machine code: nothing to do for later commands
+        sys.exit(0)
+    with holding_lock(folder) as mine:
         if mine:
             compile_kernels()
