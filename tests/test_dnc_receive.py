@@ -55,16 +55,39 @@ def test_a_file_that_appears_while_receive_waits_is_never_replaced(tmp_path):
 
 
 @pytest.mark.slow
+def _bytes_read(pid: int) -> int:
+    with open(f"/proc/{pid}/io") as f:
+        return int(re.search(r"rchar: (\d+)", f.read())[1])
+
+
+def _read_nothing_for(pid: int, seconds: float, timeout: float = 120.0) -> int:
+    """Wait until the process has read nothing for ``seconds`` (its start-up done); what it has read by then."""
+    deadline, last, since = time.monotonic() + timeout, -1, time.monotonic()
+    while time.monotonic() < deadline:
+        now = _bytes_read(pid)
+        if now != last:
+            last, since = now, time.monotonic()
+        elif time.monotonic() - since >= seconds:
+            return now
+        time.sleep(0.05)
+    raise AssertionError("the receiver kept reading")
+
+
 def test_a_line_lost_mid_program_counts_the_bytes_that_arrived(tmp_path):
     data = b"\x12" + program_text(400).encode()
     with PtyPair() as pair:
         proc = lagsym_process("receive", "--port", pair.near, "--baud", 38400, "--timeout", "60", "--quiet",
                               "-o", tmp_path / "x.nc")
-        time.sleep(1.0)
+        base = _read_nothing_for(proc.pid, 1.0)
         sender = threading.Thread(target=punch, args=(pair.far, data[:5000], 38400), kwargs={"delay_s": 0.1})
         sender.start()
         sender.join(30)
-        time.sleep(0.5)
+        # The cut comes once the receiver has read all 5000 (a hang-up flushes what is unread; on a loaded machine
+        # the relay and the receiver took longer than a fixed half second).
+        deadline = time.monotonic() + 60
+        while _bytes_read(proc.pid) < base + 5000 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.2)
         pair.hang_up()
         out, err = proc.communicate(timeout=30)
     assert proc.returncode == 3, err
