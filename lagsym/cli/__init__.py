@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
+import os
 import signal
 import sys
 import threading
@@ -253,7 +254,13 @@ def _signals_as_interrupts():
         yield
         return
 
+    main_pid = os.getpid()
+
     def stop(signum, frame):
+        if os.getpid() != main_pid:  # a forked worker not yet past its own set-up: end as the signal's default does
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         raise Terminated(signum)
 
     old = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGHUP)}

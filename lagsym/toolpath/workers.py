@@ -65,10 +65,11 @@ def _abandon(pool) -> None:
     for handler in (pool._worker_handler, pool._task_handler, pool._result_handler):
         handler._state = mp_pool.TERMINATE
     pool._state = mp_pool.TERMINATE
-    for process in pool._pool:
+    for process in list(pool._pool):
         process.kill()
-    for process in pool._pool:
-        process.join()
+    for process in list(pool._pool):  # again: one the worker handler forked before it saw the state
+        process.kill()
+        process.join(5.0)
     pool._terminate.cancel()
 
 
