@@ -16,7 +16,8 @@ from math import comb
 import flint
 import pytest
 
-from lagsym import LagsymError, curve_from_points, grid_from_table, lagrange_curve, lagrange_surface
+from lagsym import (LagsymError, curve_from_points, grid_from_points, grid_from_table, lagrange_curve,
+                    lagrange_surface)
 from lagsym.evaluate import chebyshev_transform
 from lagsym.exactsize import MAX_EXACT_MB, MAX_EXACT_S, exact_size_mb, exact_time_limit
 
@@ -366,19 +367,16 @@ def test_an_exact_computation_foreseen_past_the_time_limit_is_refused_a_few_seco
 
 
 def test_the_time_limit_is_the_callers_in_python():
-    grid = grid_from_table(*_table(_decimal_grid(70, 4)))
+    grid = _exact_grid(_decimal_grid(70, 4))
     with exact_time_limit(1.0), pytest.raises(LagsymError, match=r"70 x 70 nodes would take about .* limit of 1 s"):
         lagrange_surface(grid)  # products of about 4 s each here: refused half a second into the first
-    small = grid_from_table(*_table(_decimal_grid(4, 5)))
+    small = _exact_grid(_decimal_grid(4, 5))
     with exact_time_limit(None):
         assert lagrange_surface(small).coefficients == lagrange_surface(small).coefficients
 
 
-def _table(rows):
-    xs = sorted({Fraction(r[0]) for r in rows})
-    ys = sorted({Fraction(r[1]) for r in rows})
-    z = {(Fraction(a), Fraction(b)): Fraction(c) for a, b, c in rows}
-    return xs, ys, [[z[(a, b)] for b in ys] for a in xs]
+def _exact_grid(rows):
+    return grid_from_points([tuple(Fraction(v) for v in row) for row in rows])
 
 
 @pytest.mark.parametrize("command", ["compare", "simulate"])
