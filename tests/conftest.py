@@ -64,6 +64,29 @@ def _cutter_kernel_compiled():
     drop_cutter(surface, np.array([float(x)]), np.array([float(y)]), 1.0)
 
 
+@pytest.fixture
+def line():
+    """``start(kernel=False, **control)``: a socat pty pair (``kernel=True``: a relay-free kernel pair) with a simulated
+    control started on its far end; ``(pair, control)``, both ended after the test."""
+    from simcontrol import KernelPty, PtyPair, SimControl
+
+    pairs, sims = [], []
+
+    def start(kernel: bool = False, **kwargs):
+        pair = KernelPty() if kernel else PtyPair()
+        pairs.append(pair)
+        sim = SimControl(pair.far, pair=None if kernel else pair, **kwargs)
+        sim.start()
+        sims.append(sim)
+        return pair, sim
+
+    yield start
+    for sim in sims:
+        sim.stop()
+    for pair in pairs:
+        pair.close()
+
+
 @pytest.fixture(autouse=True)
 def _socat(request):
     """Tests marked ``socat`` need Debian's socat for their pseudo-terminal pairs."""

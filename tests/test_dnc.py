@@ -14,7 +14,7 @@ import pytest
 
 from lagsym.dnc import LineFault, LineSettings, parse_program, profile, resume_setup, send_program, transfer_segments
 from lagsym.errors import InputError, TransferError
-from simcontrol import PROGRAM, KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import PROGRAM, PtyPair, chars_per_s, program_text, punch
 
 needs_socat = pytest.mark.socat
 
@@ -115,26 +115,6 @@ def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp
 
 
 # -- real transfers over a pty pair -------------------------------------------------------------------------
-
-
-@pytest.fixture
-def line():
-    """A socat pty pair (or with ``kernel=True`` a relay-free kernel pair); starts a simulated control on its far end."""
-    pairs, sims = [], []
-
-    def start(kernel: bool = False, **kwargs):
-        pair = KernelPty() if kernel else PtyPair()
-        pairs.append(pair)
-        sim = SimControl(pair.far, pair=None if kernel else pair, **kwargs)
-        sim.start()
-        sims.append(sim)
-        return pair, sim
-
-    yield start
-    for sim in sims:
-        sim.stop()
-    for pair in pairs:
-        pair.close()
 
 
 @pytest.mark.slow

@@ -18,29 +18,10 @@ import pytest
 from lagsym.dnc import LineFault, parse_program, profile, send_program, transfer_segments
 from lagsym.dnc.port import Port
 from rfc2217rig import Rfc2217Server
-from simcontrol import PROGRAM, KernelPty, PtyPair, SimControl, chars_per_s, program_text, punch
+from simcontrol import PROGRAM, KernelPty, PtyPair, chars_per_s, program_text, punch
 
 pytestmark = pytest.mark.socat
 ROOT = Path(__file__).resolve().parent.parent
-
-
-@pytest.fixture
-def line():
-    pairs, sims = [], []
-
-    def start(**kwargs):
-        pair = PtyPair()
-        pairs.append(pair)
-        sim = SimControl(pair.far, pair=pair, **kwargs)
-        sim.start()
-        sims.append(sim)
-        return pair, sim
-
-    yield start
-    for sim in sims:
-        sim.stop()
-    for pair in pairs:
-        pair.close()
 
 
 def write(tmp_path, text, name="prog.nc"):

@@ -9,30 +9,18 @@ found no answer, credited bytes the dying control had never taken.
 
 from __future__ import annotations
 
+import functools
 import re
 
 import pytest
 
 from lagsym.dnc import LineFault, LineSettings, parse_program, profile, send_program, transfer_segments
-from simcontrol import KernelPty, SimControl, chars_per_s, program_text
+from simcontrol import chars_per_s, program_text
 
 @pytest.fixture
-def line():
-    pairs, sims = [], []
-
-    def start(**kwargs):
-        pair = KernelPty()
-        pairs.append(pair)
-        sim = SimControl(pair.far, **kwargs)
-        sim.start()
-        sims.append(sim)
-        return pair, sim
-
-    yield start
-    for sim in sims:
-        sim.stop()
-    for pair in pairs:
-        pair.close()
+def line(line):
+    """The shared fixture's kernel pairs only."""
+    return functools.partial(line, kernel=True)
 
 
 def write(tmp_path, text, name="prog.nc"):
