@@ -326,14 +326,18 @@ class _Control:
             self.last_byte_at = time.monotonic()
             for value in extra:
                 self.count_in += 1
-                self.received.append(value)
-                self.buffered += 1
-                if self.xoff:
-                    self.after += 1
+                self.hold(value)
             if self.discard_after_bytes is not None:
                 self.discard_after_bytes = max(self.discard_after_bytes, self.count_in)
             self.count.value = len(self.received)
         return line_t
+
+    def hold(self, value: int) -> None:
+        """One character from the line into the buffer, counted as past the DC3 while one is out."""
+        self.received.append(value)
+        self.buffered += 1
+        if self.xoff:
+            self.after += 1
 
     def dead(self) -> bool:
         """Past ``discard_after_bytes``: the control takes what comes and answers nothing."""
@@ -383,11 +387,8 @@ class _Control:
                     self.count_in += 1
                     if self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes:
                         continue
-                    self.received.append(byte)
-                    self.buffered += 1
-                    if self.xoff:
-                        self.after += 1
-                    elif self.buffered >= self.high:
+                    self.hold(byte)
+                    if not self.xoff and self.buffered >= self.high:
                         crossed = self.xoff = True
                         self.after = 0
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
