@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from lagsym.dnc import LineFault, parse_program, profile, send_program, transfer_segments
+from lagsym.dnc import LineFault, LineSettings, parse_program, profile, send_program, transfer_segments
 from lagsym.dnc.port import Port
 from rfc2217rig import Rfc2217Server
 from simcontrol import PROGRAM, KernelPty, PtyPair, chars_per_s, program_text, punch
@@ -310,6 +310,9 @@ def test_start_at_the_n_number_the_control_shows(line, run_cli, tmp_path):
     status, _, err = run_cli("send", write(tmp_path, text), "--port", pair.near, "--baud", 38400, "--mode", "drip",
                              "--start-at", "N900", "--no-handshake-expected", "--quiet")
     assert status == 0, err
+    # The send ends once its last byte has left the port; wait for the control to have it (the relay may lag).
+    sent = transfer_segments(parse_program(text), LineSettings(baud=38400), "drip", start_block=11)
+    assert sim.wait_for(sum(len(chunk) for _, chunk in sent))
     lines = sim.lines()
     assert lines[1] == "(RESUME AT BLOCK 11)" and lines[-4:] == ["N900 G1 X30.", "G0 Z25.", "M30", "%"]
 
