@@ -304,16 +304,20 @@ def test_an_upload_larger_than_the_memory_is_refused(run_cli, tmp_path):
 # -- 9: resume from what the control shows ------------------------------------------------------------------
 
 
+def _all_lines(sim, segments) -> list[str]:
+    """The control's lines once it has every byte of ``segments``: a send ends when its last byte has left the
+    port, and socat's relay can lag behind on a loaded machine."""
+    assert sim.wait_for(sum(len(chunk) for _, chunk in segments))
+    return sim.lines()
+
+
 def test_start_at_the_n_number_the_control_shows(line, run_cli, tmp_path):
     text = PROGRAM.replace("G1 X30.", "N900 G1 X30.")
     pair, sim = line(baud=38400)
     status, _, err = run_cli("send", write(tmp_path, text), "--port", pair.near, "--baud", 38400, "--mode", "drip",
                              "--start-at", "N900", "--no-handshake-expected", "--quiet")
     assert status == 0, err
-    # The send ends once its last byte has left the port; wait for the control to have it (the relay may lag).
-    sent = transfer_segments(parse_program(text), LineSettings(baud=38400), "drip", start_block=11)
-    assert sim.wait_for(sum(len(chunk) for _, chunk in sent))
-    lines = sim.lines()
+    lines = _all_lines(sim, transfer_segments(parse_program(text), LineSettings(baud=38400), "drip", start_block=11))
     assert lines[1] == "(RESUME AT BLOCK 11)" and lines[-4:] == ["N900 G1 X30.", "G0 Z25.", "M30", "%"]
 
 
@@ -349,7 +353,7 @@ def test_tv_check_pads_blocks_to_even_and_iso_check_refuses_lower_case(line, run
     status, _, err = run_cli("send", write(tmp_path, PROGRAM), "--port", pair.near, "--baud", 38400, "--tv-check",
                              "--quiet")
     assert status == 0, err
-    lines = sim.lines()
+    lines = _all_lines(sim, transfer_segments(parse_program(PROGRAM), LineSettings(baud=38400, tv_check=True)))
     assert lines[1:-1] == [b if len(b) % 2 else b + " " for b in parse_program(PROGRAM).blocks]
     assert all((len(x) + 1) % 2 == 0 for x in lines)
     status, _, err = run_cli("send", write(tmp_path, PROGRAM.replace("M8", "M8 (coolant)")), "--port", "loop://",
