@@ -48,25 +48,15 @@ import numpy as np
 from ._arrays import power_of_two_scale
 from ._arrays import readonly as _readonly
 from .errors import InputError
+from .exactsize import MAX_EXACT_MB
 from .grid import ControlGrid, _fmt
 from .sampling import axis_lines
 from .surfaces import HERMITE_KINDS, METHODS, make_surface
 from .values import choice
 
-__all__ = [
-    "DEFAULT_SAMPLES",
-    "DEFAULT_TOLERANCE_MM",
-    "MAX_SAMPLES",
-    "MEASURES",
-    "TABLE_FORMATS",
-    "Comparison",
-    "DeviationMeasures",
-    "MethodComparison",
-    "compare_surfaces",
-    "deviation_measures",
-    "render_table",
-    "sample_axes",
-]
+__all__ = ["DEFAULT_SAMPLES", "DEFAULT_TOLERANCE_MM", "MAX_SAMPLES", "MEASURES", "TABLE_FORMATS", "Comparison",
+           "DeviationMeasures", "MethodComparison", "compare_surfaces", "deviation_measures", "render_table",
+           "sample_axes"]
 
 DEFAULT_SAMPLES = (61, 61)  # 60 steps: every node of an evenly spaced 3- to 7-node net is a sample
 DEFAULT_TOLERANCE_MM = 1e-6
@@ -260,13 +250,13 @@ def sample_axes(grid: ControlGrid, samples: tuple[int, int] = DEFAULT_SAMPLES) -
     return axis_lines(x0, x1, int(samples[0])), axis_lines(y0, y1, int(samples[1]))
 
 
-def _reference_heights(reference, grid: ControlGrid, samples):
-    """``(label, xs, ys, z_f)`` for the three kinds of reference."""
+def _reference_heights(reference, grid: ControlGrid, samples, surface_of):
+    """``(label, xs, ys, z_f)`` for the three kinds of reference; ``surface_of(method)`` builds a method's surface."""
     if isinstance(reference, str):
         if reference != "lagrange":
             raise InputError(f"reference {reference!r}: give 'lagrange', a Formula or a ControlGrid of measured points")
         xs, ys = sample_axes(grid, samples or DEFAULT_SAMPLES)
-        return "Lagrange surface", xs, ys, make_surface("lagrange", grid).evaluate_grid(xs, ys)
+        return "Lagrange surface", xs, ys, surface_of("lagrange").evaluate_grid(xs, ys)
     if isinstance(reference, ControlGrid):
         if samples is not None:
             raise InputError(f"{reference.source}: measured points fix the samples; leave out the sample count")
@@ -294,6 +284,7 @@ def compare_surfaces(
     degree: int = 3,
     hermite: str = "corner",
     tolerance: float = DEFAULT_TOLERANCE_MM,
+    max_mb: float | None = MAX_EXACT_MB,
 ) -> Comparison:
     """Build every method's surface from ``grid`` and measure it against ``reference``.
 
@@ -317,6 +308,8 @@ def compare_surfaces(
         The Hermite surface to build.
     tolerance : float, optional
         Coincidence tolerance in mm.
+    max_mb : float or None, optional
+        The Lagrange surface's limit on its exact rationals (:func:`lagsym.lagrange.lagrange_surface`).
 
     Returns
     -------
@@ -338,7 +331,14 @@ def compare_surfaces(
     for m in methods:
         choice(m, METHODS, "method")
     choice(hermite, HERMITE_KINDS, "Hermite kind")
-    label, xs, ys, z_f = _reference_heights(reference, grid, samples)
+    built = {}
+
+    def surface_of(m):  # the Lagrange surface is built once, as the reference and as a column
+        if m not in built:
+            built[m] = make_surface(m, grid, degree=degree, hermite=hermite, max_mb=max_mb)
+        return built[m]
+
+    label, xs, ys, z_f = _reference_heights(reference, grid, samples, surface_of)
     z_f = _readonly(z_f)
     bad = np.argwhere(~np.isfinite(z_f))
     if len(bad):
@@ -348,7 +348,7 @@ def compare_surfaces(
         )
     columns = []
     for m in dict.fromkeys(methods):
-        surface = make_surface(m, grid, degree=degree, hermite=hermite)
+        surface = surface_of(m)
         z_a = _readonly(surface.evaluate_grid(xs, ys))
         measures = deviation_measures(z_f, z_a, tolerance)
         columns.append(MethodComparison(surface.name, z_a, _readonly(z_f - z_a), measures))

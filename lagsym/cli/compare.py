@@ -9,7 +9,7 @@ from ..compare import DEFAULT_SAMPLES, DEFAULT_TOLERANCE_MM, TABLE_FORMATS, comp
 from ..formula import parse_formula
 from ..io import TABLE_SUFFIXES, read_points
 from ..surfaces import HERMITE_KINDS, METHODS
-from ._common import add_exact_time_limit, count, emit, number
+from ._common import add_exact_limit, count, emit, number
 
 DESCRIPTION = """Build the Lagrange, Hermite, Bezier and B-spline surfaces from the control
 points in FILE, sample them at the same (x, y) positions and print the paper's
@@ -55,7 +55,7 @@ def add_arguments(p) -> None:
     p.add_argument("--reference", default="lagrange", metavar="REF",
                    help="z_f: 'lagrange' (default), a formula such as '0.5*x**2 + y', or a .json/.csv file of "
                         "measured points")
-    add_exact_time_limit(p)
+    add_exact_limit(p)
     p.add_argument("--samples", type=_samples, metavar="NXxNY",
                    help=f"sample grid over the control box (default {DEFAULT_SAMPLES[0]}x{DEFAULT_SAMPLES[1]})")
     p.add_argument("--methods", type=_methods, default=list(METHODS), metavar="LIST",
@@ -95,7 +95,8 @@ def run(args, out, err) -> int:
 
         image_format(args.plot)  # refuse a bad image name before the work
     comparison = compare_surfaces(grid, reference, samples=args.samples, methods=args.methods,
-                                  degree=args.degree, hermite=args.hermite, tolerance=args.tolerance)
+                                  degree=args.degree, hermite=args.hermite, tolerance=args.tolerance,
+                                  max_mb=args.max_exact_mb)
     if args.plot:
         from ..plot import deviation_map
 

@@ -7,7 +7,7 @@ from ..io import read_program
 from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, detect_dialect,
                         moves_csv, simulate)
 from ..simulate.runaway import check_lines
-from ._common import add_exact_time_limit, count, emit, exact
+from ._common import add_exact_limit, count, emit, exact
 from ._progress import progress_bar
 
 MAX_BLOCKS_LIMIT = 100_000_000  # the moves of a run this long take at most 3.7 GB
@@ -61,7 +61,7 @@ def add_arguments(p) -> None:
                         f"each takes about 11 KB while read and compiled)")
     p.add_argument("--max-idle-blocks", type=count(1, MAX_BLOCKS_LIMIT), default=MAX_IDLE_BLOCKS, metavar="N",
                    help=f"stop after N blocks in a row without a move as a runaway loop (default {MAX_IDLE_BLOCKS})")
-    add_exact_time_limit(p)
+    add_exact_limit(p)
     p.add_argument("--surface", metavar="FORMULA|FILE",
                    help="what probing moves touch: a formula in x and y, or a points or surface file (named by its "
                         "extension: .json, .csv, ...)")
@@ -77,7 +77,7 @@ def run(args, out, err) -> int:
     check_lines(text, args.max_lines, args.program)  # named here: the library does not know the file
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or control(dialect).macro.default_precision
-    target = _target(args.surface, args.tip_radius) if args.surface else None
+    target = _target(args.surface, args.tip_radius, args.max_exact_mb) if args.surface else None
     with progress_bar(err) as progress:
         sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks,
                        progress=progress, target=target, max_lines=args.max_lines)
@@ -93,7 +93,7 @@ def run(args, out, err) -> int:
     return 0
 
 
-def _target(text: str, tip_radius):
+def _target(text: str, tip_radius, max_mb: float):
     """The probe target: a points or surface file (by its extension, as 'compare --reference'), else a formula."""
     from pathlib import Path
 
@@ -105,7 +105,7 @@ def _target(text: str, tip_radius):
         from ..io import read_points
         from ..lagrange import lagrange_surface
 
-        ev = surface_evaluator(lagrange_surface(read_points(text)))
+        ev = surface_evaluator(lagrange_surface(read_points(text), max_mb=max_mb))
         return probe_target(lambda x, y: ev.points(x, y), float(tip_radius), text)
     from ..formula import parse_formula
 

@@ -19,6 +19,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from ..exactsize import MAX_EXACT_MB
 from ..values import choice
 from ..grid import ControlGrid
 from .bezier import BernsteinBasis, bernstein_matrix, bezier_surface
@@ -65,7 +66,8 @@ class Surface(Protocol):
         """``Z[i, j]`` above ``(xs[i], ys[j])``."""
 
 
-def make_surface(method: str, grid: ControlGrid, *, degree: int = 3, hermite: str = "corner") -> Surface:
+def make_surface(method: str, grid: ControlGrid, *, degree: int = 3, hermite: str = "corner",
+                 max_mb: float | None = MAX_EXACT_MB) -> Surface:
     """Build the surface of ``method`` (one of :data:`METHODS`) from ``grid``.
 
     Parameters
@@ -77,6 +79,8 @@ def make_surface(method: str, grid: ControlGrid, *, degree: int = 3, hermite: st
         B-spline degree in each direction (default 3, capped at ``n - 1``).
     hermite : {"corner", "piecewise"}, optional
         Which Hermite surface (see :mod:`lagsym.surfaces.hermite`).
+    max_mb : float or None, optional
+        The Lagrange surface's limit on its exact rationals (:func:`lagsym.lagrange.lagrange_surface`).
 
     Examples
     --------
@@ -87,7 +91,7 @@ def make_surface(method: str, grid: ControlGrid, *, degree: int = 3, hermite: st
     """
     choice(method, METHODS, "method")
     if method == "lagrange":
-        return lagrange_method(grid)
+        return lagrange_method(grid, max_mb=max_mb)
     if method == "hermite":
         return hermite_surface(grid, hermite)
     if method == "bezier":

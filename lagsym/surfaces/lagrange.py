@@ -13,6 +13,7 @@ import numpy as np
 
 from ..evaluate import evaluate_grid, evaluate_points
 from ..grid import ControlGrid
+from ..exactsize import MAX_EXACT_MB
 from ..lagrange import LagrangeSurface, lagrange_surface
 
 __all__ = ["LagrangeMethod", "lagrange_method"]
@@ -34,6 +35,6 @@ class LagrangeMethod:
         return evaluate_grid(self.surface, xs, ys)
 
 
-def lagrange_method(grid: ControlGrid) -> LagrangeMethod:
-    """The Lagrange surface through ``grid`` (exact core, numeric evaluation)."""
-    return LagrangeMethod(lagrange_surface(grid))
+def lagrange_method(grid: ControlGrid, *, max_mb: float | None = MAX_EXACT_MB) -> LagrangeMethod:
+    """The Lagrange surface through ``grid`` (exact core, numeric evaluation); ``max_mb`` as :func:`.lagrange_surface`."""
+    return LagrangeMethod(lagrange_surface(grid, max_mb=max_mb))

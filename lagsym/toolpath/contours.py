@@ -11,13 +11,14 @@ import math
 
 import numpy as np
 
-__all__ = ["BISECTIONS", "contour_passes"]
+__all__ = ["crossings_at_least", "CROSSING_POINTS", "BISECTIONS", "contour_passes"]
 
 BISECTIONS = 10
 """A crossing is bracketed to the width this many halvings of its grid edge leave (about 0.00025 mm)."""
 
 
 _FALSE_POSITIONS = 2  # steps of false position before the last, a pair of points
+CROSSING_POINTS = _FALSE_POSITIONS + 2  # the fewest drop-cutter points one crossing takes
 
 
 def _levels(f, steep: np.ndarray, d0: float) -> list[float]:
@@ -40,6 +41,21 @@ def _levels(f, steep: np.ndarray, d0: float) -> list[float]:
             return out
         out.append(level)
         start = level
+
+
+def crossings_at_least(f, steep: np.ndarray, d0: float) -> int:
+    """A lower bound of the level crossings the contours of the steep region find, before the levels are walked.
+
+    Every step between levels is at most ``d0`` and the levels run from the
+    top of the steep region to within ``d0`` of its bottom, so a grid edge
+    between two steep nodes rising ``Δz`` crosses at least ``floor(Δz / d0)``.
+    """
+    n = 0
+    for axis in (0, 1):
+        both = steep[:-1, :] & steep[1:, :] if axis == 0 else steep[:, :-1] & steep[:, 1:]
+        rise = np.abs(np.diff(f.z, axis=axis))[both]
+        n += int(np.floor(rise / d0).sum())
+    return n
 
 
 def contour_passes(drop, f, steep: np.ndarray, d0: float, tol: float, kappa: float, *, mpu: float,

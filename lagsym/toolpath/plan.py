@@ -28,7 +28,8 @@ from .filter import filter_rows
 from .pattern import (every_step, fixed_step_samples, past_reach, raster_pattern, reach_levels, scallop_stepover,
                       tool_reach, within_reach)
 from .resolution import ResolutionGrid, without_repeats
-from .scallop import row_cusps, scallop_levels
+from .plansize import check_size, scallop_rows
+from .scallop import row_cusps
 from .workers import MIN_POINTS, Workers
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
@@ -225,11 +226,12 @@ def _pattern(ev, tool: Tool, raster: RasterSpec, cl: _Cutter, reach, *, step: fl
     """
     mm_per_unit = cl.mm_per_unit
     stepover = _side_step(tool, raster)
-    scallop = None if raster.stepover_mm is not None else scallop_levels(
-        ev, raster.direction, tool.radius_mm, raster.scallop_mm, mm_per_unit)
+    scallop = None if raster.stepover_mm is not None else scallop_rows(ev, tool, raster, reach, fine=fine,
+                                                                        mm_per_unit=mm_per_unit,
+                                                                        max_points=max_points)
     if scallop is not None:  # rows walked across the surface: the size check counts them
         stepover = _span(ev.bounds, raster.direction) * mm_per_unit / max(len(scallop.levels) - 1, 1)
-    _check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
+    check_size(reach, raster.direction, stepover, fine, mm_per_unit, max_points)
     levels, along = raster_pattern(reach, raster.direction, stepover / mm_per_unit, fine / mm_per_unit)
     if scallop is not None:  # the rows across the box, then as far as the tool reaches on either side
         levels = reach_levels(scallop.levels, *(reach[2:] if raster.direction == "x" else reach[:2]))
@@ -264,21 +266,6 @@ def _place(place: Placement, x, y, z_mm):
     """
     x_mm, y_mm = place.to_machine(x, y)
     return x_mm, y_mm, np.asarray(z_mm) + place.origin_mm[2]
-
-
-def _check_size(bounds, direction: str, stepover: float, fine: float, scale: float, max_points: int | None) -> None:
-    """Refuse a plan whose fine samples (rows times samples per row) would exceed ``max_points``."""
-    if max_points is None:
-        return
-    x0, x1, y0, y1 = (float(v) for v in bounds)
-    length, cross = (x1 - x0, y1 - y0) if direction == "x" else (y1 - y0, x1 - x0)
-    rows = math.ceil(cross * scale / stepover) + 1
-    per_row = math.ceil(length * scale / fine) + 1
-    if rows * per_row > max_points:
-        raise ToolpathError(
-            f"{rows} rows of {per_row} fine samples is {rows * per_row:.3g} drop-cutter points, more than the limit "
-            f"of {max_points:.3g} (side step {stepover:g} mm, sampling step {fine:g} mm); use larger steps "
-            f"or raise the limit (--max-points)")
 
 
 def _side_step(tool: Tool, raster: RasterSpec) -> float:

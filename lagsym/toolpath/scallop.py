@@ -33,14 +33,16 @@ chosen elsewhere is reported with where it is worst; :func:`row_cusps` and
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator
 from .pattern import scallop_stepover
 
-__all__ = ["cusp_height", "ScallopRows", "scallop_levels", "row_cusps", "gap_cusps"]
+__all__ = ["cusp_height", "ScallopRows", "TooManyRows", "scallop_levels", "row_cusps", "gap_cusps"]
 
 _ALONG_SAMPLES = 401  # samples along a row (slopes and curvature are polynomials of low degree)
 _CROSS_PER_STEP = 4  # cross samples per flat-floor side step
@@ -73,18 +75,41 @@ def cusp_height(d, k, radius: float) -> np.ndarray:
 
 
 def _allowed_d(k, radius: float, scallop: float) -> np.ndarray:
-    """The largest centre distance whose cusp is at most ``scallop`` (bisection; ``nan`` where ``k R >= 1``)."""
+    """The largest centre distance whose cusp is at most ``scallop`` (``nan`` where ``k R >= 1``).
+
+    Solved in closed form: with ``q = sqrt(R**2 - d**2 / 4)`` the cusp
+    equation gives ``q = (2 (R - h) + k h**2) / (2 (1 - k h))`` on either side
+    of ``k = 0``, so ``d**2 / 4 = (R - q) (R + q)`` with ``R - q = h (2 - k (2 R
+    + h)) / (2 (1 - k h))``, no cancellation near a flat section.  Where the
+    cusp stays below ``h`` up to the largest centre distance the section
+    allows, that distance; a root the cusp does not confirm (to a part in
+    10**9) is found by bisection instead.
+    """
     k = np.asarray(k, dtype=float)
-    fits = k * radius < 1.0
-    hi = np.where(k > 0, np.minimum(2 * radius, 2 * (1 - np.minimum(k * radius, 1.0)) / np.where(k > 0, k, 1.0)),
-                  2 * radius)
+    r, h = radius, scallop
+    fits = k * r < 1.0
+    hi = np.where(k > 0, np.minimum(2 * r, 2 * (1 - np.minimum(k * r, 1.0)) / np.where(k > 0, k, 1.0)), 2 * r)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        below = h * (2.0 - k * (2.0 * r + h)) / (2.0 * (1.0 - k * h))  # R - q
+        d = np.where(below >= 0, 2.0 * np.sqrt(below * (2.0 * r - below)) * (1.0 - 1e-12), np.inf)  # the safe side
+        d = np.minimum(np.where(np.isnan(d), np.inf, d), hi)
+        cusp = cusp_height(d, k, r)
+    confirmed = np.isfinite(cusp) & (cusp <= h * (1 + 1e-9)) & ((d == hi) | (cusp >= h * (1 - 1e-6)))
+    todo = fits & ~confirmed
+    if todo.any():
+        d[todo] = _bisected_d(k[todo], hi[todo], r, h)
+    return np.where(fits, d, np.nan)
+
+
+def _bisected_d(k, hi, radius: float, scallop: float) -> np.ndarray:
+    """The largest centre distance below ``hi`` whose cusp is at most ``scallop``, by bisection."""
     lo = np.zeros_like(hi)
     for _ in range(50):
         mid = 0.5 * (lo + hi)
         h = cusp_height(mid, k, radius)
         good = np.isfinite(h) & (h <= scallop)
         lo, hi = np.where(good, mid, lo), np.where(good, hi, mid)
-    return np.where(fits, lo, np.nan)
+    return lo
 
 
 @dataclass(frozen=True)
@@ -156,8 +181,13 @@ def _across_curvature(fp, fc, fpp, fpc, fcc, radius: float) -> np.ndarray:
 
 
 def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scallop_mm: float,
-                   mm_per_unit: float) -> ScallopRows:
-    """Row levels across the box whose cusps, normal to the surface, are at most ``scallop_mm`` (see the module)."""
+                   mm_per_unit: float, *, max_rows: int | None = None) -> ScallopRows:
+    """Row levels across the box whose cusps, normal to the surface, are at most ``scallop_mm`` (see the module).
+
+    Raises :class:`TooManyRows` before the walk when the rows surely exceed
+    ``max_rows`` (a lower bound from the gaps the samples allow), or as soon
+    as the walk passes it.
+    """
     flat = scallop_stepover(radius_mm, scallop_mm)
     along, cross, stretch, k = _samples(ev, direction, mm_per_unit, flat, radius_mm)
     d = _allowed_d(k, radius_mm, scallop_mm)
@@ -171,7 +201,41 @@ def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scall
     finite = per_sample[np.isfinite(per_sample)]
     top = max(float(finite.max()) if finite.size else 0.0, flat / mm_per_unit)
     per_sample = np.where(np.isfinite(per_sample), per_sample, top)
+    levels = _walk(cross, per_sample, r, floor, top, max_rows, scallop_mm=scallop_mm, mm_per_unit=mm_per_unit)
+    levels = np.array(levels)
+    worst, at = _worst(levels, along, cross, stretch, k, radius_mm=radius_mm, mm_per_unit=mm_per_unit)
+    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight, samples=k.size)
+
+
+class TooManyRows(ToolpathError):
+    """A scallop height asks for more rows than allowed: ``at_least`` rows, side steps down to ``smallest_mm``."""
+
+    def __init__(self, at_least: int, smallest_mm: float, scallop_mm: float, max_rows: int):
+        super().__init__(f"a scallop height of {scallop_mm:g} mm needs at least {at_least} rows (side steps down "
+                         f"to {smallest_mm:.3g} mm), more than the {max_rows} allowed")
+        self.at_least, self.smallest_mm = at_least, smallest_mm
+
+
+def _walk(cross, per_sample, r: float, floor: float, top: float, max_rows: int | None, *, scallop_mm: float,
+          mm_per_unit: float) -> list[float]:
+    """The row levels walked across ``cross`` (see the module), refused past ``max_rows`` (:class:`TooManyRows`).
+
+    Each gap ``s`` from a row at ``c`` is at most the smallest allowed over
+    the samples in ``[c - r, c + s + r]`` (or the floor), so it is at most
+    the smallest within ``r - spacing`` of any sample it passes: the sum of
+    the spacing over that smallest is a lower bound of the gaps' count,
+    known before the walk.
+    """
     c0, c1 = float(cross[0]), float(cross[-1])
+    if max_rows is not None and len(cross) > 1:
+        spacing = (c1 - c0) / (len(cross) - 1)
+        m = max(int((r - spacing) / spacing), 0)
+        padded = np.pad(per_sample, m, constant_values=np.inf)
+        near = np.lib.stride_tricks.sliding_window_view(padded, 2 * m + 1).min(axis=1)
+        bound = np.maximum(near, floor)[:-1]
+        at_least = int(math.floor(float(np.sum(spacing / bound)) * (1 - 1e-9))) + 1
+        if at_least > max_rows:
+            raise TooManyRows(at_least, float(bound.min()) * mm_per_unit, scallop_mm, max_rows)
     levels = [c0]
     while levels[-1] < c1:
         c = levels[-1]
@@ -188,9 +252,10 @@ def scallop_levels(ev: SurfaceEvaluator, direction: str, radius_mm: float, scall
             lo, hi = (mid, hi) if mid <= allowed(mid) else (lo, mid)
         s = max(lo, floor)
         levels.append(min(c + s, c1) if c1 - (c + s) > 1e-9 * (c1 - c0) else c1)
-    levels = np.array(levels)
-    worst, at = _worst(levels, along, cross, stretch, k, radius_mm=radius_mm, mm_per_unit=mm_per_unit)
-    return ScallopRows(levels=levels, worst_mm=worst, worst_at=at, tight=tight, samples=k.size)
+        if max_rows is not None and len(levels) > max_rows:
+            gaps = np.diff(levels) * mm_per_unit
+            raise TooManyRows(len(levels), float(gaps.min()), scallop_mm, max_rows)
+    return levels
 
 
 def row_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm_per_unit: float,
@@ -231,15 +296,31 @@ def gap_cusps(ev: SurfaceEvaluator, direction: str, levels, radius_mm: float, mm
 
 
 def _worst(levels, along, cross, stretch, k, *, radius_mm, mm_per_unit):
-    """The largest cusp predicted between the rows at ``levels``, over each gap's band, and where."""
+    """The largest cusp predicted between the rows at ``levels``, over each gap's band, and where.
+
+    The cusp grows with the gap wherever it is defined, so a sample's worst is
+    the one the widest gap whose band covers it leaves: one evaluation per
+    sample, not one per gap and sample.  Where that gap leaves no defined cusp
+    (a hollow the ball barely fits), the gaps covering the sample are tried
+    one by one, as a smaller one may leave one.
+    """
     r = radius_mm / mm_per_unit
-    worst, at = 0.0, (float(along[0]), float(cross[0]))
-    for c, nxt in zip(levels[:-1], levels[1:]):
-        band = slice(int(np.searchsorted(cross, c - r)), int(np.searchsorted(cross, nxt + r, side="right")))
-        h = cusp_height((nxt - c) * mm_per_unit / stretch[band], k[band], radius_mm)
-        if np.isfinite(h).any():
-            i = np.nanargmax(h)
-            if h.flat[i] > worst:
-                jc, ja = np.unravel_index(i, h.shape)
-                worst, at = float(h.flat[i]), (float(along[ja]), float(cross[band][jc]))
-    return worst, at
+    levels = np.asarray(levels, dtype=float)
+    first = np.searchsorted(cross, levels[:-1] - r)
+    last = np.searchsorted(cross, levels[1:] + r, side="right")
+    widest = np.zeros(len(cross))
+    for gap, a, b in zip(np.diff(levels), first, last):
+        np.maximum(widest[a:b], gap, out=widest[a:b])
+    h = cusp_height(widest[:, None] * mm_per_unit / stretch, k, radius_mm)
+    for j in np.flatnonzero((np.isnan(h) & np.isfinite(k)).any(axis=1)):
+        covering = np.diff(levels)[(first <= j) & (last > j)]
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a sample no gap leaves a cusp at stays nan
+            h[j] = np.nanmax(cusp_height(covering[:, None] * mm_per_unit / stretch[j], k[j], radius_mm), axis=0,
+                             initial=-np.inf) if covering.size else np.nan
+    h[np.isneginf(h)] = np.nan
+    if not np.isfinite(h).any():
+        return 0.0, (float(along[0]), float(cross[0]))
+    jc, ja = np.unravel_index(int(np.nanargmax(h)), h.shape)
+    worst = float(h[jc, ja])
+    return (worst, (float(along[ja]), float(cross[jc]))) if worst > 0.0 else (0.0, (float(along[0]), float(cross[0])))

@@ -73,6 +73,7 @@ from .pattern import within_reach
 from .dropcutter import telling_compiles
 from .plan import MAX_PLAN_POINTS, Toolpath, _Cutter, _place, cutter_and_reach, plan_toolpath
 from .contours import BISECTIONS, contour_passes
+from .plansize import check_strategy_work, nearest_nodes, row_samples
 from .movesamples import EDGE_DENSER, move_samples
 from .scallop import _TIGHT, _allowed_d
 from .workers import MIN_POINTS, Workers
@@ -172,9 +173,10 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         slope = f.cross_deg if strategy == "steep-shallow" else f.slope_deg
         theta = _threshold(f, slope, d0, mpu)
         steep = ~f.tight & (slope >= theta - BAND_DEG)
+        shallow = (slope <= theta + BAND_DEG) | ~f.inside if strategy == "steep-shallow" else None
+        check_strategy_work(f, steep, shallow, d0, raster, drop.cl.ev, max_points, strategy=strategy, mpu=mpu)
         passes = []
-        if strategy == "steep-shallow":
-            shallow = (slope <= theta + BAND_DEG) | ~f.inside
+        if shallow is not None:
             with Tally(progress, "raster rows") as t:
                 passes += _raster_passes(drop, f, shallow, raster.direction, d0, tol, kappa=kappa, mpu=mpu, counter=t)
         with Tally(progress, "contours") as t:
@@ -348,9 +350,8 @@ def _raster_passes(drop: _Drop, f: _Field, shallow: np.ndarray, direction: str, 
                 break
             step = new
         c = min(c + step / mpu, c1)
-    fine = chordal.tolerance_step(drop.cl.ev, tol, mpu) / mpu
-    along = np.linspace(a_axis[0], a_axis[-1], max(int(math.ceil((a_axis[-1] - a_axis[0]) / fine)) + 1, 2))
-    ia = np.clip(np.rint((along - a_axis[0]) / (a_axis[1] - a_axis[0])).astype(int), 0, len(a_axis) - 1)
+    along = row_samples(a_axis, chordal.tolerance_step(drop.cl.ev, tol, mpu) / mpu)
+    ia = nearest_nodes(a_axis, along.size)
     pieces = []
     for r, c in enumerate(rows):
         ic = int(np.clip(np.rint((c - c_axis[0]) / (c_axis[1] - c_axis[0])), 0, len(c_axis) - 1))
