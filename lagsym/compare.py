@@ -37,6 +37,7 @@ and the root mean square of ``d``.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import json
 import math
@@ -324,20 +325,14 @@ def compare_surfaces(
     >>> [(m.name, m.measures.coincided) for m in c.methods]
     [('Lagrange', 25), ('Hermite', 10), ('Bezier', 10), ('B-spline', 10)]
     """
-    if isinstance(methods, str):
-        methods = [methods]
+    methods = [methods] if isinstance(methods, str) else methods
     if not methods:
         raise InputError(f"no methods to compare; choose from {', '.join(METHODS)}")
     for m in methods:
         choice(m, METHODS, "method")
     choice(hermite, HERMITE_KINDS, "Hermite kind")
-    built = {}
-
-    def surface_of(m):  # the Lagrange surface is built once, as the reference and as a column
-        if m not in built:
-            built[m] = make_surface(m, grid, degree=degree, hermite=hermite, max_mb=max_mb)
-        return built[m]
-
+    # the Lagrange surface is built once, as the reference and as a column
+    surface_of = functools.cache(lambda m: make_surface(m, grid, degree=degree, hermite=hermite, max_mb=max_mb))
     label, xs, ys, z_f = _reference_heights(reference, grid, samples, surface_of)
     z_f = _readonly(z_f)
     bad = np.argwhere(~np.isfinite(z_f))
@@ -353,16 +348,9 @@ def compare_surfaces(
         measures = deviation_measures(z_f, z_a, tolerance)
         columns.append(MethodComparison(surface.name, z_a, _readonly(z_f - z_a), measures))
     n, mm = grid.shape
-    return Comparison(
-        reference=label,
-        xs=_readonly(xs),
-        ys=_readonly(ys),
-        z_reference=z_f,
-        methods=tuple(columns),
-        tolerance=float(tolerance),
-        bspline_degree=(min(degree, n - 1), min(degree, mm - 1)),
-        hermite=hermite,
-    )
+    return Comparison(reference=label, xs=_readonly(xs), ys=_readonly(ys), z_reference=z_f, methods=tuple(columns),
+                      tolerance=float(tolerance), bspline_degree=(min(degree, n - 1), min(degree, mm - 1)),
+                      hermite=hermite)
 
 
 def _cell(value, kind: str) -> str:

@@ -15,6 +15,8 @@
 
 from __future__ import annotations
 
+import math
+import sys
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -76,6 +78,10 @@ class CheckReport:
         return "\n".join(lines)
 
 
+_CHUNK = 4_000_000
+_LOG_MAX = math.log(sys.float_info.max)
+
+
 def _spacing(nodes: np.ndarray) -> float:
     return float(np.mean(np.diff(nodes)))
 
@@ -87,10 +93,14 @@ def _log_lebesgue(s: np.ndarray, logw: np.ndarray, t: np.ndarray) -> np.ndarray:
     terms are positive, so nothing cancels and nothing overflows, however
     extreme the node spacing.
     """
-    logd = np.log(np.abs(t[..., None] - s))
-    terms = logd.sum(axis=-1, keepdims=True) + logw - logd
-    top = terms.max(axis=-1)
-    return top + np.log(np.exp(terms - top[..., None]).sum(axis=-1))
+    rows = max(_CHUNK // max(t[0].size * len(s), 1), 1)  # a few million terms at a time, however many nodes
+    out = np.empty(t.shape)
+    for i in range(0, len(t), rows):
+        logd = np.log(np.abs(t[i:i + rows, ..., None] - s))
+        terms = logd.sum(axis=-1, keepdims=True) + logw - logd
+        top = terms.max(axis=-1)
+        out[i:i + rows] = top + np.log(np.exp(terms - top[..., None]).sum(axis=-1))
+    return out
 
 
 def lebesgue_constant(nodes, samples: int = 17, rounds: int = 12) -> float:
@@ -157,7 +167,8 @@ def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float,
         step = (hi - lo) / (samples + 1)
         lo, hi = np.maximum(centre - step, lo), np.minimum(centre + step, hi)
     i = int(best.argmax())
-    return float(np.exp(best[i])), float(raw[0] + where[i] * (raw[-1] - raw[0]))
+    value = math.exp(best[i]) if best[i] < _LOG_MAX else math.inf  # beyond a float: said as such, not overflowed
+    return value, float(raw[0] + where[i] * (raw[-1] - raw[0]))
 
 
 def _decimal(v: Fraction) -> str:
@@ -214,15 +225,24 @@ class Amplification:
     def text(self) -> str:
         """The figure in words."""
         if self.fitted:
-            return (f"errors in the measured points can be amplified up to {self.value:.4g} times by this "
+            return (f"errors in the measured points can be amplified up to {_times(self.value)} by this "
                     f"least-squares fit (its Lebesgue function sampled over the box)")
-        return (f"errors in the points can be amplified up to {self.value:.4g} times (Lebesgue constants "
-                f"{self.lebesgue_x:.4g} in x times {self.lebesgue_y:.4g} in y), worst near (x, y) = "
+        return (f"errors in the points can be amplified up to {_times(self.value)} (Lebesgue constants "
+                f"{_figure(self.lebesgue_x)} in x times {_figure(self.lebesgue_y)} in y), worst near (x, y) = "
                 f"({self.at[0]:.4g}, {self.at[1]:.4g})")
 
     def header_note(self) -> str:
         """The program header's note when the surface was accepted above the limit."""
-        return f"conditioning {self.value:.4g}x above {self.limit:g} accepted (--accept-conditioning)"
+        return f"conditioning {_figure(self.value)}x above {self.limit:g} accepted (--accept-conditioning)"
+
+
+def _figure(v: float, spec: str = ".4g") -> str:
+    """A Lebesgue constant or an amplification: beyond a float's range said so, not as ``inf``."""
+    return format(v, spec) if math.isfinite(v) else f"more than {sys.float_info.max:.4g}"
+
+
+def _times(v: float) -> str:
+    return f"{_figure(v)} times"
 
 
 def amplification(surface, limit: float = AMPLIFICATION_LIMIT) -> Amplification:
@@ -266,7 +286,7 @@ def require_conditioning(surface, *, accept: bool = False, limit: float = AMPLIF
                f"join exact points by smooth pieces (lagsym piecewise {g.source} -o pieces.json)")
         raise ConditioningError(
             f"{g.source}: {a.text()}, above lagsym's limit of {limit:g}: 0.01 of measurement noise could move "
-            f"the surface by {0.01 * a.value:.3g}; {way}, or give --accept-conditioning to use it as it is")
+            f"the surface by {_figure(0.01 * a.value, '.3g')}; {way}, or give --accept-conditioning to use it as it is")
     return a
 
 

@@ -405,6 +405,9 @@ class RasterSpec:
         choice(self.boundary, BOUNDARIES, "boundary")
         if self.stepover_mm is None and self.scallop_mm is None:
             raise ToolpathError("give a side step (--stepover) or a scallop height (--scallop)")
+        if self.stepover_mm is not None and self.scallop_mm is not None:
+            raise ToolpathError(f"give a side step (stepover {self.stepover_mm:g} mm) or a scallop height (scallop "
+                                f"{self.scallop_mm:g} mm), not both: the rows are spaced by one of them")
         if self.step_mm is None and self.tolerance_mm is None:
             raise ToolpathError("give a forward step (--step) or a chordal tolerance (--tolerance)")
         for name in ("stepover_mm", "step_mm", "scallop_mm", "tolerance_mm"):

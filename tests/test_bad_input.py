@@ -229,9 +229,9 @@ def test_the_documented_limits_are_the_ones_in_force():
 
     cli = " ".join((ROOT / "docs" / "cli.md").read_text().split())
     formats = (ROOT / "docs" / "formats.md").read_text()
-    assert (MAX_POINTS, MAX_PLAN_POINTS, MAX_CELLS, MAX_CONTACTS, MAX_TERMS) == (10**8, 2 * 10**7, 16 * 10**6,
+    assert (MAX_POINTS, MAX_PLAN_POINTS, MAX_CELLS, MAX_CONTACTS, MAX_TERMS) == (10**8, 5 * 10**6, 16 * 10**6,
                                                                                 2 * 10**10, 2500)
-    for text in ("`sample --max-points` (default 1e8 points)", "`toolpath --max-points` (2e7 fine",
+    for text in ("`sample --max-points` (default 1e8 points)", "`toolpath --max-points` (5e6 fine",
                  "`verify --max-cells` (1.6e7 height-map cells)", "(2e10 segments swept", "(2500 terms)"):
         assert text in cli
     assert f"at most {MAX_EXPONENT} digits and a decimal exponent within +-{MAX_EXPONENT}" in formats

@@ -53,7 +53,7 @@ def test_a_job_with_a_scallop_too_small_for_the_point_limit_is_refused_in_second
     assert time.monotonic() - started < 30 and not (tmp_path / "job.ngc").exists()
     assert status == 2 and err.count("\n") == 1, err
     found = re.search(r"operations\[1\] \(finish\): at least (\d+) rows of \d+ fine samples is at least (\S+) "
-                      r"drop-cutter points, more than the limit of 2e\+07", err)
+                      r"drop-cutter points, more than the limit of 5e\+06", err)
     assert found and "(--max-points)" in err, err
     doc = " ".join((ROOT / "docs" / "toolpaths.md").read_text().split())
     assert f"at least {found.group(1)} rows, {found.group(2)} points" in doc  # the figures the docs quote
@@ -69,7 +69,7 @@ def test_waterline_at_a_tiny_scallop_is_refused_before_it_plans(tmp_path, run_cl
     assert time.monotonic() - started < 30 and not (tmp_path / "o.nc").exists()
     assert status == 2 and err.count("\n") == 1, err
     assert f"the {strategy} strategy at a scallop height of 1.1e-06 mm takes at least" in err
-    assert "more than the limit of 2e+07" in err and "(--max-points)" in err, err
+    assert "more than the limit of 5e+06" in err and "(--max-points)" in err, err
 
 
 @pytest.mark.slow
@@ -86,7 +86,7 @@ def test_the_points_foreseen_never_exceed_the_points_a_plan_drops(monkeypatch, s
 
     def check_with_no_room(*args, **kwargs):  # the figure the check would refuse with, and the plan goes on
         try:
-            real_check(*args[:-1], 1, **kwargs)
+            real_check(*args, **{**kwargs, "max_points": 1})
         except LagsymError as e:
             foreseen.append(float(re.search(r"takes at least (\S+) drop-cutter points", str(e)).group(1)))
         return real_check(*args, **kwargs)

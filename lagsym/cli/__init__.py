@@ -278,8 +278,13 @@ def run_console() -> None:
     except KeyboardInterrupt:  # between main's own handlers (a second Ctrl-C)
         sys.stderr.write("lagsym: interrupted\n")
         status = ExitStatus.INTERRUPTED
-    # the first command after an install leaves the cutter kernel compiling in the background (toolpath.warmup)
-    from ..toolpath.warmup import start_in_background
+    try:
+        if status != ExitStatus.INTERRUPTED:
+            # the first command after an install leaves the cutter kernel compiling in the background
+            from ..toolpath.warmup import start_in_background
 
-    start_in_background()
+            start_in_background()
+    except KeyboardInterrupt:  # Ctrl-C as the command ends: the command's work is done, the compile not started
+        sys.stderr.write("lagsym: interrupted\n")
+        status = ExitStatus.INTERRUPTED
     sys.exit(status)

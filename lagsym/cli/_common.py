@@ -143,7 +143,11 @@ def conditioning_notes(grid, args, err: IO[str]) -> tuple[str, ...]:
     so on ``err``), else nothing.
     """
     from ..conditioning import require_conditioning
+    from ..exactsize import check_exact_size
 
+    if grid.amplification is None:  # an interpolant still to be made: its size is refused before its conditioning
+        check_exact_size(f"surface through {grid.shape[0]} x {grid.shape[1]} nodes", grid.source, grid.x, grid.y,
+                         [v for row in grid.z for v in row], exact_limit(args))
     a = require_conditioning(grid, accept=getattr(args, "accept_conditioning", False))
     if not a.exceeds:
         return ()

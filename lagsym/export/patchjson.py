@@ -22,6 +22,7 @@ from typing import IO
 from ..cad.patch import BSplinePatch
 from ..cad.solid import check_base, volume
 from ..errors import InputError
+from ..polytext import fraction_text
 from .cadtext import check_units
 
 __all__ = ["FORMAT", "patch_document", "write_patch_json", "parse_patch_json"]
@@ -38,13 +39,13 @@ def patch_document(patch: BSplinePatch, *, base_z: Fraction | None = None, units
         "surface": patch.name,
         "units": check_units(units),
         "degree": [patch.degree_u, patch.degree_v],
-        "knots_u": [str(k) for k in patch.knots_u],
-        "knots_v": [str(k) for k in patch.knots_v],
-        "control_points": [[[str(c) for c in p] for p in row] for row in patch.control_points],
+        "knots_u": [fraction_text(k) for k in patch.knots_u],
+        "knots_v": [fraction_text(k) for k in patch.knots_v],
+        "control_points": [[[fraction_text(c) for c in p] for p in row] for row in patch.control_points],
     }
     if base_z is not None:
         base_z = check_base(patch, base_z, source)
-        doc["solid"] = {"base_z": str(Fraction(base_z)), "volume": str(volume(patch, base_z))}
+        doc["solid"] = {"base_z": fraction_text(Fraction(base_z)), "volume": fraction_text(volume(patch, base_z))}
     return doc
 
 
@@ -55,6 +56,17 @@ def write_patch_json(stream: IO[str], patch: BSplinePatch, *, base_z: Fraction |
     rows = ",\n  ".join(json.dumps(row) for row in doc.pop("control_points"))
     head = "".join(f" {json.dumps(k)}: {json.dumps(v)},\n" for k, v in doc.items())  # one item, one row a line
     stream.write(f"{{\n{head} \"control_points\": [\n  {rows}]\n}}\n")
+
+
+def _fraction(text: str) -> Fraction:
+    """``Fraction(text)`` for ``"p/q"`` or ``"p"`` of any length: Python's own text-to-int conversion stops at 4,300
+    digits, python-flint's does not."""
+    import flint
+
+    num, slash, den = text.partition("/")
+    if not num.lstrip("-").isdigit() or (slash and not den.isdigit()):
+        raise ValueError(f"{text[:40]!r} is not an integer or a ratio of integers")
+    return Fraction(int(flint.fmpz(num)), int(flint.fmpz(den)) if slash else 1)
 
 
 def parse_patch_json(text: str, source: str = "<patch>") -> BSplinePatch:
@@ -75,9 +87,9 @@ def parse_patch_json(text: str, source: str = "<patch>") -> BSplinePatch:
         if doc.get("format") != FORMAT:
             raise InputError(f"{source}: not a {FORMAT} file")
         p, q = doc["degree"]
-        net = tuple(tuple(tuple(Fraction(c) for c in pt) for pt in row) for row in doc["control_points"])
-        return BSplinePatch(doc["surface"], p, q, tuple(Fraction(k) for k in doc["knots_u"]),
-                            tuple(Fraction(k) for k in doc["knots_v"]), net)
+        net = tuple(tuple(tuple(_fraction(c) for c in pt) for pt in row) for row in doc["control_points"])
+        return BSplinePatch(doc["surface"], p, q, tuple(_fraction(k) for k in doc["knots_u"]),
+                            tuple(_fraction(k) for k in doc["knots_v"]), net)
     except (ValueError, KeyError, TypeError, AttributeError) as e:
         if isinstance(e, InputError):
             raise

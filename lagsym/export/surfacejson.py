@@ -25,22 +25,13 @@ reading only; its figures are decimals.
 from __future__ import annotations
 
 import json
-from fractions import Fraction
 from typing import IO
+
+from ..polytext import fraction_text
 
 __all__ = ["FORMAT", "surface_document", "write_surface_json"]
 
 FORMAT = "lagsym-surface"
-
-
-def _text(v: Fraction) -> str:
-    # Through python-flint: Python's own int-to-text conversion stops at 4,300 digits, and an exact fit of
-    # many points to a high degree has coefficients longer than that.
-    import flint
-
-    v = Fraction(v)
-    num = str(flint.fmpz(v.numerator))
-    return num if v.denominator == 1 else f"{num}/{flint.fmpz(v.denominator)}"
 
 
 def surface_document(surface, coefficients=None, fit=None) -> dict:
@@ -56,10 +47,10 @@ def surface_document(surface, coefficients=None, fit=None) -> dict:
     if g.units:
         doc["units"] = g.units
     doc["degree"] = [len(coeffs) - 1, len(coeffs[0]) - 1]
-    doc["coefficients"] = [[_text(c) for c in row] for row in coeffs]
-    doc["x"] = [_text(v) for v in g.x]
-    doc["y"] = [_text(v) for v in g.y]
-    doc["z"] = [[_text(v) for v in row] for row in g.z]
+    doc["coefficients"] = [[fraction_text(c) for c in row] for row in coeffs]
+    doc["x"] = [fraction_text(v) for v in g.x]
+    doc["y"] = [fraction_text(v) for v in g.y]
+    doc["z"] = [[fraction_text(v) for v in row] for row in g.z]
     if g.amplification is not None:
         doc["amplification"] = g.amplification
     if fit is not None:

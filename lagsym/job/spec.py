@@ -181,6 +181,7 @@ _RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plung
            "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
            "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
            "tolerance": (1e-6, 1000.0)}
+_ABOVE = {"scallop", "tolerance"}  # above the low end, as --scallop and --tolerance
 _LENGTH_MM = 1e5  # safe_z, origin and block coordinates: within 100 m
 
 
@@ -191,7 +192,8 @@ def _positive(value, key: str, source: str, allow_zero: bool = False) -> float:
     v = float(value)
     if not (v == v and abs(v) != float("inf")) or v < 0 or (v == 0 and not allow_zero):
         raise InputError(f"{source}: {key} = {value!r} must be a number {'0 or more' if allow_zero else 'above 0'}")
-    return in_range(v, f"{source}: {key}", low, high, above=low == 0 and not allow_zero)
+    above = (low == 0 and not allow_zero) or key.rsplit(".", 1)[-1] in _ABOVE
+    return in_range(v, f"{source}: {key}", low, high, above=above)
 
 
 def _length(value, key: str, source: str) -> float:

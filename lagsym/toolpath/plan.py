@@ -34,7 +34,7 @@ from .workers import MIN_POINTS, Workers
 
 __all__ = ["Toolpath", "plan_toolpath", "MAX_PLAN_POINTS"]
 
-MAX_PLAN_POINTS = 20_000_000  # fine drop-cutter samples of one plan by default: about 2 GB of arrays
+MAX_PLAN_POINTS = 5_000_000  # fine drop-cutter samples of one plan by default: some 300 bytes each at the peak
 _ROW_BLOCK = 1 << 15  # fine samples dropped at a time, whole rows
 
 

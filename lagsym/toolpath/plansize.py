@@ -1,6 +1,7 @@
 """How many drop-cutter points a finishing plan takes, foreseen before the plan runs, and its refusal past the limit.
 
-A raster's size is its rows times the fine samples along a row; a scallop
+A roughing path's size is its rows times samples per row times levels, a
+finishing raster's its rows times the fine samples along a row; a scallop
 height's rows are bounded from below before they are walked
 (:func:`.scallop.scallop_levels`); waterline and steep-and-shallow count the
 grid, the contour crossings (:func:`.contours.crossings_at_least`) and the
@@ -20,7 +21,7 @@ from . import chordal
 from .contours import CROSSING_POINTS, crossings_at_least
 from .scallop import TooManyRows, scallop_levels
 
-__all__ = ["check_size", "scallop_rows", "per_row", "too_many", "check_strategy_work", "row_samples", "nearest_nodes"]
+__all__ = ["check_points", "check_size", "scallop_rows", "per_row", "too_many", "check_strategy_work", "row_samples", "nearest_nodes"]
 
 
 def scallop_rows(ev, tool: Tool, raster: RasterSpec, reach, *, fine: float, mm_per_unit: float,
@@ -61,7 +62,7 @@ def check_size(bounds, direction: str, stepover: float, fine: float, scale: floa
         raise too_many(rows, along, max_points, f"side step {stepover:g} mm", fine)
 
 
-def check_strategy_work(f, steep, shallow, d0: float, raster: RasterSpec, ev, max_points: int | None, *,
+def check_strategy_work(f, steep, shallow, d0: float, raster: RasterSpec, *, ev, max_points: int | None,
                         strategy: str, mpu: float) -> None:
     """Refuse, before its passes are planned, a waterline or steep-and-shallow plan whose drop-cutter points
     surely exceed ``max_points``.
@@ -103,3 +104,26 @@ def nearest_nodes(a_axis, n: int) -> np.ndarray:
     """The grid node along ``a_axis`` nearest each of ``n`` fine samples over it."""
     along = np.linspace(a_axis[0], a_axis[-1], n)
     return np.clip(np.rint((along - a_axis[0]) / (a_axis[1] - a_axis[0])).astype(int), 0, len(a_axis) - 1)
+
+
+def check_points(stock, tool: Tool, spec, levels: int, max_points: int | None, option: str) -> None:
+    """Refuse a roughing path over ``stock`` (a :class:`.rough.Stock`) of more than ``max_points`` (rows times
+    samples per row, times ``levels``; ``spec`` a :class:`.rough.RoughSpec`) before making it."""
+    if max_points is None:
+        return
+    along, cross = ((stock.x1 - stock.x0, stock.y1 - stock.y0) if spec.direction == "x"
+                    else (stock.y1 - stock.y0, stock.x1 - stock.x0))
+    # floats: a side step of 1e-308 mm gives a count no int conversion takes, and it is refused all the same
+    rows = _whole(cross / spec.stepover_mm) + 1
+    samples = _whole((along + 2 * (spec.clearance_mm + tool.radius_mm)) / spec.step_mm) + 1
+    total = rows * samples * levels
+    if total > max_points:
+        what = f"{rows:.4g} rows of {samples:.4g} samples" + (f" at {levels} levels" if levels > 1 else "")
+        raise ToolpathError(f"{what} is {total:.3g} points, more than the limit of {max_points:.3g} (side step "
+                            f"{spec.stepover_mm:g} mm, step {spec.step_mm:g} mm, step-down {spec.stepdown_mm:g} mm); "
+                            f"use larger steps or raise the limit ({option})")
+
+
+def _whole(v: float) -> float:
+    """``ceil(v)``, kept a float: an infinity stays one."""
+    return float(math.ceil(v)) if math.isfinite(v) else v

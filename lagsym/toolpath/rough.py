@@ -48,6 +48,7 @@ from .chordal import check_moves, crosses_box_edge, lift
 from .dropcutter import drop_cutter, evaluator_of, telling_compiles
 from .pattern import levels as spaced
 from .plan import MAX_PLAN_POINTS
+from .plansize import check_points
 from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
 
 __all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
@@ -258,6 +259,9 @@ def rough_levels(floors, sigma: float, stock: Stock, cut: tuple, max_points: int
     tool, spec = cut
     reachable = np.concatenate(list(floors))
     low = float(reachable[np.isfinite(reachable)].min()) + sigma
+    if low >= stock.top_mm:
+        raise ToolpathError(f"nothing to rough: the lowest the tool goes, {low:.3f} mm with the stock to leave "
+                            f"({spec.stock_to_leave_mm:g} mm), is at or above the stock top {stock.top_mm:g} mm")
     count = max(int(math.ceil((stock.top_mm - low) / spec.stepdown_mm - 1e-9)), 1)
     check_points(stock, tool, spec, count, max_points, "--max-points")
     z_levels = np.maximum(stock.top_mm - spec.stepdown_mm * np.arange(1, count + 1), low)
@@ -284,29 +288,6 @@ def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEv
                             "ridges would stand between the rows")
     _check_stock(stock, place.box_mm(ev.bounds), ev, place)
     check_points(stock, tool, spec, 1, max_points, option)
-
-
-def check_points(stock: Stock, tool: Tool, spec: RoughSpec, levels: int, max_points: int | None,
-                  option: str) -> None:
-    """Refuse a path of more than ``max_points`` (rows times samples per row, times ``levels``) before making it."""
-    if max_points is None:
-        return
-    along, cross = ((stock.x1 - stock.x0, stock.y1 - stock.y0) if spec.direction == "x"
-                    else (stock.y1 - stock.y0, stock.x1 - stock.x0))
-    # floats: a side step of 1e-308 mm gives a count no int conversion takes, and it is refused all the same
-    rows = _whole(cross / spec.stepover_mm) + 1
-    per_row = _whole((along + 2 * (spec.clearance_mm + tool.radius_mm)) / spec.step_mm) + 1
-    total = rows * per_row * levels
-    if total > max_points:
-        what = f"{rows:.4g} rows of {per_row:.4g} samples" + (f" at {levels} levels" if levels > 1 else "")
-        raise ToolpathError(f"{what} is {total:.3g} points, more than the limit of {max_points:.3g} (side step "
-                            f"{spec.stepover_mm:g} mm, step {spec.step_mm:g} mm, step-down {spec.stepdown_mm:g} mm); "
-                            f"use larger steps or raise the limit ({option})")
-
-
-def _whole(v: float) -> float:
-    """``ceil(v)``, kept a float: an infinity stays one."""
-    return float(math.ceil(v)) if math.isfinite(v) else v
 
 
 def _check_stock(stock: Stock, box, ev: SurfaceEvaluator, place) -> None:

@@ -174,7 +174,8 @@ def plan_strategy(surface, tool: Tool, raster: RasterSpec, placement: Placement 
         theta = _threshold(f, slope, d0, mpu)
         steep = ~f.tight & (slope >= theta - BAND_DEG)
         shallow = (slope <= theta + BAND_DEG) | ~f.inside if strategy == "steep-shallow" else None
-        check_strategy_work(f, steep, shallow, d0, raster, drop.cl.ev, max_points, strategy=strategy, mpu=mpu)
+        check_strategy_work(f, steep, shallow, d0, raster, ev=drop.cl.ev, max_points=max_points, strategy=strategy,
+                            mpu=mpu)
         passes = []
         if shallow is not None:
             with Tally(progress, "raster rows") as t:

@@ -1,0 +1,107 @@
+"""A third round of hostile input: each case here failed before its fix (an internal error, an option ignored,
+air cut above the block, a refusal that came only after minutes, a traceback at the end of a command)."""
+
+from __future__ import annotations
+
+import json
+import time
+from fractions import Fraction
+
+import pytest
+
+from lagsym import LagsymError
+from lagsym.cad.patch import BSplinePatch
+from lagsym.conditioning import lebesgue_maximum
+from lagsym.export.patchjson import parse_patch_json, write_patch_json
+from lagsym.machine import RasterSpec
+from lagsym.polytext import fraction_text
+
+from conftest import EXAMPLES
+
+
+def test_a_patch_with_rationals_past_pythons_4300_digits_is_written_and_read_back_exactly(tmp_path):
+    """``export -o x.json`` of a 70x70 grid of three-decimal nodes ended in an internal error: str() of a
+    Fraction stops at 4,300 digits."""
+    huge = Fraction(3 ** 20000 + 1, 7 ** 6000)
+    patch = BSplinePatch("Lagrange", 1, 1, (Fraction(0), Fraction(0), Fraction(1), Fraction(1)),
+                         (Fraction(0), Fraction(0), Fraction(1), Fraction(1)),
+                         (((Fraction(0), Fraction(0), huge), (Fraction(0), Fraction(1), Fraction(1))),
+                          ((Fraction(1), Fraction(0), -huge), (Fraction(1), Fraction(1), Fraction(2)))))
+    path = tmp_path / "p.json"
+    with path.open("w") as f:
+        write_patch_json(f, patch)
+    assert parse_patch_json(path.read_text()) == patch
+    with pytest.raises(LagsymError, match="not a valid"):
+        parse_patch_json(path.read_text().replace(fraction_text(huge)[:50], "12x4", 1))
+
+
+def _job(tmp_path, finish: str = "stepover = 0.5\nstep = 0.2\n", rough_leave: str = "0.3"):
+    text = (EXAMPLES / "example-4-job.toml").read_text()
+    text = text[:text.rindex("stepover = 0.5")] + finish
+    text = text.replace("stock_to_leave = 0.3", f"stock_to_leave = {rough_leave}")
+    (tmp_path / "paper-example-4.json").write_text((EXAMPLES / "paper-example-4.json").read_text())
+    (tmp_path / "job.toml").write_text(text)
+    return tmp_path / "job.toml"
+
+
+@pytest.mark.parametrize("finish, words", [
+    ("stepover = 0.5\nscallop = 0.01\nstep = 0.2\n", "give a side step (stepover 0.5 mm) or a scallop height "
+                                                       "(scallop 0.01 mm), not both"),
+    ("scallop = 0.000001\nstep = 0.2\n", "operations[1].scallop = 1e-06 is out of range: give a number above 1e-06"),
+])
+def test_a_job_refuses_a_scallop_it_would_have_ignored_or_the_command_line_refuses(tmp_path, run_cli, finish, words):
+    """Both a side step and a scallop height: the scallop was ignored in silence; 1e-6 passed in a job file while
+    --scallop refuses it."""
+    status, _, err = run_cli("job", _job(tmp_path, finish), "-o", tmp_path / "j.ngc")
+    assert status == 2 and err.count("\n") == 1 and words in err, err
+    assert not (tmp_path / "j.ngc").exists()
+    with pytest.raises(LagsymError, match="not both"):
+        RasterSpec("x", 0.5, 0.2, 0.01)
+
+
+def test_roughing_with_more_stock_to_leave_than_the_block_holds_is_refused_not_cut_in_air(tmp_path, run_cli):
+    """``stock_to_leave = 100`` roughed at Z108 to Z171, above the block's top (73.56) and the safe height."""
+    job = _job(tmp_path, rough_leave="100")
+    status, _, err = run_cli("job", job, "-o", tmp_path / "j.ngc")
+    assert status == 2 and err.count("\n") == 1, err
+    assert "operations[0] (rough): nothing to rough: the lowest the tool goes, 108.677 mm with the stock to leave " \
+           "(100 mm), is at or above the stock top 73.561 mm" in err
+
+
+def test_a_grid_too_large_to_make_is_refused_before_its_conditioning_is_measured(tmp_path, run_cli):
+    """A 1500x3 grid: the Lebesgue constants of 1500 nodes took 13-26 s and 2.2 GB and overflowed to 'inf times'
+    before the size limit refused the surface."""
+    path = tmp_path / "g.json"
+    path.write_text(json.dumps({"points": [[f"{i / 10:.1f}", j, (i * j) % 10] for i in range(1500) for j in range(3)]}))
+    for command in (["export", path, "-o", tmp_path / "e.step"],
+                    ["toolpath", path, "--safe-z", "80", "--feed", "500", "-o", tmp_path / "t.nc"]):
+        started = time.monotonic()
+        status, _, err = run_cli(*command)
+        assert status == 2 and err.count("\n") == 1, err
+        assert "1500 x 3 nodes would take an estimated" in err and "(--max-exact-mb" in err, err
+        assert time.monotonic() - started < 30
+
+
+def test_a_lebesgue_constant_beyond_a_float_is_said_so():
+    value, _ = lebesgue_maximum(list(range(39)) + [10 ** 10])  # about 1e333 between the last two nodes
+    assert value == float("inf")
+    from lagsym.conditioning import Amplification
+
+    text = Amplification(value, value, 1.25, (0.0, 1.5)).text()
+    assert "inf" not in text and "more than 1.798e+308 times" in text, text
+
+
+def test_ctrl_c_as_the_command_ends_gives_one_line_and_no_traceback(monkeypatch, capsys):
+    """A Ctrl-C that arrived while the background compile was being started printed a 40-line traceback."""
+    import lagsym.cli as cli
+    import lagsym.toolpath.warmup as warmup
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(warmup, "start_in_background", interrupted)
+    monkeypatch.setattr(cli, "main", lambda: 0)
+    with pytest.raises(SystemExit) as ended:
+        cli.run_console()
+    assert ended.value.code == 130
+    assert capsys.readouterr().err == "lagsym: interrupted\n"
