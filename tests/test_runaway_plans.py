@@ -45,7 +45,7 @@ def test_the_rows_foreseen_never_exceed_the_rows_walked(name, direction, radius,
 @pytest.mark.slow
 def test_a_job_with_a_scallop_too_small_for_the_point_limit_is_refused_in_seconds(tmp_path, run_cli):
     job = (EXAMPLES / "example-4-job.toml").read_text()
-    job = job[:job.rindex("stepover = 0.5")] + "scallop = 0.000001\nstep = 0.2\n"
+    job = job[:job.rindex("stepover = 0.5")] + "scallop = 0.000002\nstep = 0.2\n"
     (tmp_path / "paper-example-4.json").write_text((EXAMPLES / "paper-example-4.json").read_text())
     (tmp_path / "job.toml").write_text(job)
     started = time.monotonic()
