@@ -105,3 +105,21 @@ def test_ctrl_c_as_the_command_ends_gives_one_line_and_no_traceback(monkeypatch,
         cli.run_console()
     assert ended.value.code == 130
     assert capsys.readouterr().err == "lagsym: interrupted\n"
+
+
+@pytest.mark.slow
+def test_a_long_program_of_expressions_is_compiled_in_pieces_and_its_alarm_names_its_line():
+    """11 MB of long expressions took 3.6 GB in Python's compiler (about 35 KB a block, all at once); the code
+    is now compiled a few thousand lines at a time, and an alarm far down still names its own line."""
+    import subprocess
+    import sys
+
+    code = ("from lagsym.simulate import simulate, ControlAlarm\n"
+            "e = '#100=[[[[#100+1.]*[#101+2.]]/[[#102+3.]+4.]]-[[[#103+1.]*2.]+[#104*3.]]+[#105+#106+#107+#108+#109]]'\n"
+            "lines = ['%', 'O1000'] + [e] * 20000 + ['#102=[#100/0]', 'M30', '%']\n"
+            "try:\n    simulate('\\n'.join(lines) + '\\n', 'fanuc', 8)\nexcept ControlAlarm as e:\n    print(e)\n"
+            "import resource; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    alarm, peak_kb = done.stdout.splitlines()
+    assert "division by zero at line 20003: '#102=[#100/0]'" in alarm, done.stdout + done.stderr
+    assert int(peak_kb) < 400_000  # all at once took 690 MB for this program

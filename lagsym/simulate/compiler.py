@@ -24,6 +24,7 @@ block is found from the line of the generated code that raised it
 
 from __future__ import annotations
 
+import ast
 import re
 from decimal import ROUND_HALF_UP, Decimal
 
@@ -39,6 +40,7 @@ __all__ = ["compile_program", "alarm_block", "SOURCE_NAME"]
 SOURCE_NAME = "<lagsym-macro>"
 _CONTROL = (While, OWhile, End, OEndWhile, OIf, OElseIf, OElse, Goto, IfGoto, IfGotoLabel, Stop)
 MAX_SEGMENT = 100  # blocks in one function at most
+_BATCH_LINES = 5000  # lines of generated code compiled at a time
 _NAME = re.compile(r"\b[A-Za-z_]\w*\b")
 
 
@@ -305,6 +307,7 @@ def compile_program(m, blocks, labels) -> tuple[list, list[int]]:
     prog = _Program(m, blocks, labels)
     starts = _leaders(blocks, labels)
     source, where, spans = [], [-1], []  # where[line number] is the block of that line
+    namespace: dict = {}
     for start, stop in zip(starts, starts[1:] + [len(blocks)]):
         lines, last = prog.segment(start, stop)
         spans.append((start, last))
@@ -314,13 +317,29 @@ def compile_program(m, blocks, labels) -> tuple[list, list[int]]:
         for text, blk in lines:
             source.append(text)
             where.append(blk)
-    code = compile("\n".join(source) + "\n", SOURCE_NAME, "exec")
-    namespace = dict(prog.env)
-    exec(code, namespace)  # the code is generated here from the parsed blocks, nothing else
+        if len(source) >= _BATCH_LINES:
+            _run(source, len(where) - 1 - len(source), prog.env, namespace)
+            source = []
+    _run(source, len(where) - 1 - len(source), prog.env, namespace)
     table: list = [None] * len(blocks)
     for start, last in spans:
         table[start] = (namespace[f"s{start}"], last - start + 1, last)
     return table, where
+
+
+def _run(source: list[str], before: int, env: dict, namespace: dict) -> None:
+    """Compile and run the functions of ``source``, numbered as lines ``before + 1`` on of the program's code.
+
+    The code is compiled a few thousand lines at a time: Python's compiler
+    takes some hundred times the text's size while it works, and a program
+    of long expressions makes tens of megabytes of code.
+    """
+    if not source:
+        return
+    tree = ast.parse("\n".join(source) + "\n", SOURCE_NAME, "exec")
+    ast.increment_lineno(tree, before)
+    namespace.update(env)
+    exec(compile(tree, SOURCE_NAME, "exec"), namespace)  # the code is generated here from the parsed blocks
 
 
 def alarm_block(error: BaseException, where: list[int]) -> int | None:
