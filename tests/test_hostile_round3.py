@@ -16,7 +16,7 @@ from lagsym.export.patchjson import parse_patch_json, write_patch_json
 from lagsym.machine import RasterSpec
 from lagsym.polytext import fraction_text
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, ROOT
 
 
 def test_a_patch_with_rationals_past_pythons_4300_digits_is_written_and_read_back_exactly(tmp_path):
@@ -123,3 +123,21 @@ def test_a_long_program_of_expressions_is_compiled_in_pieces_and_its_alarm_names
     alarm, peak_kb = done.stdout.splitlines()
     assert "division by zero at line 20003: '#102=[#100/0]'" in alarm, done.stdout + done.stderr
     assert int(peak_kb) < 400_000  # all at once took 690 MB for this program
+
+
+def test_a_program_of_more_bracketed_expressions_than_lines_allowed_is_refused_before_it_is_read(tmp_path, run_cli):
+    """99,990 lines of a 109-character expression (11 MB, within --max-lines) took 123 s and 3.6 GB."""
+    from lagsym.simulate.runaway import EXPRESSIONS_PER_LINE
+
+    e = "#100=[[[[#100+1.]*[#101+2.]]/[[#102+3.]+4.]]-[[[#103+1.]*2.]+[#104*3.]]+[#105+#106+#107]]"
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1000\n" + (e + "\n") * 100 + "M30\n%\n")
+    brackets = program.read_text().count("[")
+    status, _, err = run_cli("simulate", program, "--max-lines", brackets // EXPRESSIONS_PER_LINE - 1)
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"p.nc: {brackets:,} bracketed expressions, more than the limit of {brackets - 1:,}" in err, err
+    status, _, err = run_cli("simulate", program, "--max-lines", brackets // EXPRESSIONS_PER_LINE)
+    assert status == 0, err
+    formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
+    assert "at most 100000 lines (`--max-lines`) and as many bracketed expressions" in formats
+    assert EXPRESSIONS_PER_LINE == 1  # "as many" in the docs

@@ -38,17 +38,25 @@ __all__ = ["Runaway", "endless_jumps", "MAX_BLOCKS", "MAX_IDLE_BLOCKS"]
 
 MAX_BLOCKS = 5_000_000  # 2.0 times the 2.53 million of the README's Example 4 ball macro at 8 digits
 MAX_PROGRAM_LINES = 100_000  # lines read and compiled: about 11 KB each while compiled, so about 1.1 GB
+EXPRESSIONS_PER_LINE = 1  # bracketed expressions (each '[') the line limit allows, on average a line
 MAX_IDLE_BLOCKS = 200_000  # lagsym's macros move every few hundred blocks at most (a 12x12 Heidenhain one: 613)
 
 
 def check_lines(text: str, max_lines: int | None, source: str = "the program") -> None:
-    """Refuse ``text`` of more than ``max_lines`` lines, before any is read into blocks (None: no limit)."""
+    """Refuse ``text`` of more than ``max_lines`` lines, or of more than :data:`EXPRESSIONS_PER_LINE` times as
+    many bracketed expressions (each takes some 0.1 ms to read and compile), before any is read into blocks (None: no limit)."""
     if max_lines is None:
         return
     lines = text.count("\n") + 1
     if lines > whole(max_lines, "max_lines", 1, 1 << 62):
         raise InputError(f"{source}: {lines:,} lines, more than the limit of {max_lines:,} (about "
                          f"{lines * 11e3 / 1e9:.2g} GB to read and compile them); raise the limit (--max-lines)")
+    # A bracketed expression costs about as much to read and compile as a whole block of a point list does.
+    brackets = text.count("[")
+    if brackets > EXPRESSIONS_PER_LINE * max_lines:
+        raise InputError(f"{source}: {brackets:,} bracketed expressions, more than the limit of "
+                         f"{EXPRESSIONS_PER_LINE * max_lines:,} (one for each line --max-lines allows); "
+                         f"raise the limit (--max-lines)")
 
 
 class Runaway:
