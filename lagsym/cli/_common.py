@@ -13,22 +13,32 @@ from ..controls import CONTROLS, work_offset
 from ..values import as_exact, finite, in_range, whole
 
 
-def check_paths(args) -> None:
-    """Before any work: ``-o`` must be a path that can be written, and not one of the command's input files."""
-    from ..io import check_not_input, check_output
+# The options that name a file a command writes, by argparse name: each is checked against the command's inputs
+# and against the other outputs before any work.  ``--log`` is appended to, and checked as it opens.
+OUTPUT_OPTIONS = {"output": "-o", "print_output": "--print-output", "plot": "--plot", "log": "--log"}
 
-    output = getattr(args, "output", None)
-    if not output or output == "-" or not isinstance(output, str):
+
+def check_paths(args) -> None:
+    """Before any work: every output (``-o``, ``--print-output``, ``--plot``, ``--log``) must be a path that can
+    be written, not one of the command's input files, and not the file of another output."""
+    from ..io import check_apart, check_not_input, check_output
+
+    outputs = [(option, value) for name, option in OUTPUT_OPTIONS.items()
+               if isinstance(value := getattr(args, name, None), str) and value and value != "-"]
+    if not outputs:
         return
-    check_output(output)
     inputs = []
     for name, value in vars(args).items():
-        if name in ("output", "log"):
+        if name in OUTPUT_OPTIONS:
             continue
         for v in value if isinstance(value, (list, tuple)) else (value,):
             if isinstance(v, str) and v and v != "-" and "\x00" not in v:
                 inputs.append(v)
-    check_not_input(output, inputs)
+    for option, path in outputs:
+        if option != "--log":
+            check_output(path)
+        check_not_input(path, inputs, "" if option == "-o" else option)
+    check_apart(outputs)
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..io import write_text
+from ..io import check_not_input, write_text
 from ._common import add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
@@ -58,6 +58,8 @@ def run(args, out, err) -> int:
     from ._progress import progress_bar
 
     spec = read_job(args.job)
+    if args.output and args.output != "-" and spec.points is not None:
+        check_not_input(args.output, [spec.points])  # the job file's points are an input too
     if spec.probe is not None and not args.measured:
         return _probe_program(spec, args, out, err)
     if args.measured:

