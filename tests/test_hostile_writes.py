@@ -4,7 +4,10 @@ past the system's limits, file names with control characters, a header that does
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
+import pytest
 
 from conftest import EXAMPLES
 
@@ -70,3 +73,49 @@ def test_job_output_naming_the_job_points_is_refused(run_cli, tmp_path):
     job.write_text((EXAMPLES / "example-4-job.toml").read_text().replace('"paper-example-4.json"', '"pts.json"'))
     _refused(*run_cli("job", job, "-o", pts), "is also an input")
     assert pts.read_bytes() == EXAMPLE4.read_bytes()
+
+
+# F2: a full disk under VTK's writers (and meshio's): one line, exit 2, the earlier file untouched.
+
+@pytest.fixture
+def full_disk(tmp_path):
+    """A 200 KB tmpfs: mounted here when running as root, else the tests skip."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a small tmpfs (a disk that fills) needs root")
+    where = tmp_path / "full"
+    where.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=200k", "tmpfs", str(where)], capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {r.stderr.strip()}")
+    try:
+        yield where
+    finally:
+        subprocess.run(["umount", "-l", str(where)], check=False)
+
+
+@pytest.mark.parametrize("ext", [".vts", ".stl", ".vtk", ".ply", ".obj"])
+def test_a_full_disk_keeps_the_earlier_mesh_and_says_one_line(full_disk, ext):
+    target = full_disk / f"s{ext}"
+    target.write_text("earlier\n")
+    r = subprocess.run([sys.executable, "-m", "lagsym", "sample", str(EXAMPLE4), "--nx", "300", "-q", "-o",
+                        str(target)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2 and r.stdout == "", (r.returncode, r.stderr[:2000])
+    assert r.stderr == f"lagsym: error: {target}: cannot write ({r.stderr.split('(', 1)[1]}"
+    assert r.stderr.count("\n") == 1 and r.stderr.count("cannot write") == 1, r.stderr[:2000]
+    assert "vtk" not in r.stderr.replace(str(target), "").lower() and "any earlier file there is untouched" in r.stderr
+    if ext in (".vts", ".stl"):
+        assert "no space left on the device" in r.stderr
+    assert target.read_text() == "earlier\n"
+    assert sorted(os.listdir(full_disk)) == [target.name]  # no temporary left behind
+
+
+@pytest.mark.parametrize("ext", [".vts", ".stl"])
+def test_a_vtk_mesh_written_whole_is_checked_and_kept(run_cli, tmp_path, ext):
+    target = tmp_path / f"s{ext}"
+    status, out, err = run_cli("sample", EXAMPLE4, "--nx", "30", "--ny", "20", "-q", "-o", target)
+    assert (status, err) == (0, ""), err
+    data = target.read_bytes()
+    if ext == ".stl":
+        assert len(data) == 84 + 50 * 2 * 29 * 19
+    else:
+        assert data.endswith(b"</VTKFile>\n")

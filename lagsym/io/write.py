@@ -215,12 +215,22 @@ def atomic_path(path: str | os.PathLike) -> Iterator[str]:
         if stream:
             _copy_into(tmp, given)
         else:
+            _sync(tmp)
             _commit(tmp, real, path)
     except OSError as e:
         raise _write_error(path, e, stream) from None
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+
+
+def _sync(tmp: str) -> None:
+    """The temporary's bytes on the disk before the rename: a file system that allocates late says ENOSPC here."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _copy_into(tmp: str, target: Path) -> None:
