@@ -119,3 +119,34 @@ def test_a_vtk_mesh_written_whole_is_checked_and_kept(run_cli, tmp_path, ext):
         assert len(data) == 84 + 50 * 2 * 29 * 19
     else:
         assert data.endswith(b"</VTKFile>\n")
+
+
+# F4: a path the system cannot take whole (its absolute form over PATH_MAX, a symbolic-link loop) is one line, exit 2.
+
+@pytest.fixture
+def deep(tmp_path, monkeypatch):
+    """A relative folder of 4,089 characters (4,095 with ``/x.txt``) whose absolute path is over 4,096."""
+    monkeypatch.chdir(tmp_path)
+    rel = "/".join(["d" * 200] * 20) + "/" + "e" * 69
+    os.makedirs(rel)
+    assert len(rel + "/x.txt") == 4095 and len(os.path.abspath(rel + "/x.txt")) > 4096
+    return rel
+
+
+def test_an_output_whose_absolute_path_is_too_long_is_one_line(run_cli, deep):
+    _refused(*run_cli("equation", EXAMPLE4, "-o", deep + "/x.txt"), "longer than the system allows")
+    p = "p.nc"
+    with open(p, "w") as fh:
+        fh.write(PROGRAM)
+    _refused(*run_cli("simulate", p, "--print-output", deep + "/x.txt"), "longer than the system allows")
+    assert os.listdir(deep) == []
+
+
+def test_an_input_path_too_long_or_looping_is_one_line(run_cli, tmp_path, deep):
+    _refused(*run_cli("equation", os.path.abspath(deep) + "/x.json"), "longer than the system allows")
+    (tmp_path / "l1").symlink_to(tmp_path / "l2")
+    (tmp_path / "l2").symlink_to(tmp_path / "l1")
+    _refused(*run_cli("rough", "l1", "--stock-above", "2"), "too many levels of symbolic links")
+    (tmp_path / "c.toml").write_text(f'[[port]]\nname = "a"\ndevice = "loop://"\nprograms = "{deep}"\n'
+                                     f'received = "."\n')
+    _refused(*run_cli("dnc", "serve", "c.toml", "--check"), "longer than the system allows")

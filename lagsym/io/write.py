@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import InputError, OutputError
+from .files import path_problem
 
 __all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "check_apart",
            "OutputNotice", "temporary_name"]
@@ -47,11 +48,7 @@ def _write_error(path, e: OSError, stream: bool = False) -> OutputError:
 
 
 def _path_error(path, e: OSError) -> InputError:
-    if e.errno == errno.ELOOP:
-        return InputError(f"{path}: too many levels of symbolic links (a loop?)")
-    if e.errno == errno.ENAMETOOLONG:
-        return InputError(f"{path}: the name or path is longer than the system allows")
-    return InputError(f"{path}: cannot use this path ({_reason(e)})")
+    return InputError(f"{path}: {path_problem(e) or f'cannot use this path ({_reason(e)})'}")
 
 
 def _target(path) -> tuple[Path, os.stat_result | None]:
@@ -86,9 +83,14 @@ def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
         raise InputError(f"{path}: is a directory")
     stream = info is not None and not stat.S_ISREG(info.st_mode)
     directory = Path(tempfile.gettempdir()) if stream else real.parent
-    if not directory.is_dir():
-        what = f"{directory} is not a folder" if directory.exists() else f"the folder {directory} does not exist"
-        raise InputError(f"{path}: {what}")
+    try:
+        folder = stat.S_ISDIR(os.stat(directory).st_mode)
+    except (FileNotFoundError, NotADirectoryError):
+        raise InputError(f"{path}: the folder {directory} does not exist") from None
+    except OSError as e:  # the folder's whole path over the system's limit, a loop, no permission
+        raise _path_error(path, e) from None
+    if not folder:
+        raise InputError(f"{path}: {directory} is not a folder")
     if not stream:
         limit = _name_max(directory)
         if len(os.fsencode(real.name)) > limit:
