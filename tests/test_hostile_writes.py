@@ -150,3 +150,34 @@ def test_an_input_path_too_long_or_looping_is_one_line(run_cli, tmp_path, deep):
     (tmp_path / "c.toml").write_text(f'[[port]]\nname = "a"\ndevice = "loop://"\nprograms = "{deep}"\n'
                                      f'received = "."\n')
     _refused(*run_cli("dnc", "serve", "c.toml", "--check"), "longer than the system allows")
+
+
+# F15: a note, a warning or a summary that names a file shows a newline in the name escaped, as errors do.
+
+SEMICOLON_TABLE = "x;y;z\n1;1;1,5\n1;2;2\n2;1;3\n2;2;4\n"
+
+
+@pytest.mark.parametrize("command", ["equation", "check", "fit", "piecewise"])
+def test_a_note_naming_a_file_with_a_newline_is_one_line(run_cli, tmp_path, command):
+    p = tmp_path / "semi\ncolon.csv"
+    p.write_text(SEMICOLON_TABLE)
+    status, out, err = run_cli(command, p)
+    note = [line for line in err.splitlines() if "read as semicolon-separated" in line]
+    assert len(note) == 1 and note[0].startswith(str(tmp_path) + "/semi\\ncolon.csv: read as"), err
+    assert "colon.csv" not in err.replace("semi\\ncolon.csv", ""), err  # no line starts inside the name
+
+
+def test_summaries_naming_a_file_with_a_newline_are_one_line(run_cli, tmp_path):
+    prog = tmp_path / "p\nq.nc"
+    prog.write_text(PROGRAM)
+    status, out, err = run_cli("simulate", prog, "-o", os.devnull)
+    assert status == 0 and err == f"{tmp_path}/p\\nq.nc: fanuc, 8 digits: " + err.split(": fanuc, 8 digits: ")[1]
+    assert err.count("\n") == 1, err
+    step = tmp_path / "x\ny.step"
+    status, out, err = run_cli("export", EXAMPLE4, "-o", step)
+    assert status == 0 and out.startswith(f"{tmp_path}/x\\ny.step: ") and out.count("\n") == 1, out
+    nc = tmp_path / "t\nu.nc"
+    status, out, err = run_cli("toolpath", EXAMPLE4, "--stepover", "1", "--step", "1", "-o", nc)
+    assert status == 0 and err.startswith(f"{tmp_path}/t\\nu.nc: ") and err.count("\n") == 1, err
+    status, out, err = run_cli("equation", EXAMPLE4, "x\ny")
+    assert status == 2 and "x\\ny" in err and err.count("\n") == 1, err

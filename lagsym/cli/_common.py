@@ -9,6 +9,7 @@ from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
+from ._lines import say
 from ..controls import CONTROLS, work_offset
 from ..values import as_exact, finite, in_range, whole
 
@@ -110,9 +111,9 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
 
     f = read_point_file(path, what, getattr(args, "columns", None), getattr(args, "snap", None))
     if not f.plain:
-        err.write(f"{path}: read as {f.layout}\n")
+        say(err, f"{path}: read as {f.layout}")
     if f.snapped is not None:
-        err.write(f.snapped.text(str(path)) + "\n")
+        say(err, f.snapped.text(str(path)))
     return f.points
 
 
@@ -157,8 +158,8 @@ def conditioning_notes(grid, args, err: IO[str]) -> tuple[str, ...]:
     a = require_conditioning(grid, accept=getattr(args, "accept_conditioning", False))
     if not a.exceeds:
         return ()
-    err.write(f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
-              f"accepted with --accept-conditioning\n")
+    say(err, f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
+             f"accepted with --accept-conditioning")
     return (a.header_note(),)
 
 
