@@ -181,3 +181,45 @@ def test_summaries_naming_a_file_with_a_newline_are_one_line(run_cli, tmp_path):
     assert status == 0 and err.startswith(f"{tmp_path}/t\\nu.nc: ") and err.count("\n") == 1, err
     status, out, err = run_cli("equation", EXAMPLE4, "x\ny")
     assert status == 2 and "x\\ny" in err and err.count("\n") == 1, err
+
+
+# F19: a header of another width than its rows is refused; no message echoes more than a few hundred characters.
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_a_header_wider_than_its_rows_is_refused_in_one_short_line(run_cli, tmp_path):
+    p = _write(tmp_path / "hdr160k.csv", "x,y,z" + ",w" * 80000 + "\n1,1,2\n1,2,3\n2,1,3\n2,2,4\n")
+    status, out, err = run_cli("equation", p)
+    _refused(status, out, err, "the header (line 1) has 80,003 columns but the data lines have 3 (line 2)")
+    assert len(err) < 400 and "'x,y,z,w," in err, err
+    narrow = _write(tmp_path / "narrow.csv", "x,y,z\n1,1,2,5\n1,2,3,5\n2,1,3,5\n2,2,4,5\n")
+    _refused(*run_cli("equation", narrow), "the header (line 1) has 3 columns but the data lines have 4")
+
+
+def test_a_trailing_separator_is_not_a_column(run_cli, tmp_path):
+    for text in ("x,y,z,\n1,1,2,\n1,2,3,\n2,1,3,\n2,2,4,\n", "x,y,z,\n1,1,2\n1,2,3\n2,1,3\n2,2,4\n",
+                 "x,y,z\n1,1,2,\n1,2,3,\n2,1,3,\n2,2,4,\n"):
+        status, out, err = run_cli("equation", _write(tmp_path / "t.csv", text))
+        assert (status, out) == (0, "z = x + y\n"), (text, err)
+
+
+def test_the_notes_and_messages_quote_a_short_prefix(run_cli, tmp_path):
+    from lagsym.cli._lines import MAX_MESSAGE
+    from lagsym.io.table import SHOWN, SHOWN_NAMES
+
+    assert (SHOWN, SHOWN_NAMES, MAX_MESSAGE) == (60, 5, 600)  # as docs/formats.md says
+    ids = [f"identifier{i}" for i in range(1000)]
+    rows = "".join(",".join(["0"] * 1000) + f",{a},{b},{a + b}\n" for a in (1, 2) for b in (1, 2))
+    p = _write(tmp_path / "ids.csv", ",".join(ids) + ",x,y,z\n" + rows)
+    status, out, err = run_cli("equation", p)
+    assert status == 0 and err.count("\n") == 1 and len(err) < 400, err
+    assert "ignoring column(s) identifier0, identifier1, identifier2, identifier3, identifier4 and 995 more" in err
+    assert "'identifier0,identifier1,identifier2,identifier3,identifier4,'... (" in err
+    cell = _write(tmp_path / "cell.csv", "x,y,z\n1,1," + "q" * 9000 + "\n1,2,3\n2,1,3\n2,2,4\n")
+    _refused(*(r := run_cli("equation", cell)), "'" + "q" * 60 + "'... (8,940 more characters) is not a number")
+    assert len(r[2]) < 400
+    status, out, err = run_cli("compare", EXAMPLE4, "--reference", "+".join(["x"] * 999))
+    assert status == 2 and len(err) <= len("lagsym: error: \n") + MAX_MESSAGE + 40, err
