@@ -11,7 +11,7 @@ from typing import IO
 
 __all__ = ["MAX_MESSAGE", "one_line", "say"]
 
-MAX_MESSAGE = 600  # characters of one message: a longer one (a quoted field of a file, a long path) is cut in the middle
+MAX_MESSAGE = 2_000  # characters of one message: a longer one (a path near the system's limit) is cut in the middle
 
 
 def one_line(message: str) -> str:
