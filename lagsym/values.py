@@ -34,6 +34,13 @@ class NotANumber(InputError):
     """Text that is not an exact number; the message says why (without saying where: callers add that)."""
 
 
+QUOTED = 60  # characters of a value a message quotes: a 10,000-character cell is shown by its start
+
+
+def _quoted(text: str) -> str:
+    return repr(text) if len(text) <= QUOTED else f"{text[:QUOTED]!r}... ({len(text) - QUOTED:,} more characters)"
+
+
 def exact_number(text: str) -> Fraction:
     """Read an exact decimal or rational from text.
 
@@ -49,18 +56,18 @@ def exact_number(text: str) -> Fraction:
     if m and text.isascii():
         num, den = m.groups()
         if len(num) > MAX_EXPONENT or len(den) > MAX_EXPONENT:
-            raise NotANumber(f"{text!r} is too large")
+            raise NotANumber(f"{_quoted(text)} is too large")
         if int(den) == 0:
-            raise NotANumber(f"{text!r} divides by zero")
+            raise NotANumber(f"{_quoted(text)} divides by zero")
         return Fraction(int(num), int(den))
     if not text.isascii() or not _DECIMAL.match(text):
-        raise NotANumber(f"{text.strip()!r} is not a number")
+        raise NotANumber(f"{_quoted(text.strip())} is not a number")
     exponent = re.search(r"[eE]([+-]?\d+)", text)
     if exponent and len(exponent.group(1).lstrip("+-0")) > 6:
-        raise NotANumber(f"{text.strip()!r} is out of range (overflow)")
+        raise NotANumber(f"{_quoted(text.strip())} is out of range (overflow)")
     d = Decimal(text.strip())
     if len(d.as_tuple().digits) > MAX_EXPONENT or abs(d.adjusted()) > MAX_EXPONENT:
-        raise NotANumber(f"{text.strip()!r} is out of range (overflow)")
+        raise NotANumber(f"{_quoted(text.strip())} is out of range (overflow)")
     return Fraction(d)
 
 

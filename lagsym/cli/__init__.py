@@ -21,6 +21,7 @@ from typing import IO, Sequence
 
 from ..allocator import keep_freed_memory
 from ..errors import ExitStatus, LagsymError, Terminated
+from ._lines import one_line
 
 __all__ = ["main", "build_parser", "COMMANDS", "command_module"]
 
@@ -44,7 +45,7 @@ class _Parser(argparse.ArgumentParser):
         raise _ParserExit(status)
 
     def error(self, message):
-        self.err.write(f"lagsym: error: {message} (see '{self.prog} --help')\n")
+        self.err.write(f"lagsym: error: {one_line(message)} (see '{self.prog} --help')\n")
         raise _ParserExit(ExitStatus.BAD_INPUT)
 
 
@@ -131,25 +132,6 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run)
     return parser
-
-
-MAX_MESSAGE = 2_000  # characters of one error line; a longer message (a quoted field of a file) is cut in the middle
-
-
-def one_line(message: str) -> str:
-    """``message`` as one printable line: a newline or other control character in a name is escaped, a long one cut.
-
-    Examples
-    --------
-    >>> one_line("bad\\nname.csv: no such file")
-    'bad\\\\nname.csv: no such file'
-    """
-    text = message if message.isprintable() else "".join(
-        c if c.isprintable() else repr(c)[1:-1] for c in message)
-    if len(text) <= MAX_MESSAGE:
-        return text
-    half = MAX_MESSAGE // 2  # the head names the value, the tail says what is wrong with it
-    return f"{text[:half]}...[{len(text) - 2 * half:,} characters]...{text[-half:]}"
 
 
 def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stderr: IO[str] | None = None) -> int:

@@ -9,26 +9,37 @@ from typing import IO
 
 from ..errors import InputError
 from ..io import write_text
+from ._lines import say
 from ..controls import CONTROLS, work_offset
 from ..values import as_exact, finite, in_range, whole
 
 
-def check_paths(args) -> None:
-    """Before any work: ``-o`` must be a path that can be written, and not one of the command's input files."""
-    from ..io import check_not_input, check_output
+# The options that name a file a command writes, by argparse name: each is checked against the command's inputs
+# and against the other outputs before any work.  ``--log`` is appended to, and checked as it opens.
+OUTPUT_OPTIONS = {"output": "-o", "print_output": "--print-output", "plot": "--plot", "log": "--log"}
 
-    output = getattr(args, "output", None)
-    if not output or output == "-" or not isinstance(output, str):
+
+def check_paths(args) -> None:
+    """Before any work: every output (``-o``, ``--print-output``, ``--plot``, ``--log``) must be a path that can
+    be written, not one of the command's input files, and not the file of another output."""
+    from ..io import check_apart, check_not_input, check_output
+
+    outputs = [(option, value) for name, option in OUTPUT_OPTIONS.items()
+               if isinstance(value := getattr(args, name, None), str) and value and value != "-"]
+    if not outputs:
         return
-    check_output(output)
     inputs = []
     for name, value in vars(args).items():
-        if name in ("output", "log"):
+        if name in OUTPUT_OPTIONS:
             continue
         for v in value if isinstance(value, (list, tuple)) else (value,):
             if isinstance(v, str) and v and v != "-" and "\x00" not in v:
                 inputs.append(v)
-    check_not_input(output, inputs)
+    for option, path in outputs:
+        if option != "--log":
+            check_output(path)
+        check_not_input(path, inputs, "" if option == "-o" else option)
+    check_apart(outputs)
 
 
 def emit(text: str, output: str | None, out: IO[str]) -> None:
@@ -100,9 +111,9 @@ def load_points(path: str, args, err: IO[str], what: str = "surface"):
 
     f = read_point_file(path, what, getattr(args, "columns", None), getattr(args, "snap", None))
     if not f.plain:
-        err.write(f"{path}: read as {f.layout}\n")
+        say(err, f"{path}: read as {f.layout}")
     if f.snapped is not None:
-        err.write(f.snapped.text(str(path)) + "\n")
+        say(err, f.snapped.text(str(path)))
     return f.points
 
 
@@ -151,8 +162,8 @@ def conditioning_notes(grid, args, err: IO[str]) -> tuple[str, ...]:
     a = require_conditioning(grid, accept=getattr(args, "accept_conditioning", False))
     if not a.exceeds:
         return ()
-    err.write(f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
-              f"accepted with --accept-conditioning\n")
+    say(err, f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
+             f"accepted with --accept-conditioning")
     return (a.header_note(),)
 
 

@@ -17,6 +17,7 @@ import contextlib
 import os
 
 from ..progress import ANNOUNCED
+from ._lines import say
 
 __all__ = ["progress_bar", "draws_bars"]
 
@@ -39,7 +40,7 @@ def _announcer(err):
     def announce(done: int, total: int | None, stage: str) -> None:
         if stage.rpartition(": ")[2] in ANNOUNCED and stage not in said:
             said.add(stage)
-            err.write(f"lagsym: {stage} ...\n")
+            say(err, f"lagsym: {stage} ...")
             err.flush()
 
     return announce

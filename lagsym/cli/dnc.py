@@ -11,6 +11,7 @@ from ..dnc.config import load_config
 from ..dnc.server import serve
 from ..errors import Terminated
 from ..io import event_log
+from ._lines import say
 
 DESCRIPTION = """Serve one or more serial ports as a shop's DNC service, as configured in a
 TOML file (see docs/dnc.md): a program punched from a control is saved under
@@ -41,14 +42,14 @@ def run(args, out, err) -> int:
     config = load_config(args.config)
     if args.check:
         for port in config.ports:
-            out.write(f"{port.name}: {port.device}, {port.settings.baud} baud, programs from {port.programs}, "
-                      f"punched programs to {port.received}, log {port.log}\n")
+            say(out, f"{port.name}: {port.device}, {port.settings.baud} baud, programs from {port.programs}, "
+                     f"punched programs to {port.received}, log {port.log}")
         return 0
     lock = threading.Lock()
 
     def status(name: str, text: str) -> None:
         with lock:
-            out.write(f"{time.strftime('%H:%M:%S')} {name}: {text}\n")
+            say(out, f"{time.strftime('%H:%M:%S')} {name}: {text}")
             out.flush()
 
     stop = threading.Event()

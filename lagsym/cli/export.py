@@ -11,6 +11,7 @@ from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ._common import add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, count, read_piecewise
+from ._lines import say
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
 the Lagrange polynomial is exactly a Bezier patch of the same degrees over the
@@ -89,8 +90,8 @@ def run(args, out, err) -> int:
         err.write(f"lagsym: warning: degree ({patch.degree_u}, {patch.degree_v}) is above {KERNEL_MAX_DEGREE}, "
                   f"the largest B-spline degree OpenCascade and several CAD systems read\n")
     n, m = patch.shape
-    out.write(f"{args.output}: {patch.name} surface, degree ({patch.degree_u}, {patch.degree_v}), "
-              f"{n} x {m} exact control points, {units}\n")
+    say(out, f"{args.output}: {patch.name} surface, degree ({patch.degree_u}, {patch.degree_v}), "
+             f"{n} x {m} exact control points, {units}")
     if base is not None:
         v = volume(patch, base)
         out.write(f"solid down to z = {args.base_z}: volume {v} = {float(v):.10g} {units}^3; "

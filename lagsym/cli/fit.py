@@ -11,6 +11,7 @@ from ..fit import CRITERIA, MAX_DEGREE, fit_surface
 from ..io import read_text
 from ..values import exact_number, NotANumber
 from ._common import COLUMNS_HELP, emit, exact, measured_points
+from ._lines import say
 
 DESCRIPTION = """Fit the exact least-squares tensor-product polynomial
 z = sum c[a][b] x^a y^b (a <= P, b <= Q) to the points in FILE: a grid, a
@@ -79,7 +80,7 @@ def read_weights(path: str) -> list:
 def run(args, out, err) -> int:
     data = measured_points(args.file, args.columns)
     if not data.plain:
-        err.write(f"{data.source}: read as {data.layout}\n")
+        say(err, f"{data.source}: read as {data.layout}")
     weights = read_weights(args.weights) if args.weights else None
     if args.degree != "auto" and (args.criterion or args.max_degree):
         raise InputError(f"--{'criterion' if args.criterion else 'max-degree'} chooses the degrees, and --degree "

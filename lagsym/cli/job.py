@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from ..io import write_text
+from ..io import check_not_input, write_text
+from ._lines import say
 from ._common import add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
@@ -58,6 +59,8 @@ def run(args, out, err) -> int:
     from ._progress import progress_bar
 
     spec = read_job(args.job)
+    if args.output and args.output != "-" and spec.points is not None:
+        check_not_input(args.output, [spec.points])  # the job file's points are an input too
     if spec.probe is not None and not args.measured:
         return _probe_program(spec, args, out, err)
     if args.measured:
@@ -97,8 +100,8 @@ def _probe_program(spec, args, out, err) -> int:
     text = probe_program(stage.plan, stage.settings, spec.dialect, program_number=spec.program_number,
                          work_offset=spec.work_offset)
     emit(text, args.output, out)
-    err.write(f"{spec.source}: probe stage: {stage.plan.describe()}, {len(stage.plan)} probing moves on "
-              f"{spec.dialect}; run it, then: lagsym job {args.job} --measured RESULTS\n")
+    say(err, f"{spec.source}: probe stage: {stage.plan.describe()}, {len(stage.plan)} probing moves on "
+             f"{spec.dialect}; run it, then: lagsym job {args.job} --measured RESULTS")
     return 0
 
 
@@ -120,8 +123,8 @@ def measured_job(spec, results_path: str, err):
                          f"{len(spec.probe.plan)}: results of another program?")
     sp = surface_points(results, spec.probe.fit_degree)
     fit = fit_surface(sp.points, spec.probe.fit_degree, source=name, units=results.units)
-    err.write(f"{name}: {len(sp.points)} nodes; {sp.describe()}; fit degree {fit.degree[0]}x{fit.degree[1]}: "
-              f"residuals max {fit.max_residual:.4g} mm, RMS {fit.rms:.4g} mm\n")
+    say(err, f"{name}: {len(sp.points)} nodes; {sp.describe()}; fit degree {fit.degree[0]}x{fit.degree[1]}: "
+             f"residuals max {fit.max_residual:.4g} mm, RMS {fit.rms:.4g} mm")
     from pathlib import Path
 
     notes = (f"MEASURED {Path(name).name} SHA256 {results.sha256[:16]}",
@@ -135,5 +138,5 @@ def report(planned, prog, err) -> None:
     """One line per operation (moves and minutes, for a ball's raster the cusp it leaves) and the total."""
     for op, m in zip(planned.operations, prog.minutes):
         cusp = cusp_note(op.path) if getattr(op.path, "cusp_mm", None) is not None else ""
-        err.write(f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min{cusp}\n")
+        say(err, f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min{cusp}")
     err.write(f"cycle time about {prog.total_minutes:.1f} min (rapids at {planned.spec.rapid_mm_min:g} mm/min)\n")

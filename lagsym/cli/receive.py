@@ -12,6 +12,7 @@ from ..errors import InputError, OutputError
 from ..io import check_output, event_log, write_text
 from ..probe.results import is_probe_results, read_results
 from ._common import number
+from ._lines import say
 from .send import add_line_arguments, check_log, line_settings
 
 MAX_WAIT_S = 86_400.0  # a day: the longest --timeout or --idle-timeout
@@ -61,7 +62,7 @@ def run(args, out, err) -> int:
 
     def ready() -> None:
         if not args.quiet:
-            err.write(f"waiting on {args.port} for {args.timeout:g} s: start the output (PUNCH) on the control now\n")
+            say(err, f"waiting on {args.port} for {args.timeout:g} s: start the output (PUNCH) on the control now")
             err.flush()
 
     with event_log(args.log) as log, progress_bar(err, args.quiet) as bar:
@@ -74,7 +75,7 @@ def run(args, out, err) -> int:
         out.write(text)
     check_log(log, f"received {text.count(chr(10))} lines into {args.output if to_file else 'standard output'}")
     if not args.quiet and to_file:
-        err.write(f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}\n")
+        say(err, f"received {text.count(chr(10))} lines ({len(text)} bytes) into {args.output}")
     if results is not None and not args.quiet:
         err.write(f"probe results: {len(results.points)} nodes, tip radius {float(results.tip_radius):g} "
                   f"{results.units}, every node there: read them with lagsym read-probe\n")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..controls import VARIABLE_PROFILES, control, names
+import os
 from pathlib import Path
 
 from ..io import write_text
@@ -135,7 +136,7 @@ def job_data(args) -> dict:
         op["macro"] = True
     if args.precision is not None:
         op["precision"] = args.precision
-    job = {"points": str(Path(args.file).resolve()), "dialect": args.dialect, "units": args.units,
+    job = {"points": os.path.abspath(args.file), "dialect": args.dialect, "units": args.units,
             "scale": args.scale, "origin": list(origin(args.origin)), "safe_z": args.safe_z, "rapid": args.rapid,
             "program_number": args.program, "title": Path(args.file).name, "stock": stock,
             "tools": {"cutter": tool}, "operations": [op]}

@@ -25,6 +25,7 @@ from ..dnc import (
 from ..errors import InputError, LogLost
 from ..io import event_log, read_program
 from ..machine import LINE_ENDINGS
+from ._lines import say
 
 DESCRIPTION = """Send the program in FILE to a CNC control over a serial line, with XON/XOFF
 handled by lagsym itself (paced to the line rate, at most a few characters
@@ -214,8 +215,8 @@ def run(args, out, err) -> int:
                               safe_z=args.safe_z, progress=bar, log=log)
     check_log(log, f"sent {result.blocks} blocks to {args.port}")
     if not args.quiet:
-        out.write(f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
-                  f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF\n")
+        say(out, f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
+                 f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF")
         if not result.confirmed and result.answered_to_end:
             out.write(f"the control answered XON/XOFF {result.answers} times, the last after the last block\n")
         elif not result.confirmed and result.answers:

@@ -8,6 +8,7 @@ from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM
                         moves_csv, simulate)
 from ..simulate.runaway import check_lines
 from ._common import add_exact_limit, count, emit, exact
+from ._lines import say
 from ._progress import progress_bar
 
 MAX_BLOCKS_LIMIT = 100_000_000  # the moves of a run this long take at most 3.7 GB
@@ -85,11 +86,11 @@ def run(args, out, err) -> int:
         emit("\n".join(sim.output), args.print_output, out)
     emit(moves_csv(sim), args.output, out)
     feeds = sim.moves.feeds()
-    err.write(f"{args.program}: {dialect}, {precision} digits: {sim.blocks} blocks executed, "
-              f"{len(sim.moves)} moves ({feeds} feed), no alarm\n")
+    say(err, f"{args.program}: {dialect}, {precision} digits: {sim.blocks} blocks executed, "
+             f"{len(sim.moves)} moves ({feeds} feed), no alarm")
     if sim.probes or sim.output:
         where = f" to {args.print_output}" if args.print_output else " (give --print-output to keep them)"
-        err.write(f"{sim.probes} probing moves, {len(sim.output)} lines printed{where}\n")
+        say(err, f"{sim.probes} probing moves, {len(sim.output)} lines printed{where}")
     return 0
 
 

@@ -15,6 +15,7 @@ from ..toolpath.waterline import BAND_DEG, STRATEGIES
 
 from ._common import (add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
+from ._lines import say
 from ._progress import progress_bar
 
 DESCRIPTION = """Plan a zig-zag raster over the exact surface through the control points in
@@ -132,17 +133,17 @@ def run(args, out, err) -> int:
     if args.output and args.output != "-":
         write_text(args.output, text, newline="")
         if tp.note is not None:
-            err.write(f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} passes, "
+            say(err, f"{args.output}: {len(tp)} cutter locations in {int(tp.rows.max()) + 1} passes, "
                       f"{tp.levels} levels, contours on slopes over {tp.threshold_deg - BAND_DEG:.0f} degrees, "
                       f"moves within {raster.chordal_tolerance_mm:g} mm of the cutter path and never below it, "
                       f"passes spaced for a cusp of at most {tp.cusp_mm:g} mm "
                       f"normal to the surface outside hollows tighter than the ball "
-                      f"({100 * tp.hollow_share:.1f} % of the grid)\n")
+                      f"({100 * tp.hollow_share:.1f} % of the grid)")
             return 0
-        err.write(f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
+        say(err, f"{args.output}: {len(tp)} cutter locations (from {tp.fine_points} samples) in "
                   f"{int(tp.rows.max()) + 1} rows, side step {tp.stepover_mm:.4f} mm, largest lift for chordal "
                   f"error {tp.lift_mm.max():.4f} mm (tolerance {raster.chordal_tolerance_mm:g} mm)"
-                  + cusp_note(tp) + _arc_note(tp) + "\n")
+                  + cusp_note(tp) + _arc_note(tp))
     else:
         out.write(text)
     return 0

@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import InputError, LagsymError
-from ..io.files import read_bytes
+from ..io.files import path_problem, read_bytes
 from .settings import LineSettings, check_port, profile
 
 __all__ = ["PortConfig", "ServerConfig", "load_config", "MAX_CONFIG_BYTES"]
@@ -107,7 +107,11 @@ def _port(source: str, index: int, table, base: Path) -> PortConfig:
     if isinstance(delay, bool) or not isinstance(delay, (int, float)) or not 0 <= delay <= 3600:
         raise _bad(source, f"{where}.request_delay_s", f"{delay!r} must be 0 to 3600 seconds")
     programs, received = base / table["programs"], base / table["received"]
-    if not programs.is_dir():
+    try:
+        folder = programs.is_dir()
+    except OSError as e:  # a path over the system's limit
+        raise _bad(source, f"{where}.programs", f"{programs}: {path_problem(e) or e.strerror or e}") from None
+    if not folder:
         raise _bad(source, f"{where}.programs", f"{programs} is not a folder")
     limit = table.get("max_punch_bytes", PortConfig.max_punch_bytes)
     if isinstance(limit, bool) or not isinstance(limit, int) or not 1 <= limit <= 2**40:

@@ -11,6 +11,8 @@ limited by :data:`MESH_MAX_POINTS`; the point tables stream.
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import os
 
 import numpy as np
@@ -93,8 +95,7 @@ def write_vts(path: str | os.PathLike, sample: Sample) -> None:
         writer.SetInputData(grid)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
-        if not writer.Write():
-            raise OSError(f"{path}: VTK could not write the file")
+        _vtk_write(writer, tmp, lambda size: _ends_with(tmp, b"</VTKFile>\n"))
 
 
 def write_stl(path: str | os.PathLike, sample: Sample) -> None:
@@ -124,10 +125,67 @@ def write_stl(path: str | os.PathLike, sample: Sample) -> None:
     poly = vtkPolyData()
     poly.SetPoints(pts)
     poly.SetPolys(cells)
+    facets = 2 * (nx - 1) * (ny - 1)
     with atomic_path(path) as tmp:
         writer = vtkSTLWriter()
         writer.SetFileName(tmp)
         writer.SetInputData(poly)
         writer.SetFileTypeToBinary()
-        if not writer.Write():
-            raise OSError(f"{path}: VTK could not write the file")
+        _vtk_write(writer, tmp, lambda size: size == STL_HEADER_BYTES + STL_FACET_BYTES * facets)
+
+
+STL_HEADER_BYTES, STL_FACET_BYTES = 84, 50  # binary STL: 80-byte header and a count, then 50 bytes a facet
+
+
+@contextlib.contextmanager
+def _vtk_quiet():
+    """VTK's own error and log lines kept off standard error (the failure is one line of lagsym's), then restored."""
+    from vtkmodules.vtkCommonCore import vtkLogger, vtkObject
+
+    shown, cutoff = vtkObject.GetGlobalWarningDisplay(), vtkLogger.GetCurrentVerbosityCutoff()
+    vtkObject.GlobalWarningDisplayOff()
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    try:
+        yield
+    finally:
+        vtkLogger.SetStderrVerbosity(vtkLogger.ConvertToVerbosity(cutoff))
+        vtkObject.SetGlobalWarningDisplay(shown)
+
+
+def _vtk_write(writer, tmp: str, complete) -> None:
+    """Run a VTK ``writer`` on ``tmp`` quietly; an OSError unless its error code is clear and ``complete(size)``.
+
+    VTK's writers return success on a full disk (the XML writer) or delete the
+    file and log a line (the STL writer), so the error code and the file
+    written are checked, not the return value.
+    """
+    from vtkmodules.vtkCommonMisc import vtkErrorCode
+
+    with _vtk_quiet():
+        writer.Write()
+    code = writer.GetErrorCode()
+    if 0 < code < vtkErrorCode.FirstVTKErrorCode:  # VTK passes errno through
+        raise OSError(code, os.strerror(code))
+    if code == vtkErrorCode.OutOfDiskSpaceError:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    if code:
+        raise OSError(errno.EIO, f"the VTK writer stopped: {vtkErrorCode.GetStringFromErrorCode(code)}")
+    try:
+        size = os.stat(tmp).st_size
+    except FileNotFoundError:
+        size = -1
+    if not complete(size):
+        raise OSError(errno.EIO, "the VTK writer left an incomplete file")
+
+
+def _ends_with(name: str, tail: bytes) -> bool:
+    """Whether the file ``name`` ends with ``tail`` (an XML file's closing tag: the writer got to its end)."""
+    try:
+        with open(name, "rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            if fh.tell() < len(tail):
+                return False
+            fh.seek(-len(tail), os.SEEK_END)
+            return fh.read() == tail
+    except OSError:
+        return False

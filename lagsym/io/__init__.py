@@ -26,7 +26,7 @@ from .points import (
     read_scattered_points,
     surface_file,
 )
-from .write import OutputNotice, atomic_path, atomic_write, check_not_input, check_output, write_text
+from .write import OutputNotice, atomic_path, atomic_write, check_apart, check_not_input, check_output, write_text
 
 __all__ = [
     "read_points",
@@ -51,6 +51,7 @@ __all__ = [
     "write_text",
     "check_output",
     "check_not_input",
+    "check_apart",
     "OutputNotice",
     "MAX_BYTES",
     "STDIN_SILENCE_S",

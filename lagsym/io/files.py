@@ -9,6 +9,7 @@ control reads them: ASCII, line endings kept.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import stat
 import time
@@ -16,7 +17,7 @@ from collections.abc import Iterator
 
 from ..errors import InputError
 
-__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "read_bytes", "read_text", "read_program",
+__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "path_problem", "read_bytes", "read_text", "read_program",
            "event_log", "EventLog"]
 
 MAX_BYTES = 64 * 1024 * 1024
@@ -31,6 +32,15 @@ def display_name(path: str | os.PathLike) -> str:
     """``path`` as a message shows it: control characters (a newline, a tab) escaped, so a message stays one line."""
     name = str(path)
     return name if name.isprintable() else name.encode("unicode_escape", "backslashreplace").decode("ascii")
+
+
+def path_problem(e: OSError) -> str | None:
+    """What is wrong with a path itself, said the same for an input and an output; None for other errors."""
+    if e.errno == errno.ELOOP:
+        return "too many levels of symbolic links (a loop?)"
+    if e.errno == errno.ENAMETOOLONG:
+        return "the name or path is longer than the system allows"
+    return None
 
 
 def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> bytes:
@@ -54,7 +64,7 @@ def read_bytes(path: str | os.PathLike, what: str, limit: int = MAX_BYTES) -> by
     except IsADirectoryError:
         raise InputError(f"{name}: is a directory, not {what}") from None
     except OSError as e:
-        raise InputError(f"{name}: cannot read ({e.strerror or e})") from None
+        raise InputError(f"{name}: {path_problem(e) or f'cannot read ({e.strerror or e})'}") from None
     info = os.fstat(fd)
     refusal = f"{name}: is a directory, not {what}" if stat.S_ISDIR(info.st_mode) else next(
         (f"{name}: is {kind}, not {what}; give a regular file, or '-' for standard input"

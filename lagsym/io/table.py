@@ -73,10 +73,12 @@ class Layout:
         """One phrase: separator, decimal mark, header, columns, units."""
         names = "xyz"[:len(self.columns)]
         parts = [f"{SEPARATORS[self.separator]}-separated", "decimal comma" if self.decimal == "," else "decimal point"]
-        parts.append(f"header {self.separator.join(self.header)!r}" if self.header else "no header")
+        parts.append(f"header {clip(self.separator.join(self.header))}" if self.header else "no header")
         parts.append(", ".join(f"{n} from column {c + 1}" for n, c in zip(names, self.columns)))
         if self.ignored:
-            parts.append(f"ignoring column(s) {', '.join(self.ignored)}")
+            more = len(self.ignored) - SHOWN_NAMES
+            shown = ", ".join(clip(c, 20)[1:-1] if len(c) <= 20 else clip(c, 20) for c in self.ignored[:SHOWN_NAMES])
+            parts.append(f"ignoring column(s) {shown}" + (f" and {more:,} more" if more > 0 else ""))
         if self.units:
             parts.append(f"units {self.units}")
         return "; ".join(parts)
@@ -108,6 +110,21 @@ def parse_columns(text: str, arity: int | None = None) -> tuple[str, ...] | tupl
 
 
 MAX_CELL = 10_000  # characters in one cell: a number of 300 digits fits many times over
+SHOWN = 60  # characters of a header or cell a message quotes: a prefix, so a message stays short
+SHOWN_NAMES = 5  # names of ignored columns a description lists
+
+
+def clip(text: str, limit: int = SHOWN) -> str:
+    """``text`` quoted as a message shows a piece of a file: at most ``limit`` characters, then how many more.
+
+    Examples
+    --------
+    >>> clip("x,y,z"), clip("x,y,z" + ",w" * 100, 9)
+    ("'x,y,z'", "'x,y,z,w,w'... (196 more characters)")
+    """
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[:limit]!r}... ({len(text) - limit:,} more characters)"
 
 
 def _split(text: str, sep: str) -> list[tuple[int, list[str]]]:
@@ -172,7 +189,7 @@ def _header_names(name: str, header: list[str]) -> tuple[list[str], str | None]:
         unit = (m.group(2) or m.group(3)) if m else None
         if unit and label in ("x", "y", "z"):
             if unit.lower() not in UNIT_NAMES:
-                raise InputError(f"{name}: header {cell!r}: unit {unit!r} is not one lagsym knows (mm or inch); "
+                raise InputError(f"{name}: header {clip(cell)}: unit {clip(unit)} is not one lagsym knows (mm or inch); "
                                  f"convert the column or leave the unit out")
             units.add(UNIT_NAMES[unit.lower()])
         names.append(label)
@@ -198,13 +215,27 @@ def _choose(name: str, names: list[str] | None, width: int, columns, arity: int 
         if len(found) == len(want):
             return tuple(found)
         if columns is None and all(c in ("x", "y", "z") for c in labels):
-            raise InputError(f"{name}: line 1: header {','.join(names)} should name the columns {','.join(want)}")
+            raise InputError(f"{name}: line 1: header {clip(','.join(names))[1:-1]} should name the columns "
+                             f"{','.join(want)}")
     if labels is None and (arity is None or width == arity) and width in (2, 3):
         return tuple(range(width))
     want = ",".join("xyz"[:arity]) if arity else "x,y,z"
     example = ",".join(["id"] + list("xyz"[:arity or 3]))
     raise InputError(f"{name}: the lines have {width} columns and lagsym cannot tell which are {want}: "
                      f"name them in a header or with --columns (e.g. --columns {example} or --columns 2,3,4)")
+
+
+def _check_header(name: str, sep: str, header: list[str], line: int, rows: list[tuple[int, list[str]]]) -> None:
+    """A header naming as many columns as the data lines have (empty cells at either end aside)."""
+    named = len(header)
+    while named and not header[named - 1]:
+        named -= 1
+    width = len(rows[0][1])
+    used = max((j + 1 for _, cells in rows for j in range(width) if cells[j]), default=0)
+    if named <= width and used <= named:
+        return
+    raise InputError(f"{name}: the header (line {line}) has {named:,} columns but the data lines have {width:,} "
+                     f"(line {rows[0][0]}): header {clip(sep.join(header[:named]))}; the header should name each column of the lines below it once")
 
 
 def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[list[tuple[Fraction, ...]], Layout]:
@@ -225,8 +256,7 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
     header: list[str] = []
     names, units = None, None
     if _is_header(rows[0][1]):
-        header = rows[0][1]
-        names, units = _header_names(name, header)
+        header_line, header = rows[0]
         rows = rows[1:]
     if not rows:
         raise InputError(f"{name}: no points in the file, only the header")
@@ -234,6 +264,9 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
     for lineno, cells in rows:
         if len(cells) != width:
             raise InputError(f"{name}: line {lineno} has {len(cells)} columns, expected {width} like line {rows[0][0]}")
+    if header:
+        _check_header(name, sep, header, header_line, rows)
+        names, units = _header_names(name, header)
     # A trailing separator on every line (Excel after a deleted column) leaves a column with nothing in it.
     empty = [j for j in range(width) if all(not c[j] for _, c in rows) and (j >= len(header) or not header[j])]
     keep = [j for j in range(width) if j not in empty]

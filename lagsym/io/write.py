@@ -24,9 +24,10 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import InputError, OutputError
+from .files import path_problem
 
-__all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "OutputNotice",
-           "temporary_name"]
+__all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "check_apart",
+           "OutputNotice", "temporary_name"]
 
 SUFFIX_KEPT = 16  # characters of the target's extension the temporary keeps (meshio and VTK choose a format by it)
 
@@ -47,11 +48,7 @@ def _write_error(path, e: OSError, stream: bool = False) -> OutputError:
 
 
 def _path_error(path, e: OSError) -> InputError:
-    if e.errno == errno.ELOOP:
-        return InputError(f"{path}: too many levels of symbolic links (a loop?)")
-    if e.errno == errno.ENAMETOOLONG:
-        return InputError(f"{path}: the name or path is longer than the system allows")
-    return InputError(f"{path}: cannot use this path ({_reason(e)})")
+    return InputError(f"{path}: {path_problem(e) or f'cannot use this path ({_reason(e)})'}")
 
 
 def _target(path) -> tuple[Path, os.stat_result | None]:
@@ -86,9 +83,14 @@ def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
         raise InputError(f"{path}: is a directory")
     stream = info is not None and not stat.S_ISREG(info.st_mode)
     directory = Path(tempfile.gettempdir()) if stream else real.parent
-    if not directory.is_dir():
-        what = f"{directory} is not a folder" if directory.exists() else f"the folder {directory} does not exist"
-        raise InputError(f"{path}: {what}")
+    try:
+        folder = stat.S_ISDIR(os.stat(directory).st_mode)
+    except (FileNotFoundError, NotADirectoryError):
+        raise InputError(f"{path}: the folder {directory} does not exist") from None
+    except OSError as e:  # the folder's whole path over the system's limit, a loop, no permission
+        raise _path_error(path, e) from None
+    if not folder:
+        raise InputError(f"{path}: {directory} is not a folder")
     if not stream:
         limit = _name_max(directory)
         if len(os.fsencode(real.name)) > limit:
@@ -97,8 +99,11 @@ def check_output(path: str | os.PathLike) -> tuple[Path, bool, Path]:
     return real, stream, directory
 
 
-def check_not_input(output, inputs: Iterable) -> None:
-    """Refuse an ``output`` that is one of ``inputs`` (the same device and inode), before any work is done."""
+def check_not_input(output, inputs: Iterable, option: str = "") -> None:
+    """Refuse an ``output`` that is one of ``inputs`` (the same device and inode), before any work is done.
+
+    ``option`` (``--print-output``) is named before the path when the output is not the command's ``-o``.
+    """
     try:
         out = os.stat(output)
     except (OSError, ValueError, TypeError):
@@ -112,7 +117,38 @@ def check_not_input(output, inputs: Iterable) -> None:
             continue
         if (info.st_dev, info.st_ino) == (out.st_dev, out.st_ino):
             same = "" if os.fspath(given) == os.fspath(output) else f" ({given})"
-            raise InputError(f"{output}: is also an input{same}; write the result to another file")
+            named = f"{option} {output}" if option else f"{output}"
+            raise InputError(f"{named}: is also an input{same}; write the result to another file")
+
+
+def _identity(path) -> tuple | None:
+    """What an output writes: its device and inode, its real path for a new name, None for a device or pipe."""
+    try:
+        info = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        try:
+            return ("new", os.path.realpath(path))
+        except (OSError, ValueError):
+            return None
+    except (OSError, ValueError, TypeError):
+        return None  # check_output refuses it
+    return ("file", info.st_dev, info.st_ino) if stat.S_ISREG(info.st_mode) else None
+
+
+def check_apart(outputs: Iterable[tuple[str, str]]) -> None:
+    """Refuse two outputs of one command, ``(option, path)`` pairs, that name one file: the later would replace
+    the earlier.  A device or pipe (``/dev/null``) may take several."""
+    seen: list[tuple[str, str, tuple]] = []
+    for option, path in outputs:
+        key = _identity(path)
+        if key is None:
+            continue
+        for first, earlier, other in seen:
+            if key == other:
+                same = "" if os.fspath(earlier) == os.fspath(path) else f" ({earlier})"
+                raise InputError(f"{option} {path}: is also the output of {first}{same}; give each output its "
+                                 f"own file")
+        seen.append((option, path, key))
 
 
 def _name_max(directory: Path) -> int:
@@ -181,12 +217,22 @@ def atomic_path(path: str | os.PathLike) -> Iterator[str]:
         if stream:
             _copy_into(tmp, given)
         else:
+            _sync(tmp)
             _commit(tmp, real, path)
     except OSError as e:
         raise _write_error(path, e, stream) from None
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+
+
+def _sync(tmp: str) -> None:
+    """The temporary's bytes on the disk before the rename: a file system that allocates late says ENOSPC here."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _copy_into(tmp: str, target: Path) -> None:
