@@ -1,0 +1,135 @@
+"""Hostile inputs refused at once, in one line, with the figure and what raises the limit.
+
+Each case that ran away (minutes, gigabytes) or was taken wrongly before its
+guard existed; the slow ones run in a child process within a memory limit and a
+generous timeout, so that this suite itself never runs away.
+"""
+
+from __future__ import annotations
+
+import io
+import random
+import re
+import resource
+import subprocess
+import sys
+
+import pytest
+
+from lagsym.cli import main
+from lagsym.io import MAX_FILE_POINTS, file_points_limit, read_scattered_points
+from lagsym.surfaces.piecewise import MAX_PIECES
+
+from conftest import ROOT
+
+MEMORY = 2 * 1024**3
+
+
+def _limited():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY, MEMORY))
+
+
+def _lagsym(*argv: str, timeout: float = 30) -> subprocess.CompletedProcess:
+    """The command run in a fresh interpreter within 2 GB and ``timeout`` seconds."""
+    try:
+        return subprocess.run([sys.executable, "-m", "lagsym", *argv], capture_output=True, text=True,
+                              timeout=timeout, preexec_fn=_limited)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"still running after {timeout} s: lagsym {' '.join(argv)}")
+
+
+def _run(*argv: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    return main(list(argv), out, err), out.getvalue(), err.getvalue()
+
+
+def _refused(rc: int, err: str, *needles: str) -> str:
+    assert rc == 2, err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+# --- F5: a points file of more points than any command can use ------------------------------------------------------
+
+def _big_table(path, mb: int = 60) -> int:
+    """A 60 MB table of x,y,z lines as a scanner might write, and how many points it holds."""
+    rng = random.Random(5)
+    lines = [f"{i % 1000}.123456789,{i // 1000}.123456789,{rng.random():.12f}\n" for i in range(20_000)]
+    block = "".join(lines)
+    count, size = 0, 0
+    with open(path, "w") as fh:
+        fh.write("x,y,z\n")
+        while size < mb * 2**20:
+            fh.write(block)
+            size += len(block)
+            count += len(lines)
+    return count
+
+
+@pytest.fixture(scope="module")
+def big60(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("big")
+    csv = folder / "big60.csv"
+    count = _big_table(csv)
+    text = csv.read_text().splitlines()[1:]
+    js = folder / "big60.json"
+    js.write_text("[" + ",".join(f"[{line}]" for line in text) + "]")
+    return csv, js, count
+
+
+@pytest.mark.parametrize("kind", ["csv", "json"])
+@pytest.mark.parametrize("command", [["equation"], ["check"], ["fit", "-o", "OUT"], ["piecewise", "-o", "OUT"],
+                                     ["curve"], ["toolpath"]])
+def test_a_60_mb_points_file_is_refused_before_it_is_read(big60, tmp_path, command, kind):
+    path = big60[0] if kind == "csv" else big60[1]
+    argv = [a if a != "OUT" else str(tmp_path / "out.json") for a in command]
+    p = _lagsym(argv[0], str(path), *argv[1:])
+    line = _refused(p.returncode, p.stderr, path.name, f"more than the limit of {MAX_FILE_POINTS:,} points",
+                    "--max-file-points")
+    assert re.search(r"about [\d,]+ points", line)
+    assert not (tmp_path / "out.json").exists()
+
+
+def test_the_estimate_counts_the_points_of_a_table_and_of_json(big60):
+    from lagsym.io.files import estimate_points
+
+    csv, js, count = big60
+    assert count <= estimate_points(csv.read_text()) <= count + 1
+    assert count <= estimate_points(js.read_text()) <= count + 1
+    assert estimate_points('{"x": [0, 1, 2], "y": [0, 1, 2], "z": [[0, 1, 2], [1, 2, 3], [2, 3, 4]]}') >= 4
+
+
+def test_the_option_and_the_context_raise_the_limit(tmp_path):
+    path = tmp_path / "pts.csv"
+    path.write_text("x,y,z\n" + "".join(f"{i},{k},{i * k}\n" for i in range(3) for k in range(3)))
+    rc, out, err = _run("equation", str(path), "--max-file-points", "5")
+    _refused(rc, err, "pts.csv: about 10 points, more than the limit of 5 points", "--max-file-points")
+    rc, out, err = _run("equation", str(path), "--max-file-points", "10")
+    assert rc == 0, err
+    with file_points_limit(5), pytest.raises(Exception, match="more than the limit of 5 points"):
+        read_scattered_points(path)
+    with file_points_limit(None):
+        assert len(read_scattered_points(path).points) == 9
+
+
+def test_a_fit_of_fifty_thousand_scattered_points_is_read(tmp_path):
+    rng = random.Random(1)
+    path = tmp_path / "scan.csv"
+    path.write_text("x,y,z\n" + "".join(f"{rng.random() * 100:.4f},{rng.random() * 100:.4f},{rng.random():.4f}\n"
+                                        for _ in range(50_000)))
+    assert len(read_scattered_points(path).points) == 50_000
+
+
+def test_the_docs_quote_the_points_limit_in_force():
+    formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
+    row = next(line for line in formats.split("| a points file |")[1:2])
+    assert f"about {MAX_FILE_POINTS:,} points at most (`--max-file-points`" in row
+    assert "a 60 MB table is refused at once" in row
+    side = 501
+    assert (side - 1) ** 2 == MAX_PIECES and side * side < MAX_FILE_POINTS / 2
+    assert f"largest grid `lagsym piecewise` takes ({side} x {side})" in row
+    assert f"(default {MAX_FILE_POINTS:,})" in (ROOT / "docs" / "cli.md").read_text()
