@@ -133,3 +133,58 @@ def test_the_docs_quote_the_points_limit_in_force():
     assert (side - 1) ** 2 == MAX_PIECES and side * side < MAX_FILE_POINTS / 2
     assert f"largest grid `lagsym piecewise` takes ({side} x {side})" in row
     assert f"(default {MAX_FILE_POINTS:,})" in (ROOT / "docs" / "cli.md").read_text()
+
+
+# --- F6: TOML keys and table headers nested deep ---------------------------------------------------------------------
+
+def _dnc_toml(tmp_path, extra: str = "") -> str:
+    return (f'{extra}[[port]]\nname = "mill1"\ndevice = "/dev/ttyUSB0"\nprofile = "fanuc"\n'
+            f'programs = "{tmp_path}"\nreceived = "{tmp_path}"\n')
+
+
+DEEP = 100_000
+
+
+@pytest.mark.parametrize("layout", ["dotted", "header", "quoted", "spaced"])
+@pytest.mark.parametrize("command", ["dnc", "job", "verify"])
+def test_a_toml_key_nested_deep_is_refused_before_it_is_read(tmp_path, command, layout):
+    from lagsym.io.tomltext import MAX_TOML_DEPTH
+
+    key = {"dotted": ".".join(["a"] * DEEP), "header": "[" + ".".join(["a"] * DEEP) + "]",
+           "quoted": ".".join(['"a"'] * DEEP), "spaced": " . ".join(["a"] * DEEP)}[layout]
+    path = tmp_path / "deep.toml"
+    path.write_text('# a comment. with. dots\ntitle = "x.y.z"\n\n' + key + ("\n" if layout == "header" else " = 1\n"))
+    argv = {"dnc": ["dnc", "serve", str(path), "--check"], "job": ["job", str(path), "-o", str(tmp_path / "o.nc")],
+            "verify": ["verify", "--job", str(path), str(tmp_path / "none.nc")]}[command]
+    p = _lagsym(*argv)
+    _refused(p.returncode, p.stderr, "deep.toml: line 4:", f"{DEEP} levels deep", f"more than {MAX_TOML_DEPTH}")
+    assert not (tmp_path / "o.nc").exists()
+
+
+def test_the_toml_depth_check_reads_strings_comments_and_keys_as_toml_does(tmp_path):
+    import tomllib
+
+    from lagsym.errors import InputError
+    from lagsym.io.tomltext import MAX_TOML_DEPTH, check_toml_depth
+
+    deep = ".".join(["a"] * (MAX_TOML_DEPTH + 1))
+    fine = ".".join(["a"] * MAX_TOML_DEPTH)
+    accepted = [f'k = "{deep}"\n', f"# {deep}\n", f'k = """\n{deep}\n"""\n', f"k = '''{deep}'''\n",
+                f'k = """x"" """""\nj = "{deep}"\n', f"k = '{deep}'\n", f"[{fine}]\n{fine} = 1.5\n",
+                f'k = "\\\\"\nj = "{deep}"\n', "x = [" + ", ".join(["1.5"] * 100) + "]\n"]
+    for text in accepted:
+        tomllib.loads(text)  # each is TOML
+        check_toml_depth(text, "t.toml", "a job file")
+    refused = {f'k = """x""""\n{deep} = 1\n': 2, f"[{deep}]\n": 1, f"x = {{{deep} = 1}}\n": 1,
+               f'b = 1\n\n{deep.replace("a", chr(34) + "a" + chr(34))} = 1\n': 3}
+    for text, line in refused.items():
+        tomllib.loads(text)  # TOML, only too deep
+        with pytest.raises(InputError, match=rf"^t.toml: line {line}: not a job file: .* {MAX_TOML_DEPTH + 1} levels"):
+            check_toml_depth(text, "t.toml", "a job file")
+
+
+def test_the_docs_quote_the_toml_depth_in_force():
+    from lagsym.io.tomltext import MAX_TOML_DEPTH
+
+    formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
+    assert formats.count(f"no dotted key or table header more than {MAX_TOML_DEPTH} levels deep") == 2
