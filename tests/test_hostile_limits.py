@@ -188,3 +188,41 @@ def test_the_docs_quote_the_toml_depth_in_force():
 
     formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
     assert formats.count(f"no dotted key or table header more than {MAX_TOML_DEPTH} levels deep") == 2
+
+
+# --- F16: a boolean where the line takes a number --------------------------------------------------------------------
+
+NUMERIC_LINE_SETTINGS = ["baud", "bytesize", "stopbits", "stall_timeout_s", "overrun_chars", "buffer_chars",
+                         "memory_chars"]
+
+
+@pytest.mark.parametrize("value", [True, False])
+@pytest.mark.parametrize("name", NUMERIC_LINE_SETTINGS)
+def test_a_boolean_is_no_line_setting_number(name, value):
+    from lagsym.dnc import LineSettings
+    from lagsym.errors import InputError
+
+    with pytest.raises(InputError, match=rf" {str(value).lower()} is a boolean, not a number$"):
+        LineSettings(**{name: value})
+
+
+def test_stop_bits_true_in_a_dnc_configuration_is_refused(tmp_path):
+    from lagsym.dnc import LineSettings
+
+    assert LineSettings(stopbits=1).stopbits == 1.0 and LineSettings(stopbits=1.5).stopbits == 1.5
+    for key in ("stopbits", "bytesize", "baud"):
+        path = tmp_path / "dnc.toml"
+        path.write_text(_dnc_toml(tmp_path) + f"\n[port.line]\n{key} = true\n")
+        rc, out, err = _run("dnc", "serve", str(path), "--check")
+        _refused(rc, err, "dnc.toml: port[0].line:", "true is a boolean, not a number")
+    path.write_text(_dnc_toml(tmp_path) + "\n[port.line]\nstopbits = 1\n")
+    assert _run("dnc", "serve", str(path), "--check")[0] == 0
+
+
+def test_a_boolean_start_block_is_refused():
+    from lagsym.dnc import LineSettings, parse_program
+    from lagsym.dnc.transfer import transfer_segments
+    from lagsym.errors import InputError
+
+    with pytest.raises(InputError, match="--start-block True must be a block number"):
+        list(transfer_segments(parse_program("O1\nM30"), LineSettings(), start_block=True))
