@@ -8,6 +8,7 @@ generous timeout, so that this suite itself never runs away.
 from __future__ import annotations
 
 import io
+import json
 import random
 import re
 import resource
@@ -226,3 +227,42 @@ def test_a_boolean_start_block_is_refused():
 
     with pytest.raises(InputError, match="--start-block True must be a block number"):
         list(transfer_segments(parse_program("O1\nM30"), LineSettings(), start_block=True))
+
+
+# --- F14: nodes closer than floating point can tell apart ----------------------------------------------------------
+
+NEAR = "1.0000000000000000000001"
+
+
+@pytest.mark.parametrize("layout", ["curve", "surface", "curve-middle", "surface-middle"])
+def test_nodes_closer_than_floating_point_are_refused_by_name_for_a_curve_and_a_surface(tmp_path, layout):
+    xs = ["1", NEAR, "2"] if "middle" not in layout else ["0", "1", NEAR, "2"]
+    path = tmp_path / "close.json"
+    if layout.startswith("curve"):
+        path.write_text(json.dumps([[x, str(k)] for k, x in enumerate(xs)]))
+    else:
+        path.write_text(json.dumps([[x, y, str(i + k)] for i, x in enumerate(xs) for k, y in enumerate("012")]))
+    rc, out, err = _run("check", str(path))
+    span = "1" if "middle" not in layout else "2"
+    line = _refused(rc, err, f"lagsym: error: {path}: x nodes 1 and {NEAR} are closer than floating point can tell "
+                             f"apart over their span of {span} (a gap of")
+    assert "are equal than" not in line and out == ""
+
+
+def test_nodes_far_enough_apart_are_measured_and_the_docs_quote_the_resolution():
+    from fractions import Fraction
+
+    from lagsym.conditioning import NODE_RESOLUTION, lebesgue_maximum
+    from lagsym.errors import ConditioningError
+
+    assert NODE_RESOLUTION == Fraction(1, 2**47)
+    step = NODE_RESOLUTION * 2
+    for nodes in ([0, step, 1], [0, Fraction(1, 2), Fraction(1, 2) + step, 1], [0, 1 - step, 1]):
+        value, _ = lebesgue_maximum(nodes)
+        assert 1e13 < value < 1e15
+    with pytest.raises(ConditioningError, match=r"nodes 0 and 0\.00000000000000710542735760100185871124267578125 are closer"):
+        lebesgue_maximum([0, NODE_RESOLUTION, 1])
+    assert lebesgue_maximum([1, Fraction(NEAR)])[0] == pytest.approx(1.0, rel=1e-12)  # two nodes: always 1
+    theory = " ".join((ROOT / "docs" / "theory.md").read_text().split())
+    assert (f"closer than 2^-47 of the span of their axis ({float(NODE_RESOLUTION):.2g} of it, "
+            f"{NODE_RESOLUTION * 2**53} units of rounding)") in theory
