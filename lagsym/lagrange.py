@@ -22,7 +22,6 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
-import keyword
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -34,7 +33,7 @@ import flint
 from .errors import InputError
 from .exactsize import MAX_EXACT_MB, ExactClock, check_exact_size, stepped_product
 from .exactsize import to_fraction as _frac
-from .values import as_exact
+from .values import MAX_NAME, as_exact, check_name  # noqa: F401 - MAX_NAME: where the name check was
 
 from .grid import ControlGrid, CurvePoints
 
@@ -65,25 +64,6 @@ def __getattr__(name: str):
 
         return sympy.Symbol(name.lower())
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-MAX_NAME = 64  # characters in a variable's name
-
-
-def check_name(name, what: str = "variable") -> str:
-    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword).
-
-    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
-    writes and the Python text of ``lagsym equation --format python``: a name that is
-    not a plain identifier could be read there as code, so it is refused here, where
-    the value is made.
-    """
-    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
-                                         and name.isidentifier() and not keyword.iskeyword(name)):
-        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
-        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
-                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
-    return name
 
 
 def _variable(value, what: str):

@@ -14,6 +14,7 @@ Python mean one number everywhere.
 
 from __future__ import annotations
 
+import keyword
 import math
 import re
 from collections.abc import Iterable, Mapping
@@ -23,7 +24,7 @@ from fractions import Fraction
 from .errors import InputError
 
 __all__ = ["FrozenMap", "frozen", "as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
-           "NotANumber", "MAX_EXPONENT"]
+           "NotANumber", "MAX_EXPONENT", "MAX_NAME", "check_name"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
@@ -219,6 +220,25 @@ def choice(value, options: Iterable, what: str):
     if value not in options:
         raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
     return value
+
+
+MAX_NAME = 64  # characters in a variable's name
+
+
+def check_name(name, what: str = "variable") -> str:
+    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword).
+
+    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
+    writes and the Python text of ``lagsym equation --format python``: a name that is
+    not a plain identifier could be read there as code, so it is refused here, where
+    the value is made.
+    """
+    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
+                                         and name.isidentifier() and not keyword.iskeyword(name)):
+        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
+        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
+                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
+    return name
 
 
 class FrozenMap(Mapping):
