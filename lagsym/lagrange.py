@@ -134,10 +134,12 @@ def _distinct_nodes(nodes) -> tuple[Fraction, ...]:
     return values
 
 
-def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
+def basis_coefficients(nodes, *, max_mb: float | None = MAX_EXACT_MB) -> tuple[tuple[Fraction, ...], ...]:
     """Power-basis coefficients of the Lagrange basis on ``nodes``.
 
     Row ``i`` holds the coefficients of ``L_i`` from the constant term up.
+    ``max_mb``: refuse, before any work, a basis estimated at more megabytes
+    (as :func:`lagrange_curve`; :mod:`lagsym.exactsize`).
 
     Examples
     --------
@@ -145,13 +147,18 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     (Fraction(3, 1), Fraction(-5, 2), Fraction(1, 2))
     """
     nodes = _distinct_nodes(nodes)
+    check_exact_size(f"basis on {len(nodes)} nodes", None, nodes, None, (), max_mb)
     m = _basis_matrix(nodes)
     n = len(nodes)
     return tuple(tuple(_frac(m[i, a]) for a in range(n)) for i in range(n))
 
 
-def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly, ...]:
+def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x", *,
+                   max_mb: float | None = MAX_EXACT_MB) -> tuple[sympy.Poly, ...]:
     """The Lagrange basis polynomials ``L_i`` on ``nodes`` as exact ``sympy.Poly`` over QQ.
+
+    ``max_mb``: refuse, before any work, a basis estimated at more megabytes
+    (``--max-exact-mb``; :func:`basis_coefficients`).
 
     Examples
     --------
@@ -159,7 +166,7 @@ def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly,
     -x**2 + 4*x - 3
     """
     (symbol,) = _symbols_of((_variable(symbol, "symbol"),))
-    return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes))
+    return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes, max_mb=max_mb))
 
 
 def _poly1(coeffs, symbol) -> sympy.Poly:
@@ -220,7 +227,7 @@ class LagrangeCurve:
     @cached_property
     def basis(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 2)."""
-        return lagrange_basis(self.points.x, self.symbol)
+        return lagrange_basis(self.points.x, self.symbol, max_mb=None)  # its size checked with the curve
 
     def __repr__(self) -> str:
         sym = "" if self.variable == "x" else f", x={self.variable}"
@@ -301,12 +308,12 @@ class LagrangeSurface:
     @cached_property
     def basis_x(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 6)."""
-        return lagrange_basis(self.grid.x, self.symbols[0])
+        return lagrange_basis(self.grid.x, self.symbols[0], max_mb=None)  # checked with the surface
 
     @cached_property
     def basis_y(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_k(y)`` (paper eq. 7)."""
-        return lagrange_basis(self.grid.y, self.symbols[1])
+        return lagrange_basis(self.grid.y, self.symbols[1], max_mb=None)
 
     def __repr__(self) -> str:
         (n, m), (sx, sy) = self.grid.shape, self.variables

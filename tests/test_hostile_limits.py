@@ -266,3 +266,37 @@ def test_nodes_far_enough_apart_are_measured_and_the_docs_quote_the_resolution()
     theory = " ".join((ROOT / "docs" / "theory.md").read_text().split())
     assert (f"closer than 2^-47 of the span of their axis ({float(NODE_RESOLUTION):.2g} of it, "
             f"{NODE_RESOLUTION * 2**53} units of rounding)") in theory
+
+
+# --- F17: an exact basis on many nodes ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("call", ["lagrange_basis", "basis_coefficients"])
+def test_an_exact_basis_on_many_nodes_is_refused_before_the_work(call):
+    from lagsym.exactsize import MAX_EXACT_MB, exact_size_mb
+
+    size = exact_size_mb(range(3000))
+    code = (f"import lagsym.lagrange as L\ntry:\n    L.{call}(range(3000))\nexcept L.InputError as e:\n"
+            f"    print(e)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=30, preexec_fn=_limited)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout == (f"the exact basis on 3000 nodes would take an estimated {size / 1000:.3g} GB of exact "
+                        f"rationals, more than the limit of {MAX_EXACT_MB} MB; use fewer points (a large grid: "
+                        f"'lagsym piecewise') or raise the limit (--max-exact-mb, max_mb= in Python)\n")
+    formats = " ".join((ROOT / "docs" / "equations.md").read_text().split())
+    assert f"refuse one above `max_mb` ({MAX_EXACT_MB} MB," in formats
+    assert f"is refused at once (an estimated {size / 1000:.3g} GB)" in formats
+
+
+def test_a_basis_within_the_limit_is_made_and_the_limit_is_an_argument():
+    from fractions import Fraction
+
+    from lagsym.errors import InputError
+    from lagsym.lagrange import basis_coefficients, lagrange_basis, lagrange_curve
+    from lagsym.grid import curve_from_points
+
+    assert [p.as_expr() for p in lagrange_basis([1, 2, 3])][1].expand() == lagrange_basis([1, 2, 3])[1].as_expr()
+    assert basis_coefficients([1, 2, 3], max_mb=None)[0] == (Fraction(3), Fraction(-5, 2), Fraction(1, 2))
+    with pytest.raises(InputError, match="basis on 40 nodes would take an estimated"):
+        lagrange_basis(range(40), max_mb=0.001)
+    curve = lagrange_curve(curve_from_points([(k, k * k) for k in range(40)]), max_mb=None)
+    assert len(curve.basis) == 40  # the curve's own basis: its size was checked with the curve
