@@ -300,3 +300,78 @@ def test_a_basis_within_the_limit_is_made_and_the_limit_is_an_argument():
         lagrange_basis(range(40), max_mb=0.001)
     curve = lagrange_curve(curve_from_points([(k, k * k) for k in range(40)]), max_mb=None)
     assert len(curve.basis) == 40  # the curve's own basis: its size was checked with the curve
+
+
+# --- F18: variable names that are SymPy's own -----------------------------------------------------------------------
+
+SYMPY_NAMES = ["I", "E", "pi", "oo", "nan", "zoo", "sin", "S", "N", "Q", "O", "beta", "gamma", "Symbol", "exp"]
+GRID = [(1, 2, 7), (1, 3, 10), (3, 2, 15), (3, 3, 18)]
+
+
+@pytest.mark.parametrize("name", SYMPY_NAMES)
+@pytest.mark.parametrize("axis", ["x", "y"])
+def test_a_sympy_name_is_refused_as_a_variable(name, axis):
+    import sympy
+
+    from lagsym import curve_from_points, grid_from_points, lagrange_curve, lagrange_surface
+    from lagsym.errors import InputError
+
+    message = rf"^{axis} name '{name}' is one of SymPy's own names: sympify reads it back as SymPy's {name}, "
+    with pytest.raises(InputError, match=message):
+        lagrange_surface(grid_from_points(GRID), **{axis: name})
+    with pytest.raises(InputError, match=message):
+        lagrange_surface(grid_from_points(GRID), **{axis: sympy.Symbol(name)})
+    if axis == "x":
+        with pytest.raises(InputError, match=message):
+            lagrange_curve(curve_from_points([(0, 1), (1, 2)]), x=name)
+
+
+@pytest.mark.parametrize("names", [("x", "y"), ("u", "v"), ("theta", "phi"), ("alpha", "x1"), ("lambda_", "t"),
+                                   ("X", "Y"), ("a", "b")])
+def test_the_sympy_format_reads_back_with_every_allowed_name(names):
+    import sympy
+
+    from lagsym import grid_from_points, lagrange_surface
+    from lagsym.equation import render
+
+    s = lagrange_surface(grid_from_points(GRID), x=names[0], y=names[1])
+    back = sympy.sympify(render(s, "sympy").split(" = ", 1)[1])
+    assert back.free_symbols == {sympy.Symbol(n) for n in names}
+    assert sympy.expand(back - s.expr) == 0
+
+
+def test_the_letters_known_as_sympy_names_are_those_sympify_keeps():
+    import string
+
+    import sympy
+
+    from lagsym.values import SYMPY_LETTERS
+
+    def reads_back(name):
+        try:
+            value = sympy.sympify(name)
+        except Exception:
+            return False
+        return isinstance(value, sympy.Symbol) and value.name == name
+
+    assert SYMPY_LETTERS == {c for c in string.ascii_letters if not reads_back(c)}
+
+
+def test_a_one_letter_name_is_checked_without_sympy():
+    code = ("import sys\nfrom lagsym.values import check_name\ncheck_name('u')\n"
+            "try:\n    check_name('I')\nexcept ValueError as e:\n    print(e)\nprint('sympy' in sys.modules)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert p.stdout.splitlines()[-1] == "False", p.stdout + p.stderr
+    assert "variable name 'I' is one of SymPy's own names" in p.stdout
+
+
+def test_the_docs_name_the_refused_sympy_names():
+    equations = " ".join((ROOT / "docs" / "equations.md").read_text().split())
+    listed = "(`I`, `E`, `N`, `O`, `Q`, `S`, `pi`, `oo`, `nan`, `zoo`, `sin`, `beta`, `gamma`, ...)"
+    assert listed in equations
+    from lagsym.errors import InputError
+    from lagsym.values import check_name
+
+    for name in re.findall(r"`(\w+)`", listed):
+        with pytest.raises(InputError):
+            check_name(name)
