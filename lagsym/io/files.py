@@ -139,7 +139,7 @@ def estimate_points(text: str) -> int:
     "z": [[..]]}`` table, a height a value: the larger of the brackets and a
     third of the values (commas) counts either.
 
-    >>> estimate_points("x,y,z\n1,2,3\n4,5,6\n"), estimate_points("[[1, 2, 3], [4, 5, 6]]")
+    >>> estimate_points("x,y,z\\n1,2,3\\n4,5,6\\n"), estimate_points("[[1, 2, 3], [4, 5, 6]]")
     (3, 3)
     """
     if text.lstrip()[:1] in ("[", "{"):
