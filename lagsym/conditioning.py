@@ -44,6 +44,9 @@ AMPLIFICATION_LIMIT = 100.0
 OVERSHOOT_LIMIT = 0.10  # the surface leaves the data range by more than 10 % of it
 FLOAT_ERROR_LIMIT = 1e-12  # numeric samples trusted to this fraction of the data range
 EPS = float(np.finfo(float).eps)
+# Neighbouring nodes closer than this fraction of their span (64 units of rounding at the span's end) are refused:
+# floating point cannot place the samples between them that the Lebesgue constant is sought at.
+NODE_RESOLUTION = Fraction(1, 2**47)
 
 
 @dataclass(frozen=True)
@@ -124,10 +127,14 @@ def lebesgue_constant(nodes, samples: int = 17, rounds: int = 12) -> float:
     return lebesgue_maximum(nodes, samples, rounds)[0]
 
 
-def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float, float]:
+def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12, *, what: str = "nodes",
+                     source: str | None = None) -> tuple[float, float]:
     """The Lebesgue constant of ``nodes`` and where the Lebesgue function reaches it (a coordinate in their span).
 
-    The search of :func:`lebesgue_constant`, which this is.
+    The search of :func:`lebesgue_constant`, which this is.  Two nodes closer
+    than :data:`NODE_RESOLUTION` of their span are refused (the search cannot
+    tell them apart): with ``what`` (``"x nodes"``) and ``source`` (the file)
+    in the message.
 
     Examples
     --------
@@ -142,13 +149,8 @@ def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float,
     # The nodes scaled to [0, 1] exactly, then rounded: the constant does not change under scaling, and
     # nodes that differ far below a float's resolution at their size are still told apart.
     span = exact[-1] - exact[0]
-    s = np.asarray([float((v - exact[0]) / span) for v in exact]) if span else np.zeros(len(exact))
-    close = np.flatnonzero(np.diff(s) <= 0)
-    if close.size:
-        a, b = exact[close[0]], exact[close[0] + 1]
-        raise ConditioningError(f"nodes {_decimal(a)} and {_decimal(b)} are {'equal' if a == b else 'closer'} "
-                                f"than floating point can tell apart over their span of {_decimal(span)}: the "
-                                f"Lebesgue constant is beyond any limit; space the nodes further apart")
+    _check_gaps(exact, span, what, source)
+    s = np.asarray([float((v - exact[0]) / span) for v in exact])
     diff = np.abs(s[:, None] - s[None, :])
     np.fill_diagonal(diff, 1.0)
     logw = -np.log(diff).sum(axis=1)
@@ -159,16 +161,28 @@ def lebesgue_maximum(nodes, samples: int = 17, rounds: int = 12) -> tuple[float,
     for _ in range(rounds):
         t = lo[:, None] + (hi - lo)[:, None] * u
         vals = _log_lebesgue(s, logw, t)
+        vals[np.isnan(vals)] = -np.inf  # a sample that rounds onto a node: the function is 1 there, never the top
         k = vals.argmax(axis=1)
         top = vals[np.arange(len(lo)), k]
         centre = t[np.arange(len(lo)), k]
         where = np.where(top > best, centre, where)
-        best = np.maximum(best, top)
+        best = np.fmax(best, top)
         step = (hi - lo) / (samples + 1)
         lo, hi = np.maximum(centre - step, lo), np.minimum(centre + step, hi)
     i = int(best.argmax())
     value = math.exp(best[i]) if best[i] < _LOG_MAX else math.inf  # beyond a float: said as such, not overflowed
     return value, float(raw[0] + where[i] * (raw[-1] - raw[0]))
+
+
+def _check_gaps(exact: list[Fraction], span: Fraction, what: str, source: str | None) -> None:
+    """Refuse two neighbouring ``exact`` nodes closer than :data:`NODE_RESOLUTION` of their ``span``."""
+    for a, b in zip(exact, exact[1:]):
+        if b - a <= span * NODE_RESOLUTION:
+            where = f"{source}: " if source else ""
+            how = "are equal" if a == b else (f"are closer than floating point can tell apart over their span of "
+                                              f"{_decimal(span)} (a gap of {float((b - a) / span):.3g} of it)")
+            raise ConditioningError(f"{where}{what} {_decimal(a)} and {_decimal(b)} {how}: the Lebesgue constant is "
+                                    f"beyond any limit; space the nodes further apart")
 
 
 def _decimal(v: Fraction) -> str:
@@ -256,8 +270,8 @@ def amplification(surface, limit: float = AMPLIFICATION_LIMIT) -> Amplification:
     (2623, True)
     """
     g = surface if isinstance(surface, ControlGrid) else surface.grid
-    lx, ax = lebesgue_maximum(g.x)
-    ly, ay = lebesgue_maximum(g.y)
+    lx, ax = lebesgue_maximum(g.x, what="x nodes", source=g.source)
+    ly, ay = lebesgue_maximum(g.y, what="y nodes", source=g.source)
     if g.amplification is not None:  # the heights were computed from measured points: theirs is the figure
         return Amplification(g.amplification, lx, ly, (ax, ay), limit, fitted=True)
     return Amplification(lx * ly, lx, ly, (ax, ay), limit)
@@ -380,7 +394,7 @@ def check_curve(curve, samples_per_interval: int = 48) -> CheckReport:
 
     p = curve.points
     d = curve.degree
-    lam = lebesgue_constant(p.x_array)
+    lam = lebesgue_maximum(p.x, what="x nodes", source=p.source)[0]
     xs = np.linspace(p.x_array[0], p.x_array[-1], d * samples_per_interval + 1)
     ys = evaluate_curve(curve, xs)
     lo, hi = float(p.y_array.min()), float(p.y_array.max())

@@ -22,7 +22,6 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
-import keyword
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -34,7 +33,7 @@ import flint
 from .errors import InputError
 from .exactsize import MAX_EXACT_MB, ExactClock, check_exact_size, stepped_product
 from .exactsize import to_fraction as _frac
-from .values import as_exact
+from .values import MAX_NAME, as_exact, check_name  # noqa: F401 - MAX_NAME: where the name check was
 
 from .grid import ControlGrid, CurvePoints
 
@@ -65,25 +64,6 @@ def __getattr__(name: str):
 
         return sympy.Symbol(name.lower())
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-MAX_NAME = 64  # characters in a variable's name
-
-
-def check_name(name, what: str = "variable") -> str:
-    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword).
-
-    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
-    writes and the Python text of ``lagsym equation --format python``: a name that is
-    not a plain identifier could be read there as code, so it is refused here, where
-    the value is made.
-    """
-    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
-                                         and name.isidentifier() and not keyword.iskeyword(name)):
-        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
-        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
-                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
-    return name
 
 
 def _variable(value, what: str):
@@ -154,10 +134,12 @@ def _distinct_nodes(nodes) -> tuple[Fraction, ...]:
     return values
 
 
-def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
+def basis_coefficients(nodes, *, max_mb: float | None = MAX_EXACT_MB) -> tuple[tuple[Fraction, ...], ...]:
     """Power-basis coefficients of the Lagrange basis on ``nodes``.
 
     Row ``i`` holds the coefficients of ``L_i`` from the constant term up.
+    ``max_mb``: refuse, before any work, a basis estimated at more megabytes
+    (as :func:`lagrange_curve`; :mod:`lagsym.exactsize`).
 
     Examples
     --------
@@ -165,13 +147,18 @@ def basis_coefficients(nodes) -> tuple[tuple[Fraction, ...], ...]:
     (Fraction(3, 1), Fraction(-5, 2), Fraction(1, 2))
     """
     nodes = _distinct_nodes(nodes)
+    check_exact_size(f"basis on {len(nodes)} nodes", None, nodes, None, (), max_mb)
     m = _basis_matrix(nodes)
     n = len(nodes)
     return tuple(tuple(_frac(m[i, a]) for a in range(n)) for i in range(n))
 
 
-def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly, ...]:
+def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x", *,
+                   max_mb: float | None = MAX_EXACT_MB) -> tuple[sympy.Poly, ...]:
     """The Lagrange basis polynomials ``L_i`` on ``nodes`` as exact ``sympy.Poly`` over QQ.
+
+    ``max_mb``: refuse, before any work, a basis estimated at more megabytes
+    (``--max-exact-mb``; :func:`basis_coefficients`).
 
     Examples
     --------
@@ -179,7 +166,7 @@ def lagrange_basis(nodes, symbol: sympy.Symbol | str = "x") -> tuple[sympy.Poly,
     -x**2 + 4*x - 3
     """
     (symbol,) = _symbols_of((_variable(symbol, "symbol"),))
-    return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes))
+    return tuple(_poly1(row, symbol) for row in basis_coefficients(nodes, max_mb=max_mb))
 
 
 def _poly1(coeffs, symbol) -> sympy.Poly:
@@ -240,7 +227,7 @@ class LagrangeCurve:
     @cached_property
     def basis(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 2)."""
-        return lagrange_basis(self.points.x, self.symbol)
+        return lagrange_basis(self.points.x, self.symbol, max_mb=None)  # its size checked with the curve
 
     def __repr__(self) -> str:
         sym = "" if self.variable == "x" else f", x={self.variable}"
@@ -321,12 +308,12 @@ class LagrangeSurface:
     @cached_property
     def basis_x(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_i(x)`` (paper eq. 6)."""
-        return lagrange_basis(self.grid.x, self.symbols[0])
+        return lagrange_basis(self.grid.x, self.symbols[0], max_mb=None)  # checked with the surface
 
     @cached_property
     def basis_y(self) -> tuple[sympy.Poly, ...]:
         """The basis polynomials ``L_k(y)`` (paper eq. 7)."""
-        return lagrange_basis(self.grid.y, self.symbols[1])
+        return lagrange_basis(self.grid.y, self.symbols[1], max_mb=None)
 
     def __repr__(self) -> str:
         (n, m), (sx, sy) = self.grid.shape, self.variables

@@ -14,6 +14,8 @@ Python mean one number everywhere.
 
 from __future__ import annotations
 
+import functools
+import keyword
 import math
 import re
 from collections.abc import Iterable, Mapping
@@ -23,7 +25,7 @@ from fractions import Fraction
 from .errors import InputError
 
 __all__ = ["FrozenMap", "frozen", "as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
-           "NotANumber", "MAX_EXPONENT"]
+           "NotANumber", "MAX_EXPONENT", "MAX_NAME", "SYMPY_LETTERS", "check_name"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
@@ -226,6 +228,56 @@ def choice(value, options: Iterable, what: str):
     if value not in options:
         raise InputError(f"{what} {value!r} is not one of {', '.join(str(o) for o in options)}")
     return value
+
+
+MAX_NAME = 64  # characters in a variable's name
+# The single letters SymPy's parser reads as its own (E: e, I: the imaginary unit, N, O, Q, S: functions and
+# registries); known here so that a one-letter name, which lagsym prints without SymPy, needs no SymPy to check.
+# tests/test_hostile_limits.py checks the set against the SymPy installed.
+SYMPY_LETTERS = frozenset("EINOQS")
+
+
+def check_name(name, what: str = "variable") -> str:
+    """``name`` if it is a plain ASCII identifier (letters, digits, ``_``; a letter first; no keyword) that SymPy's
+    parser reads back as a symbol of that name.
+
+    A variable's name reaches SymPy's parser (``sympify``), the code ``sympy.lambdify``
+    writes and the Python text of ``lagsym equation --format python``: a name that is
+    not a plain identifier could be read there as code, and one of SymPy's own names
+    (``I``, ``E``, ``pi``, ``sin``, ``gamma``) is read back as the constant or function
+    it names, so the ``sympy`` format would not read back.  Both are refused here,
+    where the value is made.
+
+    >>> check_name("u"), check_name("theta")
+    ('u', 'theta')
+    >>> check_name("I", "x")
+    Traceback (most recent call last):
+    ...
+    lagsym.errors.InputError: x name 'I' is one of SymPy's own names: sympify reads it back as SymPy's I, not as a variable, so the sympy format would not read back; choose another name
+    """
+    if not isinstance(name, str) or not (0 < len(name) <= MAX_NAME and name.isascii() and name[0].isalpha()
+                                         and name.isidentifier() and not keyword.iskeyword(name)):
+        shown = repr(name) if not isinstance(name, str) or len(name) <= 80 else repr(name[:80]) + "..."
+        raise InputError(f"{what} name {shown} is not a plain identifier (ASCII letters, digits and _, a letter "
+                         f"first, at most {MAX_NAME} characters, not a Python keyword)")
+    if not _read_back(name):
+        raise InputError(f"{what} name {name!r} is one of SymPy's own names: sympify reads it back as SymPy's "
+                         f"{name}, not as a variable, so the sympy format would not read back; choose another name")
+    return name
+
+
+@functools.lru_cache(maxsize=256)
+def _read_back(name: str) -> bool:
+    """Whether ``sympy.sympify(name)`` is the plain symbol ``name`` (a letter is looked up, not parsed)."""
+    if len(name) == 1:
+        return name not in SYMPY_LETTERS
+    import sympy
+
+    try:
+        value = sympy.sympify(name)
+    except Exception:  # noqa: BLE001 - a name SymPy keeps for a function or a class: its parser fails on its own way
+        return False
+    return isinstance(value, sympy.Symbol) and value.name == name
 
 
 class FrozenMap(Mapping):

@@ -159,7 +159,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         in_program_units(args)
         check_paths(args)
         with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)), \
-                _exact_time(getattr(args, "max_exact_s", None)):
+                _exact_time(getattr(args, "max_exact_s", None)), _file_points(getattr(args, "max_file_points", None)):
             return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
@@ -192,6 +192,18 @@ def _exact_time(seconds: float | None):
     from ..exactsize import exact_time_limit
 
     with exact_time_limit(seconds):
+        yield
+
+
+@contextlib.contextmanager
+def _file_points(points: int | None):
+    """The command's points files under its ``--max-file-points`` (None: a command without it, the default)."""
+    if points is None:
+        yield
+        return
+    from ..io import file_points_limit
+
+    with file_points_limit(points):
         yield
 
 

@@ -70,6 +70,16 @@ def add_points_arguments(p) -> None:
     """The options of every command that reads a points file: ``--columns`` and ``--snap``."""
     p.add_argument("--columns", metavar="LIST", help=COLUMNS_HELP)
     p.add_argument("--snap", metavar="TOL", help=SNAP_HELP)
+    add_file_points_limit(p)
+
+
+def add_file_points_limit(p) -> None:
+    """``--max-file-points``: the points a points file may hold, estimated from its lines before any is read."""
+    from ..io.files import MAX_FILE_POINTS
+
+    p.add_argument("--max-file-points", type=count(1, 10**9), default=MAX_FILE_POINTS, metavar="N",
+                   help=f"refuse a points file that holds more than about N points, counted from its lines before "
+                        f"any is read (default {MAX_FILE_POINTS:,})")
 
 
 def add_exact_limit(p) -> None:

@@ -9,7 +9,7 @@ from ..compare import DEFAULT_SAMPLES, DEFAULT_TOLERANCE_MM, TABLE_FORMATS, comp
 from ..formula import parse_formula
 from ..io import TABLE_SUFFIXES, read_points
 from ..surfaces import HERMITE_KINDS, METHODS
-from ._common import add_exact_limit, count, emit, number
+from ._common import add_file_points_limit, add_exact_limit, count, emit, number
 
 DESCRIPTION = """Build the Lagrange, Hermite, Bezier and B-spline surfaces from the control
 points in FILE, sample them at the same (x, y) positions and print the paper's
@@ -52,6 +52,7 @@ def _methods(text: str) -> list[str]:
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="control points file: JSON or CSV with x,y,z")
+    add_file_points_limit(p)
     p.add_argument("--reference", default="lagrange", metavar="REF",
                    help="z_f: 'lagrange' (default), a formula such as '0.5*x**2 + y', or a .json/.csv file of "
                         "measured points")

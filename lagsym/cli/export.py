@@ -10,7 +10,8 @@ from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ._common import add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, count, read_piecewise
+from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument,
+                      conditioning_notes, count, read_piecewise)
 from ._lines import say
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
@@ -41,6 +42,7 @@ examples:
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     p.add_argument("file", help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface")
     add_conditioning_argument(p)
     p.add_argument("-o", "--output", metavar="FILE", required=True,

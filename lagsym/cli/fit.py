@@ -10,7 +10,7 @@ from ..export.surfacejson import write_surface_json
 from ..fit import CRITERIA, MAX_DEGREE, fit_surface
 from ..io import read_text
 from ..values import exact_number, NotANumber
-from ._common import COLUMNS_HELP, emit, exact, measured_points
+from ._common import add_file_points_limit, COLUMNS_HELP, emit, exact, measured_points
 from ._lines import say
 
 DESCRIPTION = """Fit the exact least-squares tensor-product polynomial
@@ -45,6 +45,7 @@ examples:
 def add_arguments(p) -> None:
     p.add_argument("file", help="points file: JSON or a table with x,y,z (a grid, or scattered)")
     p.add_argument("--columns", metavar="LIST", help=COLUMNS_HELP)
+    add_file_points_limit(p)
     p.add_argument("--degree", default="auto", metavar="P[xQ]",
                    help=f"degree in x and y (4), or in each (4x3), 0 to {MAX_DEGREE}; "
                         f"auto (default) chooses them by --criterion")

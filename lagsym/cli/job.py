@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..io import check_not_input, write_text
 from ._lines import say
-from ._common import add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
+from ._common import add_file_points_limit, add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
@@ -32,6 +32,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("job", help="job file (TOML)")
+    add_file_points_limit(p)
     p.add_argument("--measured", metavar="RESULTS",
                    help="a job with a [probe] table: the probing program's results, fitted into the job's surface")
     add_conditioning_argument(p)

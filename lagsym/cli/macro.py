@@ -12,7 +12,7 @@ from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_p
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
 from ..macro.program import MAX_MACRO_POINTS
-from ._common import (add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -39,6 +39,7 @@ examples:
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     p.add_argument("file", help="points file: JSON or CSV with x,y,z")
     add_conditioning_argument(p)
     p.add_argument("--dialect", choices=MACRO_DIALECTS, default="fanuc", help=f"the control: {dialect_help(MACRO_DIALECTS)}")

@@ -8,7 +8,7 @@ from ..errors import InputError
 from ..grid import CurvePoints
 from ..io import read_any_points
 from ..lagrange import lagrange_curve, lagrange_surface
-from ._common import add_exact_limit, exact_limit, SCALE, count, measured_points, number
+from ._common import add_file_points_limit, add_exact_limit, exact_limit, SCALE, count, measured_points, number
 
 DESCRIPTION = """Draw the Lagrange surface through the control points in FILE, shaded and
 coloured by z, with the control points and the net joining them; or, with
@@ -62,6 +62,7 @@ def _size(text: str) -> tuple[int, int]:
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     # Optional only so that '--show basis FILE' works too: --show swallows the words after it.
     p.add_argument("file", nargs="?", help="points file: JSON or CSV with x,y,z (a surface) or x,y (a curve)")
     p.add_argument("--show", nargs="+", metavar=("WHAT", "PROGRAM"), default=None,

@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..io import read_points
 from ..lagrange import lagrange_surface
 from ..sampling import MAX_AXIS_POINTS, MAX_POINTS, Box, iter_blocks, sample_grid
-from ._common import add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, count, exact, read_piecewise
+from ._common import add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, count, exact, read_piecewise
 
 DESCRIPTION = f"""Sample the exact Lagrange surface through the control points in FILE on a
 regular grid and write the interior data, numerically stable at any density.
@@ -42,6 +42,7 @@ PROGRESS_POINTS = 250_000  # smaller jobs finish before a bar is worth drawing
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     p.add_argument("file", help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface")
     add_conditioning_argument(p)
     d = p.add_argument_group("density (counts or spacing)")

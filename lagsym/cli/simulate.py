@@ -7,7 +7,7 @@ from ..io import read_program
 from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, detect_dialect,
                         moves_csv, simulate)
 from ..simulate.runaway import check_lines
-from ._common import add_exact_limit, count, emit, exact
+from ._common import add_file_points_limit, add_exact_limit, count, emit, exact
 from ._lines import say
 from ._progress import progress_bar
 
@@ -49,6 +49,7 @@ examples:
 
 def add_arguments(p) -> None:
     p.add_argument("program", help="the program file")
+    add_file_points_limit(p)
     p.add_argument("--dialect", choices=SIM_DIALECTS,
                    help="the control (default: guessed from the text: fanuc, linuxcnc or heidenhain)")
     p.add_argument("--precision", type=int, choices=(8, 15),

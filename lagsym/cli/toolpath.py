@@ -13,7 +13,7 @@ from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.waterline import BAND_DEG, STRATEGIES
 
-from ._common import (add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._lines import say
 from ._progress import progress_bar
@@ -41,6 +41,7 @@ POINT_DIALECTS = names(point_lists=True)
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     p.add_argument("file", help="points file: JSON or CSV with x,y,z, a 'lagsym fit' surface or a "
                                 "'lagsym piecewise' surface")
     add_conditioning_argument(p)

@@ -12,7 +12,7 @@ from ..io import read_points, read_program
 from ..lagrange import lagrange_surface
 from ..machine import TOOL_SHAPES, Placement, Tool, mm_per_surface_unit
 from ..verify import MAX_CELLS, MAX_CONTACTS, MAX_LEFT_MM, program_resolution_mm, simulate_cut
-from ._common import add_exact_limit, exact_limit, CORNER_MM, SCALE, TOOL_MM, count, number, origin, read_piecewise
+from ._common import add_file_points_limit, add_exact_limit, exact_limit, CORNER_MM, SCALE, TOOL_MM, count, number, origin, read_piecewise
 from ._progress import progress_bar
 
 DESCRIPTION = """Simulate the material the moves of PROGRAM remove with the given tool, on a
@@ -57,6 +57,7 @@ _SINGLE_TOOL = {"tool_shape": "ball", "tool_diameter": 6.0, "corner_radius": Non
 
 def add_arguments(p) -> None:
     add_exact_limit(p)
+    add_file_points_limit(p)
     p.add_argument("surface", metavar="SURFACE",
                    help="points file: JSON or CSV with x,y,z, or a 'lagsym piecewise' surface (with --job: the job file)")
     p.add_argument("program", help="G-code program (point list: G00/G01 moves, G02/G03 arcs with I J K)")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..errors import InputError, LagsymError
 from ..io.files import path_problem, read_bytes
+from ..io.tomltext import check_toml_depth
 from .settings import LineSettings, check_port, profile
 
 __all__ = ["PortConfig", "ServerConfig", "load_config", "MAX_CONFIG_BYTES"]
@@ -135,7 +136,9 @@ def load_config(path: str | Path) -> ServerConfig:
     source = str(path)
     raw = read_bytes(path, "a DNC configuration", MAX_CONFIG_BYTES)  # a regular file, within a limit: never /dev/zero
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        text = raw.decode("utf-8")
+        check_toml_depth(text, source, "a configuration")
+        data = tomllib.loads(text)
     except UnicodeDecodeError as e:
         raise InputError(f"{source}: not UTF-8 text (byte {e.start}); a configuration is a TOML text file") from None
     except tomllib.TOMLDecodeError as e:

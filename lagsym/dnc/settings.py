@@ -31,6 +31,12 @@ _LOGGING = ("debug", "info", "warning", "error")
 _FILLERS = {"NUL": "\x00", "SPACE": " ", "ETX": "\x03", "EOT": "\x04", "CR": "\r", "LF": "\n", "DEL": "\x7f"}
 
 
+# The settings that are numbers, as messages name them.
+_NUMBERS = {"baud": "baud rate", "bytesize": "data bits", "stopbits": "stop bits",
+            "stall_timeout_s": "stall timeout (seconds)", "overrun_chars": "overrun limit",
+            "buffer_chars": "control buffer", "memory_chars": "control memory"}
+
+
 @dataclass(frozen=True)
 class LineSettings:
     """How the serial line to one control is set up.
@@ -123,11 +129,14 @@ class LineSettings:
     handshake_expected: bool = True
 
     def __post_init__(self):
+        for name, what in _NUMBERS.items():  # True is 1 to Python, never a number of bits or characters to a user
+            if isinstance(getattr(self, name), bool):
+                raise InputError(f"{what} {str(getattr(self, name)).lower()} is a boolean, not a number")
         if not isinstance(self.baud, int) or not 50 <= self.baud <= 4_000_000:
             raise InputError(f"baud rate {self.baud!r} must be a whole number from 50 to 4000000")
         choice(self.bytesize, (5, 6, 7, 8), "data bits")
         choice(self.parity, tuple(PARITIES), "parity")
-        if isinstance(self.stopbits, (int, float)) and not isinstance(self.stopbits, bool):
+        if isinstance(self.stopbits, (int, float)):
             object.__setattr__(self, "stopbits", float(self.stopbits))
         choice(self.stopbits, (1.0, 1.5, 2.0), "stop bits")
         choice(self.flow, FLOW_CONTROLS, "flow control")

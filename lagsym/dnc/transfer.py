@@ -38,7 +38,7 @@ def transfer_segments(program: Program, settings: LineSettings, mode: str = "upl
     b'%\\r\\nO1\\r\\nM30\\r\\n%\\r\\n'
     """
     choice(mode, MODES, "mode")
-    if not isinstance(start_block, int) or start_block < 1:
+    if isinstance(start_block, bool) or not isinstance(start_block, int) or start_block < 1:
         raise InputError(f"--start-block {start_block!r} must be a block number from 1")
     blocks: list[tuple[int | None, str]] = []
     if start_block > 1:

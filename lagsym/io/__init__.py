@@ -11,7 +11,8 @@
 from __future__ import annotations
 
 from ..values import exact_number
-from .files import MAX_BYTES, STDIN_SILENCE_S, EventLog, event_log, read_bytes, read_program, read_text
+from .files import (MAX_BYTES, MAX_FILE_POINTS, STDIN_SILENCE_S, EventLog, event_log, file_points_limit, read_bytes,
+                    read_program, read_text)
 from .points import (
     TABLE_SUFFIXES,
     SURFACE_FORMAT,
@@ -54,6 +55,8 @@ __all__ = [
     "check_apart",
     "OutputNotice",
     "MAX_BYTES",
+    "MAX_FILE_POINTS",
+    "file_points_limit",
     "STDIN_SILENCE_S",
     "TABLE_SUFFIXES",
 ]

@@ -9,6 +9,7 @@ control reads them: ASCII, line endings kept.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import errno
 import os
 import stat
@@ -17,10 +18,15 @@ from collections.abc import Iterator
 
 from ..errors import InputError
 
-__all__ = ["MAX_BYTES", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "path_problem", "read_bytes", "read_text", "read_program",
-           "event_log", "EventLog"]
+__all__ = ["MAX_BYTES", "MAX_FILE_POINTS", "STDIN_NAMES", "STDIN_SILENCE_S", "display_name", "path_problem", "read_bytes",
+           "read_text", "read_program", "event_log", "EventLog", "file_points_limit", "estimate_points",
+           "check_point_count"]
 
 MAX_BYTES = 64 * 1024 * 1024
+# Points of one points file (--max-file-points): reading takes about 0.1 ms and 1 kB a point, so a million is
+# minutes and a gigabyte, four times the largest grid 'lagsym piecewise' takes and far beyond any fit's data.
+MAX_FILE_POINTS = 1_000_000
+_POINTS_LIMIT: contextvars.ContextVar[int | None] = contextvars.ContextVar("file_points_limit", default=MAX_FILE_POINTS)
 
 _KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe (FIFO)"),
           (stat.S_ISSOCK, "a socket"))
@@ -118,6 +124,47 @@ def read_text(path: str | os.PathLike) -> tuple[str, str]:
     if not text.strip():
         raise InputError(f"{name}: the file is empty")
     return name, text
+
+
+@contextlib.contextmanager
+def file_points_limit(points: int | None):
+    """Within the block, a points file estimated to hold more than ``points`` points is refused (None: no limit).
+
+    Examples
+    --------
+    >>> with file_points_limit(5_000_000):
+    ...     pass
+    """
+    token = _POINTS_LIMIT.set(None if points is None else int(points))
+    try:
+        yield
+    finally:
+        _POINTS_LIMIT.reset(token)
+
+
+def estimate_points(text: str) -> int:
+    """About how many points the text of a points file holds, counted without reading a number.
+
+    A table holds a point a line.  JSON holds a point a list or object
+    (``[x, y, z]``, ``{"x": ..}``), or, in an ``{"x": [..], "y": [..],
+    "z": [[..]]}`` table, a height a value: the larger of the brackets and a
+    third of the values (commas) counts either.
+
+    >>> estimate_points("x,y,z\\n1,2,3\\n4,5,6\\n"), estimate_points("[[1, 2, 3], [4, 5, 6]]")
+    (3, 3)
+    """
+    if text.lstrip()[:1] in ("[", "{"):
+        return max(text.count("[") + text.count("{"), (text.count(",") + 1) // 3)
+    return text.count("\n") or text.count("\r") or 1
+
+
+def check_point_count(name: str, text: str) -> None:
+    """Refuse the points file ``name`` when :func:`estimate_points` says it holds more than the limit in force."""
+    limit = _POINTS_LIMIT.get()
+    if limit is not None and (count := estimate_points(text)) > limit:
+        raise InputError(f"{name}: about {count:,} points, more than the limit of {limit:,} points in one file "
+                         f"(reading them would take minutes and gigabytes); thin the points, or raise the limit "
+                         f"(--max-file-points, file_points_limit() in Python)")
 
 
 def read_program(path: str | os.PathLike) -> str:

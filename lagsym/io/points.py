@@ -17,7 +17,7 @@ from typing import Any
 from ..errors import InputError
 from ..grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
 from ..values import MAX_EXPONENT, NotANumber, choice, exact_number
-from .files import read_text
+from .files import check_point_count, read_text
 from .table import UNIT_NAMES, parse_columns, read_table
 
 __all__ = ["PointsFile", "read_point_file", "surface_file", "SURFACE_FORMAT", "ScatteredPoints",
@@ -297,6 +297,7 @@ def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None
         raise InputError(f"a points file's path, not {type(path).__name__} {_shown(path)}: for points in memory "
                          f"use lagsym.{maker}(points)")
     name, text = read_text(path)
+    check_point_count(name, text)
     cols = parse_columns(columns, arity) if columns else None
     if _kind(name, text) == "json":
         if cols:
@@ -349,6 +350,7 @@ def read_scattered_points(path: str | os.PathLike, columns=None) -> ScatteredPoi
     first, or a mistake).
     """
     name, text = read_text(path)
+    check_point_count(name, text)
     cols = parse_columns(columns, 3) if columns else None
     if _kind(name, text) == "json":
         if cols:

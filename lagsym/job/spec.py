@@ -32,6 +32,7 @@ from pathlib import Path
 
 from ..errors import InputError, LagsymError
 from ..io.files import read_bytes
+from ..io.tomltext import check_toml_depth
 from ..controls import VARIABLE_PROFILES, control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
@@ -137,7 +138,9 @@ def read_job(path) -> JobSpec:
     """Read and check the job file at ``path``."""
     raw = read_bytes(path, "a job file")
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        text = raw.decode("utf-8")
+        check_toml_depth(text, str(path), "a job file")
+        data = tomllib.loads(text)
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
         raise InputError(f"{path}: not a valid TOML job file: {e}") from None
     except RecursionError:
