@@ -13,9 +13,10 @@ more than those of small integers.  So each exact computation (a polynomial's
 coefficients; the change of basis its numeric evaluation uses) is timed as
 its products run: once a product has run for :data:`FORESEE_SECONDS`, the
 pace of its rows gives the time the computation will take on this machine,
-and one that would take more than :func:`exact_time_limit` allows
-(:data:`MAX_EXACT_S` unless set; ``--max-exact-s``) is refused with that
-figure, a second or so into it.
+and one that would end later than :func:`exact_time_limit` allows (within
+such a block, as a command runs, counted from the block's start for all its
+computations together; else :data:`MAX_EXACT_S` for each; ``--max-exact-s``)
+is refused with that figure, a second or so into it.
 """
 
 from __future__ import annotations
@@ -36,21 +37,26 @@ __all__ = ["MAX_EXACT_MB", "MAX_EXACT_S", "ExactClock", "check_exact_size", "exa
 
 MAX_EXACT_MB = 400  # estimated megabytes of exact rationals one polynomial may take (--max-exact-mb)
 STEP_SECONDS = 0.2  # about how long one step of a stepped product holds the interpreter: a signal waits no longer
-MAX_EXACT_S = 15.0  # seconds one exact computation may take here, foreseen from its first rows (--max-exact-s)
+MAX_EXACT_S = 15.0  # seconds a command's exact computations may take here, foreseen from their first rows (--max-exact-s)
 FORESEE_SECONDS = 0.5  # how long a product runs before its pace foretells the whole computation's time
-_LIMIT_S: contextvars.ContextVar[float | None] = contextvars.ContextVar("exact_time_limit", default=MAX_EXACT_S)
+# (limit in seconds or None, the time the limit counts from or None: from each computation's own start)
+_LIMIT_S: contextvars.ContextVar[tuple[float | None, float | None]] = contextvars.ContextVar(
+    "exact_time_limit", default=(MAX_EXACT_S, None))
 
 
 @contextlib.contextmanager
 def exact_time_limit(seconds: float | None):
-    """Within the block, an exact computation foreseen to take more than ``seconds`` is refused (None: no limit).
+    """Within the block, an exact computation foreseen to end more than ``seconds`` after the block began is
+    refused (None: no limit): the limit holds for all the block's exact work together, as a command's.
+
+    Outside such a block each computation has :data:`MAX_EXACT_S` of its own.
 
     Examples
     --------
     >>> with exact_time_limit(60.0):
     ...     pass
     """
-    token = _LIMIT_S.set(None if seconds is None else float(seconds))
+    token = _LIMIT_S.set((None if seconds is None else float(seconds), time.perf_counter()))
     try:
         yield
     finally:
@@ -62,8 +68,8 @@ class ExactClock:
 
     def __init__(self, what: str, source=None):
         self.what, self.source = what, source
-        self.limit = _LIMIT_S.get()
-        self.started = time.perf_counter()
+        self.limit, since = _LIMIT_S.get()
+        self.started = time.perf_counter() if since is None else since
 
     def foresee(self, done: int, total: int, spent: float, products_after: int) -> None:
         """Refuse if the computation, its current product ``done`` of ``total`` rows in after ``spent`` seconds and

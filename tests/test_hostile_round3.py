@@ -117,7 +117,7 @@ def test_a_long_program_of_expressions_is_compiled_in_pieces_and_its_alarm_names
     code = ("from lagsym.simulate import simulate, ControlAlarm\n"
             "e = '#100=[[[[#100+1.]*[#101+2.]]/[[#102+3.]+4.]]-[[[#103+1.]*2.]+[#104*3.]]+[#105+#106+#107+#108+#109]]'\n"
             "lines = ['%', 'O1000'] + [e] * 20000 + ['#102=[#100/0]', 'M30', '%']\n"
-            "try:\n    simulate('\\n'.join(lines) + '\\n', 'fanuc', 8)\nexcept ControlAlarm as e:\n    print(e)\n"
+            "try:\n    simulate('\\n'.join(lines) + '\\n', 'fanuc', 8, max_lines=None)\nexcept ControlAlarm as e:\n    print(e)\n"
             "import resource; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     alarm, peak_kb = done.stdout.splitlines()
@@ -141,3 +141,21 @@ def test_a_program_of_more_bracketed_expressions_than_lines_allowed_is_refused_b
     formats = " ".join((ROOT / "docs" / "formats.md").read_text().split())
     assert "at most 100000 lines (`--max-lines`) and as many bracketed expressions" in formats
     assert EXPRESSIONS_PER_LINE == 1  # "as many" in the docs
+
+
+def test_the_time_limit_counts_a_commands_exact_work_together(monkeypatch):
+    """``check`` of a 100x100 grid took 15.5 s with the limit at 15 s: each of its two exact computations was within
+    the limit on its own.  Within ``exact_time_limit`` the clock counts from the block's start."""
+    import lagsym.exactsize as es
+
+    now = [100.0]
+    monkeypatch.setattr(es.time, "perf_counter", lambda: now[0])
+    with es.exact_time_limit(15.0):
+        now[0] += 10.0  # ten seconds of exact work already done in this command
+        clock = es.ExactClock("surface through 3 x 3 nodes")
+        now[0] += 1.0
+        with pytest.raises(LagsymError, match="would take about 17 s here"):
+            clock.foresee(1, 7, 1.0, 0)  # one row of seven in one second: six more to come
+    clock = es.ExactClock("surface through 3 x 3 nodes")  # outside: a computation's own 15 s
+    now[0] += 1.0
+    clock.foresee(1, 7, 1.0, 0)

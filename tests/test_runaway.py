@@ -171,7 +171,7 @@ def test_the_docs_quote_the_limit_and_the_figures_in_force():
     assert "points 0.1 apart: 2.7 GB; of 500 points: 306 MB" in cli.replace("\n", " ")
     assert "a curve of 1000 points 0.1 apart (2.7 GB)" in formats
     assert f"`--max-exact-s` ({MAX_EXACT_S:g} s)" in cli.replace("\n", " ")
-    assert f"to take more than {MAX_EXACT_S:g} s here (`--max-exact-s`)" in formats
+    assert f"to end more than {MAX_EXACT_S:g} s after the command began (`--max-exact-s`" in formats
 
 
 def test_a_power_of_powers_in_a_formula_is_refused_with_its_size_before_it_is_computed(tmp_path):

@@ -94,12 +94,14 @@ def add_exact_limit(p) -> None:
 
 
 def add_exact_time_limit(p) -> None:
-    """``--max-exact-s``: the limit on the time of each exact computation, foreseen from the pace of its first rows."""
+    """``--max-exact-s``: the limit on the time of the command's exact computations, foreseen from the pace of their
+    first rows."""
     from ..exactsize import MAX_EXACT_S
 
     p.add_argument("--max-exact-s", type=number(0.001, 1e9), default=MAX_EXACT_S, metavar="S",
                    help=f"refuse an exact computation (the polynomial, or the change of basis its evaluation uses) "
-                        f"that its first rows show would take more than S seconds here (default {MAX_EXACT_S:g})")
+                        f"that its first rows show would end more than S seconds after the command began "
+                        f"(default {MAX_EXACT_S:g})")
 
 
 def exact_limit(args) -> float:
