@@ -37,7 +37,7 @@ __all__ = ["MAX_EXACT_MB", "MAX_EXACT_S", "ExactClock", "check_exact_size", "exa
 
 MAX_EXACT_MB = 400  # estimated megabytes of exact rationals one polynomial may take (--max-exact-mb)
 STEP_SECONDS = 0.2  # about how long one step of a stepped product holds the interpreter: a signal waits no longer
-MAX_EXACT_S = 15.0  # seconds a command's exact computations may take here, foreseen from their first rows (--max-exact-s)
+MAX_EXACT_S = 15.0  # seconds a command's exact computations may take here, foreseen from their rows (--max-exact-s)
 FORESEE_SECONDS = 0.5  # how long a product runs before its pace foretells the whole computation's time
 # (limit in seconds or None, the time the limit counts from or None: from each computation's own start)
 _LIMIT_S: contextvars.ContextVar[tuple[float | None, float | None]] = contextvars.ContextVar(

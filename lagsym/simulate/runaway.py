@@ -44,7 +44,8 @@ MAX_IDLE_BLOCKS = 200_000  # lagsym's macros move every few hundred blocks at mo
 
 def check_lines(text: str, max_lines: int | None, source: str = "the program") -> None:
     """Refuse ``text`` of more than ``max_lines`` lines, or of more than :data:`EXPRESSIONS_PER_LINE` times as
-    many bracketed expressions (each takes some 0.1 ms to read and compile), before any is read into blocks (None: no limit)."""
+    many bracketed expressions (each takes some 0.1 ms to read and compile), before any is read into blocks
+    (None: no limit)."""
     if max_lines is None:
         return
     lines = text.count("\n") + 1

@@ -21,7 +21,8 @@ from . import chordal
 from .contours import CROSSING_POINTS, crossings_at_least
 from .scallop import TooManyRows, scallop_levels
 
-__all__ = ["check_points", "check_size", "scallop_rows", "per_row", "too_many", "check_strategy_work", "row_samples", "nearest_nodes"]
+__all__ = ["check_points", "check_size", "scallop_rows", "per_row", "too_many", "check_strategy_work", "row_samples",
+           "nearest_nodes"]
 
 
 def scallop_rows(ev, tool: Tool, raster: RasterSpec, reach, *, fine: float, mm_per_unit: float,
