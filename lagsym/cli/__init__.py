@@ -158,8 +158,7 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
 
         in_program_units(args)
         check_paths(args)
-        with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)), \
-                _exact_time(getattr(args, "max_exact_s", None)), _file_points(getattr(args, "max_file_points", None)):
+        with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)), _limits(args):
             return int(args._run(args, out, err))
     except LagsymError as e:
         if getattr(args, "traceback", False):
@@ -184,26 +183,17 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
 
 
 @contextlib.contextmanager
-def _exact_time(seconds: float | None):
-    """The command's exact computations under its ``--max-exact-s`` (None: a command without it, the default)."""
-    if seconds is None:
-        yield
-        return
-    from ..exactsize import exact_time_limit
+def _limits(args):
+    """The command's ``--max-exact-s`` and ``--max-file-points`` around its work (a command without one: the default)."""
+    with contextlib.ExitStack() as stack:
+        if getattr(args, "max_exact_s", None) is not None:
+            from ..exactsize import exact_time_limit
 
-    with exact_time_limit(seconds):
-        yield
+            stack.enter_context(exact_time_limit(args.max_exact_s))
+        if getattr(args, "max_file_points", None) is not None:
+            from ..io import file_points_limit
 
-
-@contextlib.contextmanager
-def _file_points(points: int | None):
-    """The command's points files under its ``--max-file-points`` (None: a command without it, the default)."""
-    if points is None:
-        yield
-        return
-    from ..io import file_points_limit
-
-    with file_points_limit(points):
+            stack.enter_context(file_points_limit(args.max_file_points))
         yield
 
 
