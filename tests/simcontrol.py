@@ -383,7 +383,7 @@ class _Control:
                 self.first_byte_at = self.first_byte_at or now
                 self.last_byte_at = now
                 self.starved_at_last = self.starved_s
-                for byte in data:
+                for at, byte in enumerate(data, 1):
                     self.count_in += 1
                     if self.discard_after_bytes is not None and self.count_in > self.discard_after_bytes:
                         continue
@@ -393,8 +393,9 @@ class _Control:
                         self.after = 0
                     if self.drop_after_bytes is not None and len(self.received) >= self.drop_after_bytes:
                         # What is already on its way arrives (a UART would have taken it while the
-                        # simulation was not running); what comes after the cut is lost.
-                        self.received += self.port.read(self.port.in_waiting or 1)
+                        # simulation was not running), the rest of this read first; what comes after the
+                        # cut is lost.
+                        self.received += data[at:] + self.port.read(self.port.in_waiting or 1)
                         self.count.value = len(self.received)
                         self.cut()
                         return

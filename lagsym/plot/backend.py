@@ -79,12 +79,15 @@ def _start_xvfb() -> str:
     """Start a private Xvfb server that ends with this process; return its display name.
 
     The kernel ends the server when this process exits (not an ``atexit``
-    handler, which would run while VTK still holds its X connection).
+    handler, which would run while VTK still holds its X connection).  It
+    runs with ``-noreset``: an X server resets when its last client leaves,
+    and a window opened during the reset finds no server ("bad X server
+    connection"), which VTK, opening and closing connections, ran into.
     """
     read_fd, write_fd = os.pipe()
     try:
         server = subprocess.Popen(
-            ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+            ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp", "-noreset"],
             pass_fds=(write_fd,),
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
