@@ -80,10 +80,19 @@ class ExactClock:
         foreseen = time.perf_counter() - self.started + rest
         if foreseen > self.limit:
             where = f"{self.source}: " if self.source else ""
-            raise InputError(f"{where}the exact {self.what} would take about {foreseen:.0f} s here (foreseen from "
+            raise InputError(f"{where}the exact {self.what} would take about {_seconds(foreseen, self.limit)} s here (foreseen from "
                              f"its first {done} of {total} rows), more than the limit of {self.limit:g} s; use fewer "
                              f"points (a large grid: 'lagsym piecewise') or raise the limit (--max-exact-s, "
                              f"exact_time_limit() in Python)")
+
+
+def _seconds(foreseen: float, limit: float) -> str:
+    """``foreseen`` in whole seconds, or with as many decimals as it takes to read as more than ``limit``."""
+    for decimals in range(4):
+        text = f"{foreseen:.{decimals}f}"
+        if float(text) > limit:
+            return text
+    return text
 
 
 def _basis_bits(nodes: tuple[Fraction, ...]) -> float:

@@ -70,6 +70,9 @@ def test_point_tool_path_lies_on_the_surface(example4):
 @example(big_ball_surface(), 7.375, "ball", 0.125, "x")
 @example(lagrange_surface(grid_from_table([0, 2, 4], [0, Fraction(3, 2)], [[0, 0], [0, -1], [0, 1]])), 5.25, "flat",
          0.005859375, "y")  # the rim leaves the corner (20, 7.5) mm from an axis beyond the box in y only
+@example(lagrange_surface(grid_from_table([0, 2], [0, Fraction(3, 2), 3, Fraction(9, 2)],
+                                          [[0, 0, 0, 0], [0, 0, Fraction(5, 2), Fraction(-5, 2)]])), 6.0, "ball",
+         0.005000000000000001, "x")  # a ball whose equator leaves the corner (10, 22.5) mm
 def test_planned_points_between_exact_value_and_tolerance_above(surf, diameter, shape, tol, direction):
     tp = plan(surf, tool=Tool(shape, diameter), raster=RasterSpec(direction, 3.0, None, None, tol), scale=5.0)
     p = tp.points_mm
@@ -81,10 +84,10 @@ def test_planned_points_between_exact_value_and_tolerance_above(surf, diameter, 
     beyond_x = np.maximum(np.maximum(x0 - p[:, 0], p[:, 0] - x1), 0)
     beyond_y = np.maximum(np.maximum(y0 - p[:, 1], p[:, 1] - y1), 0)
     assert np.all(np.hypot(beyond_x, beyond_y) <= diameter / 2 + 1e-9)
-    # More than the tolerance above only where the page says: a flat end beyond the box whose rim leaves a box
-    # corner, so that its height falls by more than the tolerance within one unit of the last decimal and the
-    # move cannot be split further; there the point is lifted by the dip found, and no more.
-    assert not over.any() or shape == "flat"
+    # More than the tolerance above only where the page says: a cutter beyond the box whose edge (a flat end's
+    # rim, a ball's equator) leaves a box corner, so that its height falls by more than the tolerance within one
+    # unit of the last decimal and the move cannot be split further; there the point is lifted by the dip found,
+    # and no more.
     corner = np.min([np.hypot(p[over, 0] - cx, p[over, 1] - cy) for cx in (x0, x1) for cy in (y0, y1)], axis=0)
     assert np.all(np.maximum(beyond_x[over], beyond_y[over]) > 0)
     assert np.all(np.abs(corner - diameter / 2) <= 0.01)  # the rim at the corner, within ten units of 0.001 mm
