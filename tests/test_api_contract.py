@@ -67,6 +67,7 @@ def test_a_plain_program_still_simulates_after_the_checks():
     assert [(m.x, m.y, m.z) for m in sim.moves] == [(1.0, 2.0, 0.0), (1.0, 2.0, -1.0)]
 
 
+@pytest.mark.slow
 def test_star_import_gives_the_simulate_function():
     # In a fresh interpreter: the order of imports is what made the subpackage shadow the function.
     code = ("from lagsym import *\nimport lagsym.simulate\n"
@@ -201,6 +202,7 @@ _KEYS = st.sampled_from(["points", "title", "stock", "tools", "operations", "dia
                          "work_offset", "program_number", "safe_z", "rapid", "variables"])
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.dictionaries(_KEYS, _VALUE, max_size=4), st.booleans())
 def test_generated_job_tables_answer_with_a_lagsym_error(changes, onto_a_good_job):

@@ -56,6 +56,7 @@ def test_import_lagsym_loads_no_heavy_library():
     assert done.stdout.strip() == ""
 
 
+@pytest.mark.slow
 def test_the_plain_library_does_not_load_serial_pictures_or_numba():
     code = ("import sys; from lagsym import lagrange_surface, read_points, sample, plan_toolpath, macro_program, "
             "simulate, parse_program, LineSettings; "
@@ -75,6 +76,7 @@ def test_no_module_is_too_long():
     assert long == {}
 
 
+@pytest.mark.slow
 def test_no_function_is_too_long_without_a_reason():
     long = []
     for p in _modules():

@@ -160,6 +160,7 @@ def test_lagsym_reads_the_arcs_as_rs274_moves_them(rs274, tmp_path):
         assert len(pts) > 3
 
 
+@pytest.mark.slow
 def test_arcs_are_off_by_default_and_the_command_reports_the_blocks(tmp_path, run_cli):
     args = ("toolpath", EXAMPLES / "paper-example-2.json", "--scale", 10, "--stepover", 1.5, "--tolerance", TOL,
             "--safe-z", 100, "--dialect", "linuxcnc")

@@ -157,6 +157,7 @@ def test_equation_of_a_large_grid_is_estimated(run_cli, tmp_path):
     assert status == 0 and out.startswith("z = ")
 
 
+@pytest.mark.slow
 def test_sample_refuses_heights_whose_rounding_exceeds_the_data(run_cli, tmp_path):
     n = 60
     p = tmp_path / "g.json"

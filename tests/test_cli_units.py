@@ -40,6 +40,7 @@ def test_a_unit_given_with_the_number_wins(run_cli, tmp_path):
     assert named == plain
 
 
+@pytest.mark.slow
 def test_a_millimetre_program_is_as_before(run_cli, tmp_path):
     plain = program(run_cli, tmp_path, "a.nc", "--safe-z", "80", "--feed", "600")
     named = program(run_cli, tmp_path, "b.nc", "--safe-z", "80mm", "--feed", "600mm/min")

@@ -293,6 +293,7 @@ def test_cli_errors_exit_2_with_one_line(run_cli, args, message):
     assert len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_cli_plot_writes_a_deviation_map(run_cli, tmp_path):
     from PIL import Image
 

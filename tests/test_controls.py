@@ -102,6 +102,7 @@ def test_a_bad_name_or_word_names_the_choices():
     ("G154 P5", "fanuc", False), ("G54.1 P48", "fanuc", True), ("G54.1 P49", "fanuc", False),
     ("G59.3", "linuxcnc", True), ("G59.1", "grbl", False),
 ])
+@pytest.mark.slow
 def test_each_control_reads_its_own_work_offsets(word, dialect, ok):
     s = MachineSettings(dialect=dialect, work_offset=word) if ok or re.fullmatch(
         "|".join(c.work_offsets for c in CONTROLS.values() if c.work_offsets), word) else None
@@ -150,6 +151,7 @@ def test_a_haas_point_list_is_read_by_rs274_and_moves_as_planned(rs274):
     assert [x for x in lines if x.startswith(moves)] == [x for x in fanuc.splitlines() if x.startswith(moves)]
 
 
+@pytest.mark.slow
 def test_a_haas_macro_runs_in_the_simulator_at_haas_precision_as_the_fanuc_macro_does(run_cli, tmp_path):
     points = str(EXAMPLES / "paper-example-4.json")
     common = ["--scale", "20", "--tool-diameter", "4", "--stepover", "4", "--step", "2", "--safe-z", "100"]

@@ -87,6 +87,7 @@ def test_bad_options_are_input_errors(run_cli, tmp_path):
     assert status == 2 and "BEL" in err
 
 
+@pytest.mark.slow
 def test_a_socket_that_vanishes_mid_transfer_gives_the_resume_block(run_cli, tmp_path):
     text = program_text(400)
     path = write(tmp_path, text)
@@ -231,6 +232,7 @@ def test_a_control_that_never_asks_for_the_program_stalls(line):
     assert sim.received == b""
 
 
+@pytest.mark.slow
 @needs_socat
 def test_progress_counts_only_what_has_left_the_line(line):
     baud = 38400
@@ -329,6 +331,7 @@ def test_a_control_that_drops_the_line_half_way_then_a_resume_completes_it(line,
     assert 2 <= _resume_and_check(line, run_cli, path, text, baud, sim.stop(), err, tmp_path) <= 300
 
 
+@pytest.mark.slow
 def test_a_cut_mid_block_loses_nothing(line, tmp_path):
     # A kernel pty pair: the control takes what is on its way and closes its end, and the sender sees
     # the hang-up at once.  (A relay process can hold characters for a long time on a loaded machine;
@@ -353,6 +356,7 @@ def test_a_cut_mid_block_loses_nothing(line, tmp_path):
         assert f"blocks {fault.last_left_block + 1} to {fault.last_sent_block} were on their way" in str(fault)
 
 
+@pytest.mark.slow
 @needs_socat
 def test_receive_a_program_punched_with_dc2_dc4(line, run_cli, tmp_path):
     baud = 19200

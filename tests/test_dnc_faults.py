@@ -66,6 +66,7 @@ def test_a_signal_stops_a_drip_feed_with_the_resume_block_and_exit_3(line, tmp_p
     assert err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_a_signal_stops_a_receive_with_exit_3_and_nothing_saved(tmp_path):
     with PtyPair() as pair:
         target = tmp_path / "got.nc"
@@ -99,6 +100,7 @@ def test_a_busy_port_is_one_line_and_exit_3(run_cli, tmp_path):
 # -- 2: a stall is a stall, not a lost cable ----------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_missing_dc1_and_a_silent_receive_are_not_called_lost_lines(line, run_cli, tmp_path):
     pair, sim = line(baud=38400)
     status, _, err = run_cli("send", write(tmp_path, PROGRAM), "--port", pair.near, "--wait-for-xon",
@@ -151,6 +153,7 @@ def test_a_drip_feed_over_rfc2217_hears_the_controls_xoff_and_xon(line):
         server.close()
 
 
+@pytest.mark.slow
 def test_receive_over_rfc2217(run_cli, tmp_path):
     with PtyPair() as pair:
         server = Rfc2217Server(pair.near)

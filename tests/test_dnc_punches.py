@@ -152,6 +152,7 @@ def test_a_punch_all_is_split_and_odd_numbers_are_saved_not_lost(tmp_path):
     assert not any("ONone" in line or "None.nc" in line for line in server.logs["p0"])
 
 
+@pytest.mark.slow
 def test_a_link_in_the_received_folder_is_never_written_through(tmp_path):
     outside = tmp_path / "outside"
     outside.mkdir()

@@ -75,6 +75,7 @@ def _no_rtprio():
 _WITHOUT_SYS_NICE = ["setpriv", "--bounding-set", "-sys_nice", "--inh-caps", "-sys_nice"] if os.geteuid() == 0 else []
 
 
+@pytest.mark.slow
 def test_a_refused_priority_is_one_line_exit_3_before_the_port_opens():
     with tempfile.TemporaryDirectory() as tmp:
         prog = Path(tmp) / "O1.nc"

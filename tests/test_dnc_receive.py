@@ -38,6 +38,7 @@ def wait_for_text(proc_err_fd, text, timeout=30.0):
     return seen
 
 
+@pytest.mark.slow
 def test_a_file_that_appears_while_receive_waits_is_never_replaced(tmp_path):
     target = tmp_path / "got.nc"
     text = program_text(30)
@@ -73,6 +74,7 @@ def _read_nothing_for(pid: int, seconds: float, timeout: float = 120.0) -> int:
     raise AssertionError("the receiver kept reading")
 
 
+@pytest.mark.slow
 def test_a_line_lost_mid_program_counts_the_bytes_that_arrived(tmp_path):
     data = b"\x12" + program_text(400).encode()
     with PtyPair() as pair:

@@ -49,6 +49,7 @@ def test_a_drip_feed_the_control_never_answered_is_exit_3(line, run_cli, tmp_pat
     assert len(sim.received) == 1500
 
 
+@pytest.mark.slow
 def test_no_handshake_expected_accepts_a_silent_control_and_says_nothing_is_confirmed(line, run_cli, tmp_path):
     baud = 38400
     pair, sim = line(baud=baud)

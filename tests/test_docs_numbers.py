@@ -153,6 +153,7 @@ def test_notebook_1_overshoot_sentence_matches_its_table():
     assert "drops from degree 4 to 6 and from 8 to 10" in text
 
 
+@pytest.mark.slow
 def test_macros_page_quotes_what_macro_stats_prints(tmp_path, monkeypatch, run_cli):
     text = (DOCS / "macros.md").read_text()
     block = text.split("$ lagsym macro examples/paper-example-4.json", 1)[1].split("```", 1)[0]

@@ -86,6 +86,7 @@ PRELUDE = ("import sys, numpy as np; from lagsym import lagrange_surface, read_p
            "loaded = lambda: 'numba' in sys.modules; ")
 
 
+@pytest.mark.slow
 def test_one_large_grid_runs_in_numpy_and_the_kernels_load_once_they_pay():
     out = _run(PRELUDE + (
         "engine.PROCESS_ENGINE.load_seconds = 0.2; first = sample(s, 600, 600).z; print(loaded()); calls = 1\n"
@@ -97,6 +98,7 @@ def test_one_large_grid_runs_in_numpy_and_the_kernels_load_once_they_pay():
     assert out == ["False", "True", "True", "True", "True"]
 
 
+@pytest.mark.slow
 def test_loading_the_kernels_first_runs_every_large_batch_compiled():
     out = _run(PRELUDE + (
         "from lagsym.evaluate import load_compiled, evaluate_points; load_compiled(); print(loaded())\n"
@@ -124,6 +126,7 @@ def test_writing_one_large_sample_does_not_load_the_kernels(tmp_path):
     assert z.shape == (490_000, 3)
 
 
+@pytest.mark.slow
 def test_an_engine_turned_off_never_loads_the_kernels_and_gives_the_same_bits():
     """``Engine("numpy")``, given or scoped with use_engine: however long large batches take, no kernel loads."""
     out = _run(PRELUDE + (

@@ -167,6 +167,7 @@ def write_points(path, points):
                                         ((float(a), float(b), float(c)) for a, b, c in points)))
 
 
+@pytest.mark.slow
 def test_cli_fit_writes_a_surface_file_every_command_reads(run_cli, tmp_path):
     src, surf = tmp_path / "probe.csv", tmp_path / "surface.json"
     points = noisy_grid()
@@ -246,6 +247,7 @@ def _disc_top(coefficients, cx, cy, radius, n=61):
                   - radius).max())
 
 
+@pytest.mark.slow
 def test_the_fitted_surface_machines_without_gouge_and_its_macro_runs_in_rs274(run_cli, tmp_path, rs274):
     from gcheck import interpret
 

@@ -107,6 +107,7 @@ def test_equal_grids_compare_equal_whatever_their_source():
 _rational = st.fractions(min_value=-1000, max_value=1000, max_denominator=1000)
 
 
+@pytest.mark.slow
 @given(st.lists(_rational, min_size=2, max_size=6, unique=True),
        st.lists(_rational, min_size=2, max_size=6, unique=True), st.data())
 def test_any_order_of_a_full_grid_gives_the_same_grid(xs, ys, data):

@@ -93,6 +93,7 @@ def test_commands_refuse_the_noisy_12x12_interpolant_in_one_line(run_cli, tmp_pa
     assert not out_file.exists()
 
 
+@pytest.mark.slow
 def test_job_refuses_and_accepts_with_the_header_note(run_cli, tmp_path, noisy):
     job = tmp_path / "job.toml"
     job.write_text(f'points = "{noisy.name}"\nscale = 1\n[stock]\ntop_above = 2\n'
@@ -105,6 +106,7 @@ def test_job_refuses_and_accepts_with_the_header_note(run_cli, tmp_path, noisy):
     assert "(CONDITIONING 2623X ABOVE 100 ACCEPTED --ACCEPT-CONDITIONING)" in (tmp_path / "j.nc").read_text()
 
 
+@pytest.mark.slow
 def test_the_override_is_recorded_in_the_program_header(run_cli, tmp_path, noisy):
     prog = tmp_path / "p.nc"
     status, _, err = run_cli("toolpath", noisy, "-o", prog, "--accept-conditioning", "--stepover", "10", "--step", "5")

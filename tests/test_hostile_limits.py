@@ -82,6 +82,7 @@ def big60(tmp_path_factory):
     return csv, js, count
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["csv", "json"])
 @pytest.mark.parametrize("command", [["equation"], ["check"], ["fit", "-o", "OUT"], ["piecewise", "-o", "OUT"],
                                      ["curve"], ["toolpath"]])
@@ -117,6 +118,7 @@ def test_the_option_and_the_context_raise_the_limit(tmp_path):
         assert len(read_scattered_points(path).points) == 9
 
 
+@pytest.mark.slow
 def test_a_fit_of_fifty_thousand_scattered_points_is_read(tmp_path):
     rng = random.Random(1)
     path = tmp_path / "scan.csv"

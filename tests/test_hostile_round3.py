@@ -49,6 +49,7 @@ def _job(tmp_path, finish: str = "stepover = 0.5\nstep = 0.2\n", rough_leave: st
                                                        "(scallop 0.01 mm), not both"),
     ("scallop = 0.000001\nstep = 0.2\n", "operations[1].scallop = 1e-06 is out of range: give a number above 1e-06"),
 ])
+@pytest.mark.slow
 def test_a_job_refuses_a_scallop_it_would_have_ignored_or_the_command_line_refuses(tmp_path, run_cli, finish, words):
     """Both a side step and a scallop height: the scallop was ignored in silence; 1e-6 passed in a job file while
     --scallop refuses it."""

@@ -167,6 +167,7 @@ def test_a_note_naming_a_file_with_a_newline_is_one_line(run_cli, tmp_path, comm
     assert "colon.csv" not in err.replace("semi\\ncolon.csv", ""), err  # no line starts inside the name
 
 
+@pytest.mark.slow
 def test_summaries_naming_a_file_with_a_newline_are_one_line(run_cli, tmp_path):
     prog = tmp_path / "p\nq.nc"
     prog.write_text(PROGRAM)

@@ -268,6 +268,7 @@ def _sideways_after_changes(calls, safe_z: float):
     return changes
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["job", "rough", "rough --macro"])
 def test_after_every_tool_change_the_length_offset_and_safe_z_come_before_any_sideways_move(
         kind, rs274, tmp_path, run_cli):

@@ -137,6 +137,7 @@ def test_surface_passes_through_every_control_point(data):
             assert s.exact_value(xi, yk) == z[i][k]
 
 
+@pytest.mark.slow
 @given(grids(), st.data())
 def test_surface_reproduces_polynomials_of_low_enough_degree(data, draw):
     xs, ys, _ = data
@@ -159,6 +160,7 @@ def test_basis_sums_to_one_and_is_cardinal(nodes):
             assert p.eval(sympy.Rational(t.numerator, t.denominator)) == (1 if i == j else 0)
 
 
+@pytest.mark.slow
 @given(grids(), st.randoms(use_true_random=False))
 def test_shuffling_or_reversing_the_input_changes_nothing(data, rnd):
     xs, ys, z = data

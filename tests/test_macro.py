@@ -194,6 +194,7 @@ def test_a_constant_the_control_cannot_read_is_refused():
 
 # ---------------------------------------------------------------- size
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc"])
 @pytest.mark.parametrize("n", [3, 5, 7])
 def test_macro_stays_under_4kb_up_to_7x7_at_any_step(dialect, n):
@@ -295,6 +296,7 @@ def _depth(line: str) -> int:
     return best
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("form", ["horner", "lagrange"])
 def test_fanuc_program_follows_macro_b_rules(form):
     program = macro_program(rough_grid(7, seed=1), machine(dialect="fanuc", program_number=42),
@@ -429,6 +431,7 @@ def test_cli_macro_refuses_with_exit_2(run_cli, tmp_path):
 BALL = Tool("ball", 4.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("direction", ["x", "y"])
 def test_ball_end_macro_through_rs274_equals_the_pc_offset(rs274, tmp_path, direction):
     s = surface("paper-example-4")
@@ -691,6 +694,7 @@ def test_comments_are_iso_840_without_commas():
             assert re.fullmatch(r"[A-Z0-9 .+\-/]*", comment), comment
 
 
+@pytest.mark.slow
 def test_the_small_variable_profile_refuses_what_does_not_fit():
     s = surface("paper-example-4")
     ok = macro_program(s, machine(mm_per_unit=20.0), RasterSpec("x", 5.0, 5.0), FLAT, variables="small")

@@ -45,6 +45,7 @@ def reference_surface(grid) -> HermiteSurface:
     return HermiteSurface("reference", HermiteBasis(tuple(x)), HermiteBasis(tuple(y)), z, zx, zy, zxy)
 
 
+@pytest.mark.slow
 def test_continuity_is_exact_across_every_border():
     s = piecewise_surface(wavy_grid(7, 6))
     assert s.continuity == CONTINUITY == "C1"
@@ -235,6 +236,7 @@ def test_cad_file_read_back_by_opencascade(tmp_path, suffix):
     assert np.abs(got[:, :, 2] - want).max() <= 1e-12 * float(hi - lo)
 
 
+@pytest.mark.slow
 def test_command_line(tmp_path):
     from lagsym.cli import main
 

@@ -190,6 +190,7 @@ def test_curve_basis_figure(curve3):
     check_reference(img, "curve_basis")
 
 
+@pytest.mark.slow
 def test_basis_figure(surface2):
     img = render(plot.basis_figure(surface2, samples=15, window_size=WIDE))
     check_picture(img, WIDE, 0.08)
@@ -267,6 +268,7 @@ def _warmth(img: np.ndarray, box) -> float:
     return float((px[:, 0] - px[:, 2]).mean()) if len(px) else 0.0
 
 
+@pytest.mark.slow
 def test_one_sign_for_deviations(surface4):
     """Both deviation pictures draw d = z_f - z_a: Hermite lies above the reference (blue), Bezier below (red)."""
     x, y, surfaces = comparison(surface4)
@@ -425,6 +427,7 @@ def test_rendering_backend_is_known():
         plot.rendering_backend() == os.environ.get("VTK_DEFAULT_OPENGL_WINDOW")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux", reason="Xvfb is the Linux fallback")
 def test_xvfb_fallback_renders():
     """The last resort where neither EGL nor OSMesa works: a private Xvfb server, gone with its process."""
@@ -598,6 +601,7 @@ def test_cli_writes_pictures(run_cli, tmp_path, file, show):
     assert ink(np.asarray(Image.open(out).convert("RGB"))) > 0.01
 
 
+@pytest.mark.slow
 def test_cli_draws_a_program_over_the_surface(run_cli, tmp_path):
     program = tmp_path / "rough.nc"
     status, _, err = run_cli("toolpath", EXAMPLES / "paper-example-4.json", "--scale", "20", "--tool-diameter", "6",
@@ -686,6 +690,7 @@ def _slot_part():
                         (-2.0, 12.0, 0.0, 10.0, 5.0), cell_mm=0.1)
 
 
+@pytest.mark.slow
 def test_machined_figure_draws_each_stage_coloured_by_material_left():
     part = _slot_part()
     img = render(plot.machined_figure(part, window_size=WIDE, off_screen=True))

@@ -39,6 +39,7 @@ def program_text(tp, **kw):
     return write_program(point_program(tp, s, title="Paper example 4")), s
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dialect", POINT_DIALECTS)
 @pytest.mark.parametrize("units", ["mm", "inch"])
 @pytest.mark.parametrize("line_ending", ["lf", "crlf"])
@@ -193,6 +194,7 @@ def test_the_header_says_the_surface_units():
     assert "(SURFACE IN INCH 25.4 MM PER UNIT PROGRAM IN INCH)" in write_program(p)
 
 
+@pytest.mark.slow
 def test_cli_inch_surface_is_programmed_at_25_4_mm_a_unit(rs274, run_cli, tmp_path):
     import json
 

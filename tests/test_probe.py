@@ -358,6 +358,7 @@ def test_the_probing_page_quotes_the_lebesgue_constants():
         assert f"| {n} | {cheb:.3g} | {even:.3g} |" in doc
 
 
+@pytest.mark.slow
 def test_the_probing_page_quotes_the_fits_amplification(tmp_path):
     """The page's example probed at 9 x 9 Chebyshev and even nodes and fitted with degree 6."""
     line = _page_commands()[1]

@@ -38,6 +38,7 @@ def _receive(pair, target, *extra):
                             stderr=subprocess.PIPE)
 
 
+@pytest.mark.slow
 def test_dprnt_output_received_as_probe_results_then_fitted(tmp_path):
     lines = _printed()
     target = tmp_path / "results.txt"

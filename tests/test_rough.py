@@ -192,6 +192,7 @@ def test_every_roughing_position_is_above_the_flat_drop_cutter_height(rs274, pro
     assert (p[:, 2] - cl).min() >= STOCK - 0.002
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dialect", ["fanuc", "linuxcnc", "grbl"])
 @pytest.mark.parametrize("milling", ["zigzag", "climb"])
 def test_every_dialect_passes_rs274(rs274, run_cli, tmp_path, dialect, milling):
@@ -204,6 +205,7 @@ def test_every_dialect_passes_rs274(rs274, run_cli, tmp_path, dialect, milling):
     assert min(m[3] for m in mv if m[0] == "F") >= 3.0
 
 
+@pytest.mark.slow
 def test_climb_rows_keep_the_material_on_the_right(rs274, run_cli, tmp_path):
     """One-way climb rows along x, advancing in +y on the first level: every cutting row runs in -x."""
     out = tmp_path / "r.ngc"
@@ -227,6 +229,7 @@ def test_climb_rows_keep_the_material_on_the_right(rs274, run_cli, tmp_path):
     (("--stock-above", "2", "--pattern", "offset", "--milling", "zigzag"), "cuts every rectangle one way"),
     (("--stock-above", "2", "--pattern", "offset", "--macro"), "a roughing macro runs raster rows"),
 ])
+@pytest.mark.slow
 def test_bad_roughing_requests_get_one_line_and_exit_2(run_cli, args, words):
     status, out, err = run_cli("rough", EX4, "--scale", "20", "--safe-z", "90", *args)
     assert status == 2 and words in err and err.count("\n") == 1 and not out, err

@@ -157,6 +157,7 @@ def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274, extra):
     (["--macro", "--plunge-angle", "10"], "ramp angle of 10 degrees"),
     (["--plunge-angle", "0.5", "--max-points", "110000"], "with its ramps at 0.5 degrees is"),
 ])
+@pytest.mark.slow
 def test_a_tool_that_may_not_plunge_is_refused_where_it_would(run_cli, tmp_path, extra, words):
     out = tmp_path / "r.nc"
     status, _, err = run_cli(*README, *extra, "-o", out)
@@ -195,6 +196,7 @@ step = 1
     ("plunge_angle = 0", 2, "tools.rougher.plunge_angle = 0"),
     ("centre_cutting = false\nplunge_angle = 90", 2, "cannot make"),
 ])
+@pytest.mark.slow
 def test_the_job_file_gives_the_tool_its_ramp(run_cli, tmp_path, extra, status, words):
     job = tmp_path / "j.toml"
     job.write_text(JOB.format(points=EX4.as_posix(), extra=extra))

@@ -150,6 +150,7 @@ def test_the_chebyshev_change_of_basis_is_the_solved_one(nodes):
     assert chebyshev_transform(nodes)[2] == _chebyshev_by_solving(nodes)
 
 
+@pytest.mark.slow
 def test_the_change_of_basis_of_100_decimal_nodes_takes_no_minute():
     # 100 nodes with four decimals: over a minute by a general exact solve (and 'check' or 'sample'
     # on a 100 x 100 grid of such nodes over two minutes); the closed form takes under a second.
@@ -312,6 +313,7 @@ def test_sigterm_acts_within_seconds_during_the_exact_products(tmp_path):
     assert waited < 3.0, f"SIGTERM acted after {waited:.1f} s"
 
 
+@pytest.mark.slow
 def test_a_tolerance_finer_than_the_written_positions_is_refused_at_once(tmp_path, run_cli):
     """A job's ``tolerance = 0.000001`` planned for minutes inside the workers (8.8 million samples, under the
     point limit); it cannot be held at 3 decimals anyway.  Every strategy refuses it in one line naming the figures,
@@ -366,6 +368,7 @@ def test_an_exact_computation_foreseen_past_the_time_limit_is_refused_a_few_seco
     assert not (tmp_path / "s.csv").exists()
 
 
+@pytest.mark.slow
 def test_the_time_limit_is_the_callers_in_python():
     grid = _exact_grid(_decimal_grid(70, 4))
     with exact_time_limit(1.0), pytest.raises(LagsymError, match=r"70 x 70 nodes would take about .* limit of 1 s"):
@@ -379,6 +382,7 @@ def _exact_grid(rows):
     return grid_from_points([tuple(Fraction(v) for v in row) for row in rows])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["compare", "simulate"])
 def test_compare_and_simulate_take_the_time_limit_too(tmp_path, run_cli, command):
     """Both build the exact surface from a points file; the limit they are refused by is one they take."""

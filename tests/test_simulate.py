@@ -197,6 +197,7 @@ def _expressions():
     return st.recursive(leaf | var, extend, max_leaves=6)
 
 
+@pytest.mark.slow
 @settings(max_examples=15, deadline=None)
 @given(st.lists(_expressions(), min_size=1, max_size=8))
 def test_simulator_agrees_with_rs274(rs274, tmp_path_factory, exprs):
@@ -356,6 +357,7 @@ def test_moves_are_kept_as_columns():
     assert held == BYTES_PER_MOVE * 4
 
 
+@pytest.mark.slow
 def test_the_readme_ball_macro_runs_under_the_default_limit(run_cli, tmp_path):
     """The README's Example 4 ball macro: 2525622 blocks at 8 digits, under the 5e6 default (docs/macros.md)."""
     from conftest import EXAMPLES

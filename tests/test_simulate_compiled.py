@@ -106,6 +106,7 @@ def test_fanuc_compiled_code_matches_the_closures(statements, precision):
     assert compiled(text, "fanuc", precision) == interpreted(text, "fanuc", precision), text
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None)
 @given(st.lists(st.tuples(st.sampled_from(["#<a>", "#<b>", "#5", "#[#<a>]"]),
                           _expressions(["#<a>", "#<b>", "#<c>", "#5", "#[#5+1]"])), min_size=1, max_size=6))

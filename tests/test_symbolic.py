@@ -25,6 +25,7 @@ def example1():
     return lagrange_surface(read_points(EXAMPLES / "paper-example-1.json"))
 
 
+@pytest.mark.slow
 def test_the_symbols_a_user_types_work_everywhere():
     expr = example1().expr
     assert expr == x**2 + 3 * y

@@ -140,6 +140,7 @@ def test_verify_command_exit_statuses(run_cli, tmp_path, ex2_program):
     assert status == 2 and "missing.nc" in err
 
 
+@pytest.mark.slow
 def test_toolpath_command_writes_a_program_the_interpreter_accepts(run_cli, tmp_path, rs274):
     from gcheck import interpret
 

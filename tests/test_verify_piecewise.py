@@ -73,6 +73,7 @@ def brute(ref, a, b, centre, half, step=0.01):
     return dict(gouge=max(0.0, -float(above.min())), left_height=float(above.max()), left_normal=float(normal.max()))
 
 
+@pytest.mark.slow
 def test_the_reference_is_the_pieces(ref, plan):
     """The test's own pieces agree with lagsym's exact ones, on and off the borders."""
     surface, _ = plan
@@ -142,6 +143,7 @@ def test_a_point_a_hundredth_deeper_is_caught(ref, plan):
     assert np.hypot(report.gouge_at[0] - p[k, 0], report.gouge_at[1] - p[k, 1]) < RADIUS
 
 
+@pytest.mark.slow
 def test_command_line_verifies_a_piecewise_file(tmp_path, plan):
     from lagsym.cli import main
 
