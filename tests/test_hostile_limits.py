@@ -118,6 +118,34 @@ def test_the_option_and_the_context_raise_the_limit(tmp_path):
         assert len(read_scattered_points(path).points) == 9
 
 
+@pytest.mark.parametrize("command", ["read-probe", "fit"])
+def test_probe_results_whose_header_states_more_nodes_than_the_limit_are_refused_at_once(tmp_path, command):
+    """The header's node count was trusted: 'N 999999999999' made a list of every node it named as missing."""
+    path = tmp_path / "results.txt"
+    path.write_text("LAGSYM PROBE MM N 999999999999 R 1.0\nP 1 X 1.0 Y 1.0 Z 1.0 OK\nEND\n")
+    done = _lagsym(command, str(path), timeout=30)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert (f"results.txt: line 1: 999,999,999,999 points stated, more than the limit of {MAX_FILE_POINTS:,} points"
+            in done.stderr and "--max-file-points" in done.stderr), done.stderr
+
+
+def test_probe_results_are_counted_against_the_limit_and_their_missing_nodes_counted_not_listed(tmp_path):
+    from lagsym.probe import read_results
+
+    lines = "LAGSYM PROBE MM N 3 R 1.0\n" + "".join(f"P {n} X {n}.0 Y 1.0 Z 1.0 OK\n" for n in (1, 2, 3)) + "END\n"
+    with file_points_limit(2), pytest.raises(Exception, match="about 5 points, more than the limit of 2 points"):
+        read_results(lines, "r.txt")
+    with file_points_limit(4), pytest.raises(Exception, match="r.txt: line 1: 10 points stated, more than the limit"):
+        read_results("LAGSYM PROBE MM N 10 R 1.0\nP 1 X 1.0 Y 1.0 Z 1.0 OK\nEND\n", "r.txt")
+    assert len(read_results(lines, "r.txt").points) == 3
+    path = tmp_path / "r.txt"
+    path.write_text("LAGSYM PROBE MM N 5000000 R 1.0\nP 1 X 1.0 Y 1.0 Z 1.0 OK\nEND\n")
+    rc, out, err = _run("read-probe", str(path), "--max-file-points", "10000000")
+    _refused(rc, err, "r.txt: node 2 and 4,999,998 more of 5,000,000 missing", "node 2")
+    rc, out, err = _run("read-probe", str(path))
+    _refused(rc, err, "r.txt: line 1: 5,000,000 points stated, more than the limit of 1,000,000", "--max-file-points")
+
+
 @pytest.mark.slow
 def test_a_fit_of_fifty_thousand_scattered_points_is_read(tmp_path):
     rng = random.Random(1)

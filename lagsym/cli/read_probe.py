@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..io import read_text
 from ..probe import points_json, read_results, surface_points
-from ._common import emit
+from ._common import add_file_points_limit, emit
 
 DESCRIPTION = """Read the text a 'lagsym probe' program sent back -- Fanuc/Haas DPRNT
 output received over the serial line, or LinuxCNC's log file -- check that
@@ -34,6 +34,7 @@ def add_arguments(p) -> None:
     p.add_argument("--degree", default="auto", metavar="P[xQ]",
                    help="the degree of the fit whose normals take the tip radius off (default auto)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the points file here instead of standard output")
+    add_file_points_limit(p)
 
 
 def run(args, out, err) -> int:

@@ -158,11 +158,17 @@ def estimate_points(text: str) -> int:
     return text.count("\n") or text.count("\r") or 1
 
 
-def check_point_count(name: str, text: str) -> None:
-    """Refuse the points file ``name`` when :func:`estimate_points` says it holds more than the limit in force."""
+def check_point_count(name: str, text: str, *, stated: int | None = None) -> None:
+    """Refuse the points file ``name`` when :func:`estimate_points` says it holds more than the limit in force.
+
+    ``stated`` is a count the file states of itself (a probing program's
+    header), refused the same way before anything is made for it.
+    """
     limit = _POINTS_LIMIT.get()
-    if limit is not None and (count := estimate_points(text)) > limit:
-        raise InputError(f"{name}: about {count:,} points, more than the limit of {limit:,} points in one file "
+    count = estimate_points(text) if stated is None else stated
+    if limit is not None and count > limit:
+        said = f"{count:,} points stated" if stated is not None else f"about {count:,} points"
+        raise InputError(f"{name}: {said}, more than the limit of {limit:,} points in one file "
                          f"(reading them would take minutes and gigabytes); thin the points, or raise the limit "
                          f"(--max-file-points, file_points_limit() in Python)")
 

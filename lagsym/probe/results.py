@@ -37,6 +37,7 @@ from fractions import Fraction
 
 from ..errors import InputError
 from ..gcode.numbers import fixed
+from ..io.files import check_point_count
 from ..values import exact_number
 
 __all__ = ["ProbeResults", "read_results", "is_probe_results", "surface_points", "SurfacePoints", "points_json"]
@@ -78,6 +79,7 @@ def read_results(text: str, source: str = "<results>") -> ProbeResults:
     >>> r.points, r.tip_radius
     (((Fraction(2, 1), Fraction(3, 1), Fraction(-3, 2)),), Fraction(1, 1))
     """
+    check_point_count(source, text)  # a node a line
     clean = text.translate({ord(ch): None for ch in _IGNORED})
     lines = clean.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     header, count, radius, units = None, 0, Fraction(0), "mm"
@@ -93,6 +95,7 @@ def read_results(text: str, source: str = "<results>") -> ProbeResults:
                 header, count, radius, units = lineno, int(m.group(2)), _number(m.group(3)), m.group(1).lower()
                 if count < 1:
                     raise InputError(f"{source}: line {lineno}: a header of {count} nodes")
+                check_point_count(f"{source}: line {lineno}", text, stated=count)
             continue
         where = f"{source}: line {lineno}"
         if ended:
@@ -115,14 +118,15 @@ def read_results(text: str, source: str = "<results>") -> ProbeResults:
         last = n
     if header is None:
         raise InputError(f"{source}: no 'LAGSYM PROBE' header line: not the output of a lagsym probing program")
-    missing = [n for n in range(1, count + 1) if n not in found]
+    missing = count - len(found)  # every node found is one of the header's
+    first = next((n for n in range(1, count + 1) if n not in found), None) if missing else None
     if not ended:
-        nxt = f"; node {missing[0]} and after never came" if missing else ""
+        nxt = f"; node {first} and after never came" if missing else ""
         raise InputError(f"{source}: the results stop after node {last} without END (the control stopped with an "
                          f"alarm, or the line was cut){nxt}")
     if missing:
-        more = f" and {len(missing) - 1} more" if len(missing) > 1 else ""
-        raise InputError(f"{source}: node {missing[0]}{more} of {count} missing")
+        more = f" and {missing - 1:,} more" if missing > 1 else ""
+        raise InputError(f"{source}: node {first}{more} of {count:,} missing")
     return ProbeResults(points=tuple(found[n] for n in range(1, count + 1)), tip_radius=radius, units=units,
                         source=source, sha256=hashlib.sha256(text.encode("utf-8", "surrogateescape")).hexdigest())
 
