@@ -127,6 +127,12 @@ def test_a_port_that_fails_does_not_stop_the_others(tmp_path):
     (lambda c: c.replace("baud = 19200", 'baud = 19200\nrealtime = "yes"'), "port[0].line: realtime 'yes' must be true"),
     (lambda c: c.replace('profile = "haas"', 'profile = "mazak"'), "port[1].profile"),
     (lambda c: c + "\n[extra]\n", "extra: unknown key"),
+    (lambda c: c.replace('"dnc/lathe2.log"', '"dnc/mill1.log"'), "dnc/mill1.log is also port 'mill1''s log"),
+    (lambda c: c.replace('"dnc/mill1.log"', '"dnc.toml"'), "dnc.toml is this configuration file"),
+    (lambda c: c.replace('"dnc/mill1.log"', '"dnc/programs/O1234"'), "is named as a program in port 'mill1''s programs"),
+    (lambda c: c.replace('"dnc/lathe2.log"', '"dnc/received/mill1/3002.received-2.nc"'),
+     "is named as a program in port 'mill1''s received folder"),
+    (lambda c: c.replace('"dnc/mill1.log"', '"/dev/ttyUSB1"'), "is port 'lathe2''s device"),
 ])
 def test_a_bad_config_is_one_line_naming_the_key(run_cli, tmp_path, edit, words):
     (tmp_path / "dnc" / "programs").mkdir(parents=True)
