@@ -30,6 +30,9 @@ __all__ = ["FrozenMap", "frozen", "as_exact", "exact_number", "finite", "positiv
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
 _DECIMAL = re.compile(r"^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$")
+_PLAIN = re.compile(r"\s*([+-]?)(\d*)(?:\.(\d*))?\s*")  # a decimal without exponent: most numbers of a file
+_PLAIN_DIGITS = 100  # the plain path's digits, well within MAX_EXPONENT: longer numbers take the checked path
+_TENS = tuple(10**k for k in range(_PLAIN_DIGITS + 1))
 
 
 class NotANumber(InputError):
@@ -54,6 +57,13 @@ def exact_number(text: str) -> Fraction:
     >>> exact_number("1.06"), exact_number("-1/3"), exact_number("2e3")
     (Fraction(53, 50), Fraction(-1, 3), Fraction(2000, 1))
     """
+    m = _PLAIN.fullmatch(text)
+    if m and text.isascii():
+        sign, whole, fraction = m.groups()
+        digits = whole + (fraction or "")
+        if digits and len(digits) <= _PLAIN_DIGITS:
+            n = int(digits)
+            return Fraction(-n if sign == "-" else n, _TENS[len(fraction or "")])
     m = _RATIONAL.match(text)
     if m and text.isascii():
         num, den = m.groups()

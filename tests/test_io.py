@@ -6,6 +6,8 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from lagsym import GridError, InputError, read_any_points, read_curve_points, read_points
 from lagsym.grid import ControlGrid, CurvePoints
@@ -144,3 +146,20 @@ def test_written_files_get_the_usual_permissions(tmp_path):
     finally:
         os.umask(mask)
     assert (tmp_path / "o.txt").stat().st_mode & 0o777 == 0o644
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.from_regex(r"[ \t]?[+-]?[0-9]{0,30}(\.[0-9]{0,30})?[ \t]?", fullmatch=True))
+def test_a_plain_decimal_reads_as_the_decimal_module_reads_it(text):
+    """The short path for decimals without exponent gives the value Decimal gives, and refuses what it refuses."""
+    from decimal import Decimal, InvalidOperation
+
+    from lagsym.values import NotANumber, exact_number
+
+    try:
+        expected = Fraction(Decimal(text.strip()))
+    except InvalidOperation:
+        with pytest.raises(NotANumber):
+            exact_number(text)
+        return
+    assert exact_number(text) == expected
