@@ -80,8 +80,9 @@ class ExactClock:
         foreseen = time.perf_counter() - self.started + rest
         if foreseen > self.limit:
             where = f"{self.source}: " if self.source else ""
-            raise InputError(f"{where}the exact {self.what} would take about {_seconds(foreseen, self.limit)} s here (foreseen from "
-                             f"its first {done} of {total} rows), more than the limit of {self.limit:g} s; use fewer "
+            raise InputError(f"{where}the exact {self.what} would take about {_seconds(foreseen, self.limit)} s here "
+                             f"(foreseen from its first {done} of {total} rows), more than the limit of "
+                             f"{self.limit:g} s; use fewer "
                              f"points (a large grid: 'lagsym piecewise') or raise the limit (--max-exact-s, "
                              f"exact_time_limit() in Python)")
 

@@ -6,6 +6,7 @@ valid, a bad value with the key that holds it, in one line.
 
 from __future__ import annotations
 
+import os
 import re
 import tomllib
 from dataclasses import dataclass, fields, replace
@@ -159,7 +160,7 @@ def load_config(path: str | Path) -> ServerConfig:
         dup = next((v for v in seen if seen.count(v) > 1), None)
         if dup is not None:
             raise _bad(source, f"port.{key}", f"{dup!r} is given twice")
-    _check_logs(source, Path(path).resolve(), ports)
+    _check_logs(source, _real(Path(path)), ports)
     return ServerConfig(ports, source)
 
 
@@ -168,21 +169,29 @@ def load_config(path: str | Path) -> ServerConfig:
 _PROGRAM_NAME = re.compile(r"O?\d+(\.nc|\.txt)?|(\d+|unnumbered)(\.received-\d+)?\.nc")
 
 
+def _real(path: Path) -> Path:
+    """``path`` with its links followed where they can be (a loop of links stays as written)."""
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError):
+        return Path(os.path.abspath(path))
+
+
 def _check_logs(source: str, config: Path, ports: tuple[PortConfig, ...]) -> None:
     """Each port's log is a file of its own: not the configuration, a device, another port's log, or a file named as
     a program in a folder of programs (the server appends to it as it runs)."""
     owner: dict[Path, str] = {}
     for index, port in enumerate(ports):
-        where, log = f"port[{index}].log", port.log.resolve()
+        where, log = f"port[{index}].log", _real(port.log)
         if log == config:
             raise _bad(source, where, f"{port.log} is this configuration file")
         if log in owner:
             raise _bad(source, where, f"{port.log} is also port {owner[log]!r}'s log: give each port its own")
         for other in ports:
-            if log == Path(other.device).resolve():
+            if log == _real(Path(other.device)):
                 raise _bad(source, where, f"{port.log} is port {other.name!r}'s device")
             for kind in ("programs", "received"):
-                if log.parent == getattr(other, kind).resolve() and _PROGRAM_NAME.fullmatch(log.name):
+                if log.parent == _real(getattr(other, kind)) and _PROGRAM_NAME.fullmatch(log.name):
                     raise _bad(source, where, f"{port.log} is named as a program in port {other.name!r}'s {kind} "
                                               f"folder: the server would serve it or save a punch there")
         owner[log] = port.name
