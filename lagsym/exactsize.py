@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import inspect
+import math
 import time
 from fractions import Fraction
 from math import gcd, log2
@@ -88,12 +89,8 @@ class ExactClock:
 
 
 def _seconds(foreseen: float, limit: float) -> str:
-    """``foreseen`` in whole seconds, or with as many decimals as it takes to read as more than ``limit``."""
-    for decimals in range(4):
-        text = f"{foreseen:.{decimals}f}"
-        if float(text) > limit:
-            return text
-    return text
+    """``foreseen`` in whole seconds, rounded up where rounding would read as no more than ``limit``."""
+    return str(round(foreseen) if round(foreseen) > limit else math.ceil(foreseen))
 
 
 def _basis_bits(nodes: tuple[Fraction, ...]) -> float:

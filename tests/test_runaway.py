@@ -361,14 +361,27 @@ def test_an_exact_computation_foreseen_past_the_time_limit_is_refused_a_few_seco
                        timeout=120)
     waited = time.monotonic() - started
     assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-    m = re.search(r"g100.csv: the exact surface through 100 x 100 nodes would take about ([\d.]+) s here .* more than "
+    m = re.search(r"g100.csv: the exact surface through 100 x 100 nodes would take about (\d+) s here .* more than "
                   r"the limit of 15 s; .*--max-exact-s", r.stderr)
-    assert m and float(m[1]) > MAX_EXACT_S, r.stderr  # a foreseen 15.3 s reads "15.3", not "15"
+    assert m and int(m[1]) > MAX_EXACT_S, r.stderr  # a foreseen 15.3 s reads "16", not "15"
     assert waited < MAX_EXACT_S, f"refused after {waited:.1f} s"
     assert not (tmp_path / "s.csv").exists()
 
 
 @pytest.mark.slow
+@pytest.mark.slow
+def test_the_bezier_form_for_cad_is_timed_like_the_polynomial():
+    """export's change to the Bezier form (two exact products as long as the polynomial's) ran outside the clock:
+    a 70 x 70 grid took 26 s there after its polynomial, under any --max-exact-s."""
+    from lagsym.cad.convert import bezier_patch
+
+    with exact_time_limit(None):
+        surface = lagrange_surface(_exact_grid(_decimal_grid(50, 3)))
+    with exact_time_limit(0.001), pytest.raises(LagsymError, match=r"the exact Bezier form of the surface through "
+                                                                   r"50 x 50 nodes would take about \d+ s"):
+        bezier_patch(surface)
+
+
 def test_the_time_limit_is_the_callers_in_python():
     grid = _exact_grid(_decimal_grid(70, 4))
     with exact_time_limit(1.0), pytest.raises(LagsymError, match=r"70 x 70 nodes would take about .* limit of 1 s"):

@@ -27,6 +27,7 @@ from math import comb
 import flint
 
 from ..errors import InputError
+from ..exactsize import ExactClock, stepped_product, to_fraction
 from ..lagrange import LagrangeSurface, lagrange_surface
 from .patch import BezierPatch, BSplinePatch
 
@@ -62,8 +63,7 @@ def _transform(degree: int, lo: Fraction, hi: Fraction) -> flint.fmpq_mat:
     return flint.fmpq_mat(r) * flint.fmpq_mat(s)
 
 
-def _frac(v: flint.fmpq) -> Fraction:
-    return Fraction(int(v.p), int(v.q))
+_frac = to_fraction  # FLINT keeps its rationals in lowest terms: no gcd is sought again
 
 
 def bezier_patch(surface: LagrangeSurface) -> BezierPatch:
@@ -79,10 +79,13 @@ def bezier_patch(surface: LagrangeSurface) -> BezierPatch:
     p, q = surface.degree
     x0, x1, y0, y1 = surface.grid.bounds
     c = flint.fmpq_mat([[_fmpq(v) for v in row] for row in surface.coefficients])
-    z = _transform(p, x0, x1) * c * _transform(q, y0, y1).transpose()
+    # Two products as long as the polynomial's own: timed with it, against the command's --max-exact-s.
+    clock = ExactClock(f"Bezier form of the surface through {p + 1} x {q + 1} nodes", surface.grid.source)
+    left = stepped_product(_transform(p, x0, x1), c, clock=clock, products_after=1)
+    z = stepped_product(left, _transform(q, y0, y1).transpose(), clock=clock).entries()
     xs = [x0 + (x1 - x0) * Fraction(i, p) for i in range(p + 1)]
     ys = [y0 + (y1 - y0) * Fraction(k, q) for k in range(q + 1)]
-    net = tuple(tuple((xs[i], ys[k], _frac(z[i, k])) for k in range(q + 1)) for i in range(p + 1))
+    net = tuple(tuple((xs[i], ys[k], _frac(z[i * (q + 1) + k])) for k in range(q + 1)) for i in range(p + 1))
     return BezierPatch(p, q, net, (x0, x1, y0, y1))
 
 
