@@ -302,3 +302,44 @@ def test_coefficients_longer_than_python_prints_are_written_read_and_printed(run
     num, den = json.loads(out)["coefficients"]["1,0"].split("/")
     assert status == 0 and Fraction(int(flint.fmpz(num)), int(flint.fmpz(den))) == c
     assert run_cli("check", surf)[0] == 0
+
+
+def _scores_one_qr_a_candidate(points, criterion, top):
+    """The scores computed the plain way: each candidate's own least-squares problem, factored on its own."""
+    xs, ys, zs = (np.array([float(p[i]) for p in points]) for i in range(3))
+    cheb = np.polynomial.chebyshev.chebvander
+    vx = cheb((2 * xs - (xs.min() + xs.max())) / (xs.max() - xs.min()), top[0])
+    vy = cheb((2 * ys - (ys.min() + ys.max())) / (ys.max() - ys.min()), top[1])
+    n, out = len(xs), {}
+    for p in range(top[0] + 1):
+        for q in range(top[1] + 1):
+            k = (p + 1) * (q + 1)
+            if k >= n:
+                continue
+            qm, rm = np.linalg.qr((vx[:, :p + 1, None] * vy[:, None, :q + 1]).reshape(n, k))
+            diag = np.abs(np.diag(rm))
+            if diag.min() <= 1e-10 * diag.max():
+                continue
+            res = zs - qm @ (qm.T @ zs)
+            h = np.einsum("ij,ij->i", qm, qm)
+            gcv = n * float(res @ res) / (n - k) ** 2
+            out[p, q] = gcv if criterion == "gcv" else float(np.mean((res / (1 - h)) ** 2))
+    return out
+
+
+@pytest.mark.parametrize("criterion", ["gcv", "loo"])
+@pytest.mark.parametrize("layout", ["scattered", "on four lines"])
+def test_the_scores_from_one_factorization_are_each_candidates_own(criterion, layout):
+    from lagsym.fit.select import scores
+
+    rng = np.random.default_rng(5)
+    n = 400
+    xs = rng.uniform(0, 10, n) if layout == "scattered" else rng.choice([0.0, 2.5, 7.0, 10.0], n)
+    ys = rng.uniform(0, 5, n)
+    zs = xs * xs * ys - 3 * ys**3 + xs + rng.normal(0, 0.01, n)
+    points = [(Fraction(float(x)), Fraction(float(y)), Fraction(float(z))) for x, y, z in zip(xs, ys, zs)]
+    got = dict(scores(points, None, criterion, (6, 5)))
+    want = _scores_one_qr_a_candidate(points, criterion, (6, 5))
+    assert got.keys() == want.keys()  # the same candidates scored, the same refused (on four lines: x degree 3 at most)
+    assert all(abs(got[c] - want[c]) <= 1e-9 * want[c] for c in want), max(abs(got[c] / want[c] - 1) for c in want)
+    assert layout == "scattered" or max(p for p, _ in want) == 3

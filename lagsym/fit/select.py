@@ -50,7 +50,14 @@ def _chebyshev(values, lo: float, hi: float, top: int):
 
 
 def scores(points, weights, criterion: str, max_degree: tuple[int, int]) -> list[tuple[tuple[int, int], float]]:
-    """Every candidate's score in floating point, in the Chebyshev basis of the box, lowest first."""
+    """Every candidate's score in floating point, in the Chebyshev basis of the box, lowest first.
+
+    One QR factorization of the largest candidate's basis, ``A = Q R``, serves
+    them all: a candidate's columns are ``Q R_S``, so its residual is the part
+    of the data outside ``Q`` (common to all) plus that of a small problem in
+    ``R_S``, and its own factors are ``Q U`` and ``T`` from ``R_S = U T``.  One
+    pass over the points instead of one a candidate.
+    """
     import numpy as np
 
     xs = np.array([float(p[0]) for p in points])
@@ -60,24 +67,29 @@ def scores(points, weights, criterion: str, max_degree: tuple[int, int]) -> list
     sw = np.sqrt(w)
     vx = _chebyshev(xs, xs.min(), xs.max(), max_degree[0])
     vy = _chebyshev(ys, ys.min(), ys.max(), max_degree[1])
-    n = len(xs)
+    n, width = len(xs), max_degree[1] + 1
+    q_all, r_all = np.linalg.qr((vx[:, :, None] * vy[:, None, :]).reshape(n, -1) * sw[:, None])
+    target = sw * zs
+    y = q_all.T @ target
+    outside = target - q_all @ y  # what no candidate reaches
+    base = float(outside @ outside)
     out = []
     for p in range(max_degree[0] + 1):
         for q in range(max_degree[1] + 1):
             k = (p + 1) * (q + 1)
             if k >= n:
                 continue
-            a = (vx[:, :p + 1, None] * vy[:, None, :q + 1]).reshape(n, k) * sw[:, None]
-            qm, rm = np.linalg.qr(a)
-            diag = np.abs(np.diag(rm))
+            u, t = np.linalg.qr(r_all[:, [a * width + b for a in range(p + 1) for b in range(q + 1)]])
+            diag = np.abs(np.diag(t))
             if diag.min() <= 1e-10 * diag.max():
                 continue  # these points do not determine the degree
-            res = sw * zs - qm @ (qm.T @ (sw * zs))
+            inside = y - u @ (u.T @ y)
             if criterion == "gcv":
-                s = n * float(res @ res) / (n - k) ** 2
+                s = n * (base + float(inside @ inside)) / (n - k) ** 2
             else:
-                h = np.einsum("ij,ij->i", qm, qm)
-                s = float(np.mean((res / (1 - h)) ** 2))
+                qs = q_all @ u
+                h = np.einsum("ij,ij->i", qs, qs)
+                s = float(np.mean(((outside + q_all @ inside) / (1 - h)) ** 2))
             out.append(((p, q), s))
     out.sort(key=lambda t: (t[1], sum(t[0])))
     return out
