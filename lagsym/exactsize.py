@@ -74,11 +74,15 @@ class ExactClock:
 
     def foresee(self, done: int, total: int, spent: float, products_after: int) -> None:
         """Refuse if the computation, its current product ``done`` of ``total`` rows in after ``spent`` seconds and
-        ``products_after`` as long to follow, would end past the limit."""
-        if self.limit is None or spent < FORESEE_SECONDS or done >= total:
+        ``products_after`` as long to follow, would end past the limit.  A pace is trusted after ``FORESEE_SECONDS``;
+        before that, only a computation already past the limit is refused."""
+        if self.limit is None or done >= total:
+            return
+        elapsed = time.perf_counter() - self.started
+        if spent < FORESEE_SECONDS and elapsed <= self.limit:
             return
         rest = spent / done * (total - done) + products_after * spent / done * total
-        foreseen = time.perf_counter() - self.started + rest
+        foreseen = elapsed + rest
         if foreseen > self.limit:
             where = f"{self.source}: " if self.source else ""
             raise InputError(f"{where}the exact {self.what} would take about {_seconds(foreseen, self.limit)} s here "
