@@ -15,9 +15,12 @@ result is the same whichever process computes it.
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import multiprocessing.pool as mp_pool
+import os
 import signal
+import sys
 import threading
 
 from ..evaluate.threads import available_cores
@@ -33,20 +36,34 @@ MAX_PROCESSES = 8
 _EVALUATOR = None  # in a worker process only: the evaluator its initializer received
 
 
-def _start(evaluator) -> None:
+def _start(evaluator, parent: int) -> None:
     """A worker's start: the evaluator kept, and the signals a command catches given back to the system.
 
     The fork copies the command's handlers (SIGTERM and SIGHUP stop it with
     one line, :mod:`lagsym.cli`); in a worker they would turn the pool's own
     SIGTERM at the end of every plan into a traceback.  Ctrl-C reaches the
     whole process group: the command stops and ends the pool, so a worker
-    ignores it.
+    ignores it.  On Linux the kernel kills a worker whose command has ended
+    (:func:`_die_with`): none is left holding the command's standard error.
     """
     global _EVALUATOR
     _EVALUATOR = evaluator
+    _die_with(parent)
     for sig in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _die_with(parent: int) -> None:
+    """Linux: be killed when the thread that forked this worker ends (the command, or the pool's worker handler);
+    end now if the command ended before this was asked."""
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            return
+        if os.getppid() != parent:
+            os._exit(0)
 
 
 def _abandon(pool) -> None:
@@ -65,6 +82,9 @@ def _abandon(pool) -> None:
     for handler in (pool._worker_handler, pool._task_handler, pool._result_handler):
         handler._state = mp_pool.TERMINATE
     pool._state = mp_pool.TERMINATE
+    # The worker handler forks a replacement for each worker it finds dead until it sees the state: wait for it
+    # to stop, so that no worker is forked after the kills below (one was, left holding the command's stderr).
+    pool._worker_handler.join(2.0)
     for process in list(pool._pool):
         process.kill()
     for process in list(pool._pool):  # again: one the worker handler forked before it saw the state
@@ -95,7 +115,7 @@ class Workers:
         if (self.processes > 1 and threading.active_count() == 1
                 and "fork" in multiprocessing.get_all_start_methods()):
             ctx = multiprocessing.get_context("fork")
-            self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator,))
+            self._pool = ctx.Pool(self.processes, initializer=_start, initargs=(self.evaluator, os.getpid()))
         return self
 
     def __exit__(self, exc_type, *exc) -> None:
