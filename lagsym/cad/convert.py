@@ -52,7 +52,7 @@ def bernstein_transform(degree: int, lo: Fraction, hi: Fraction) -> tuple[tuple[
     >>> [[str(v) for v in row] for row in bernstein_transform(1, Fraction(1), Fraction(3))]
     [['1', '1'], ['1', '3']]
     """
-    return tuple(tuple(_frac(v) for v in row) for row in _transform(degree, Fraction(lo), Fraction(hi)).tolist())
+    return tuple(tuple(to_fraction(v) for v in row) for row in _transform(degree, Fraction(lo), Fraction(hi)).tolist())
 
 
 def _transform(degree: int, lo: Fraction, hi: Fraction) -> flint.fmpq_mat:
@@ -61,9 +61,6 @@ def _transform(degree: int, lo: Fraction, hi: Fraction) -> flint.fmpq_mat:
     s = [[_fmpq(comb(a, k) * lo ** (a - k) * h**k) if a >= k else 0 for a in range(size)] for k in range(size)]
     r = [[_fmpq(Fraction(comb(i, k), comb(degree, k))) if k <= i else 0 for k in range(size)] for i in range(size)]
     return flint.fmpq_mat(r) * flint.fmpq_mat(s)
-
-
-_frac = to_fraction  # FLINT keeps its rationals in lowest terms: no gcd is sought again
 
 
 def bezier_patch(surface: LagrangeSurface) -> BezierPatch:
@@ -85,7 +82,7 @@ def bezier_patch(surface: LagrangeSurface) -> BezierPatch:
     z = stepped_product(left, _transform(q, y0, y1).transpose(), clock=clock).entries()
     xs = [x0 + (x1 - x0) * Fraction(i, p) for i in range(p + 1)]
     ys = [y0 + (y1 - y0) * Fraction(k, q) for k in range(q + 1)]
-    net = tuple(tuple((xs[i], ys[k], _frac(z[i * (q + 1) + k])) for k in range(q + 1)) for i in range(p + 1))
+    net = tuple(tuple((xs[i], ys[k], to_fraction(z[i * (q + 1) + k])) for k in range(q + 1)) for i in range(p + 1))
     return BezierPatch(p, q, net, (x0, x1, y0, y1))
 
 
