@@ -30,7 +30,7 @@ README = ROOT / "README.md"
 BEGIN = "<!-- results: generated from benchmarks/results.json by benchmarks/results.py; tests/test_readme.py checks them -->"
 END = "<!-- end results -->"
 # The results the README quotes, against the peers a reader knows; docs/benchmarks.md gives them all.
-README_KEYS = ("toolpath", "toolpath-quick", "dropcutter", "verify", "exact", "scatter", "simulate")
+README_KEYS = ("toolpath", "toolpath-quick", "dropcutter", "verify", "exact", "scatter", "simulate", "first-run")
 
 
 def add_option(ap: argparse.ArgumentParser) -> None:

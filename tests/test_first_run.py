@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -117,3 +118,94 @@ def test_a_plan_started_while_the_background_compile_runs_waits_for_its_kernel(t
     while compiling_in_background(folder):  # the rest of the kernels, then the lock is let go
         assert time.monotonic() < deadline
         time.sleep(0.2)
+
+
+_AHEAD = """
+import json
+import numpy as np
+from numba.core import event
+from lagsym.grid import grid_from_table
+from lagsym.lagrange import lagrange_surface
+from lagsym.toolpath.dropcutter import drop_cutter
+from lagsym.toolpath.kernelahead import compile_ahead
+
+class Names(event.Listener):
+    def __init__(self):
+        self.names = []
+    def on_start(self, e):
+        self.names.append(e.data["dispatcher"].py_func.__name__)
+    def on_end(self, e):
+        pass
+
+ahead, kernel = Names(), Names()
+with event.install_listener("numba:compile", ahead):
+    compile_ahead()
+surface = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 0]]))
+xs = np.linspace(0.0, 2.0, 5)
+with event.install_listener("numba:compile", kernel):
+    for shape, corner in (("ball", None), ("flat", None), ("bull", 0.1)):
+        drop_cutter(surface, xs, xs, 0.5, shape, corner=corner)
+print(json.dumps([ahead.names, kernel.names]))
+"""
+
+
+@pytest.mark.slow
+def test_the_kernels_heaviest_callees_compile_ahead_in_a_second_process_for_the_types_the_kernel_passes(tmp_path):
+    """compile_ahead's second process compiles one group of callees while this one compiles the other; the kernel
+    then loads both from the cache.  Types that differ from the kernel's would show here as a second compile."""
+    from lagsym.toolpath.kernelahead import PARTS
+
+    cache = tmp_path / "numba-cache"
+    r = subprocess.run([sys.executable, "-c", _AHEAD], env={**os.environ, "NUMBA_CACHE_DIR": str(cache)},
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    ahead, kernel = json.loads(r.stdout)
+    assert set(PARTS["lattice"]) <= set(ahead), ahead  # compiled here
+    assert not set(PARTS["newton"]) & set(ahead), ahead  # compiled by the second process, loaded here
+    assert {path.name.split("-")[0] for path in cache.rglob("*.nbi")} >= {f"kernel.{n}" for n in PARTS["newton"]}
+    assert "drop_chunk" in kernel and not set(PARTS["newton"] + PARTS["lattice"]) & set(kernel), kernel
+
+
+def test_the_background_compile_leaves_the_evaluation_kernels_while_a_plan_runs(tmp_path):
+    """A plan holds the planning lock until its process ends; the background compile's evaluation kernels wait
+    for it (at most their limit), so they do not share the first plan's cores."""
+    import time
+
+    from lagsym.toolpath.kernelcache import hold_planning_lock, wait_for_no_plan
+
+    folder = tmp_path / "cache"
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import sys, time; from pathlib import Path\n"
+         "from lagsym.toolpath.kernelcache import hold_planning_lock\n"
+         "print(hold_planning_lock(Path(sys.argv[1])), flush=True); time.sleep(1.0)", str(folder)],
+        stdout=subprocess.PIPE, text=True)
+    assert holder.stdout.readline() == "True\n"  # the plan holds it now, and lets it go when it ends
+    start = time.monotonic()
+    with wait_for_no_plan(folder, limit=60.0):
+        waited = time.monotonic() - start
+        assert holder.poll() is not None, "entered while the plan still ran"
+        assert hold_planning_lock(folder) is False  # a plan that starts meanwhile does not wait for the lock
+    assert waited < 60.0
+    assert holder.wait() == 0
+    assert hold_planning_lock(folder) is True and hold_planning_lock(folder) is True  # held once per folder
+    start = time.monotonic()
+    with wait_for_no_plan(folder, limit=0.3):  # this process plans: the wait ends at its limit
+        assert time.monotonic() - start >= 0.3
+
+
+def test_a_plan_takes_the_planning_lock_before_it_waits_for_or_compiles_the_kernel(tmp_path, monkeypatch):
+    import time
+
+    from lagsym.toolpath import kernelahead, kernelcache
+    from lagsym.toolpath.dropcutter import telling_compiles
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    ahead = []
+    monkeypatch.setattr(kernelahead, "compile_ahead", lambda: ahead.append(kernelcache.cache_folder()))
+    with telling_compiles(None):
+        pass
+    folder = kernelcache.cache_folder()
+    assert ahead == [folder]  # no kernel in this cache: the plan compiles it, the heaviest parts side by side
+    start = time.monotonic()
+    with kernelcache.wait_for_no_plan(folder, limit=0.3):
+        assert time.monotonic() - start >= 0.3

@@ -307,7 +307,8 @@ def telling_compiles(progress: Progress | None):
     and no other report may be made meanwhile.
     """
     from .compiling import told_if_compiling
-    from .kernelcache import wait_for_background
+    from .kernelahead import compile_ahead
+    from .kernelcache import cache_folder, hold_planning_lock, kernel_cached, wait_for_background
 
     told = []
 
@@ -316,8 +317,11 @@ def telling_compiles(progress: Progress | None):
             progress(0, None, COMPILING)
         told.append(True)
 
+    hold_planning_lock()  # the background compile leaves the evaluation kernels until this process ends
     wait_for_background(tell)  # a plan just after an install: the kernel is being compiled in the background
     with told_if_compiling(tell):
+        if cache_folder() is not None and not kernel_cached():  # compiled here: its heaviest callees on two cores
+            compile_ahead()
         yield
     if told and progress is not None:
         progress(1, 1, COMPILING)

@@ -14,10 +14,12 @@ import time
 from pathlib import Path
 
 __all__ = ["KERNEL_FILE", "cache_folder", "kernel_cached", "compiling_in_background", "wait_for_background",
-           "holding_lock"]
+           "holding_lock", "hold_planning_lock", "wait_for_no_plan"]
 
 KERNEL_FILE = Path(__file__).resolve().with_name("kernel.py")
 _LOCK = "lagsym-compiling.lock"  # held by the background process while it compiles
+_PLANNING = "lagsym-planning.lock"  # shared by the processes that plan, until they end
+_planning: dict[Path, int] = {}  # the planning locks this process holds, by cache folder
 
 
 def cache_folder(module: Path = KERNEL_FILE) -> Path | None:
@@ -91,3 +93,51 @@ def holding_lock(folder: Path):
         yield True
     finally:
         os.close(fd)
+
+
+def hold_planning_lock(folder: Path | None = None) -> bool:
+    """Hold, until this process ends, a shared lock in the cache saying that a plan runs here; whether it is held.
+
+    The background compile leaves the evaluation kernels, which no plan
+    needs, until no process holds it (:func:`wait_for_no_plan`): compiling
+    them beside the first plan would take a share of its cores.  A plan never
+    waits for this lock: where the background process holds it (compiling
+    now), the plan runs without it.
+    """
+    folder = cache_folder() if folder is None else folder
+    if folder is None:
+        return False
+    if folder in _planning:
+        return True
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd = os.open(folder / _PLANNING, os.O_RDONLY | os.O_CREAT, 0o644)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return False
+    _planning[folder] = fd  # closed, and so released, when the process ends
+    return True
+
+
+@contextlib.contextmanager
+def wait_for_no_plan(folder: Path, *, limit: float = 120.0):
+    """A block entered once no process holds the planning lock (or after ``limit`` s), holding it alone meanwhile."""
+    fd = None
+    with contextlib.suppress(OSError):
+        fd = os.open(folder / _PLANNING, os.O_RDONLY | os.O_CREAT, 0o644)
+    try:
+        start = time.monotonic()
+        while fd is not None and time.monotonic() - start < limit:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                time.sleep(0.1)
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)

@@ -5,15 +5,19 @@ kernels (:mod:`lagsym.evaluate.compiled`) the first time they run and keeps
 the machine code in its cache, beside the modules (or under
 ``NUMBA_CACHE_DIR``).  Compiling takes several seconds; loading takes a
 fraction of one.  So when a ``lagsym`` command ends and the cache holds no
-cutter kernel yet, :func:`start_in_background` starts a detached process at
-low priority that runs the kernels once on a tiny surface, filling the cache:
+cutter kernel yet, :func:`start_in_background` starts a detached process
+that runs the kernels once on a tiny surface, filling the cache:
 the README's first command (``lagsym equation``) leaves the kernels ready for
 the ``toolpath`` that follows (and the large evaluations of ``sample`` and
 ``verify``).  The process holds a lock in the cache while it compiles, so
 no second one starts beside it, and a plan that starts meanwhile waits for
 the kernel rather than compiling it a second time (both say so,
 :mod:`.kernelcache`); a plan with no kernel cached and none compiling
-compiles it itself and says so (:mod:`.compiling`).
+compiles it itself and says so (:mod:`.compiling`).  The cutter kernel's
+heaviest callees compile in two processes side by side (:mod:`.kernelahead`),
+and the evaluation kernels then wait, at low priority, until no plan runs
+(each plan holds a shared lock in the cache until its command ends), so the
+first plan has the cores.
 
 Nothing here imports Numba: the checks look for the cache's index file and lock (:mod:`.kernelcache`).
 ``LAGSYM_NO_BACKGROUND_COMPILE=1`` turns the background process off.  Where
@@ -24,11 +28,13 @@ that cannot leave its work behind.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
 
-from .kernelcache import KERNEL_FILE, cache_folder, compiling_in_background, holding_lock, kernel_cached
+from .kernelcache import (KERNEL_FILE, cache_folder, compiling_in_background, holding_lock, kernel_cached,
+                          wait_for_no_plan)
 
 __all__ = ["OFF", "cache_folder", "kernel_cached", "start_in_background", "compile_kernels"]
 
@@ -39,7 +45,7 @@ def start_in_background() -> bool:
     """Start the detached process that fills the cache, unless it holds the kernel, cannot or is told not to.
 
     Returns whether a process was started.  It runs in a session of its own
-    at low priority, reads and writes nothing the user sees, and a failure
+    (the evaluation kernels at low priority), reads and writes nothing the user sees, and a failure
     to start it is not an error: the next plan compiles as before.
     """
     if os.environ.get(OFF) == "1" or cache_folder() is None or kernel_cached() or compiling_in_background():
@@ -56,7 +62,8 @@ def start_in_background() -> bool:
 
 
 def compile_kernels() -> None:
-    """Run the cutter kernel for each cutter shape, then the evaluation kernels, on a tiny surface: Numba caches them."""
+    """Run the cutter kernel for each cutter shape, then (once no plan runs, at low priority) the evaluation
+    kernels, on a tiny surface: Numba caches them."""
     import numpy as np
 
     from ..evaluate import evaluate_grid, evaluate_points
@@ -64,23 +71,27 @@ def compile_kernels() -> None:
     from ..grid import grid_from_table
     from ..lagrange import lagrange_surface
     from .dropcutter import drop_cutter
+    from .kernelahead import compile_ahead
 
+    compile_ahead()  # the kernel's heaviest callees, on two cores at once
     surface = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 0]]))
     xs = np.linspace(0.0, 2.0, 5)
     for shape, corner in (("ball", None), ("flat", None), ("bull", 0.1)):
         drop_cutter(surface, xs, xs, 0.5, shape, corner=corner)
+    # The next plan waits for the cutter kernel, so it compiles at the user's priority; the evaluation kernels
+    # serve later commands only, so they run behind whatever the user runs next, and after any plan.
+    with contextlib.suppress(OSError):
+        os.nice(10)
     side = int(COMPILED_POINTS ** 0.5) + 1  # a batch large enough to run compiled
-    with use_engine(Engine("compiled")):
+    folder = cache_folder()
+    with (wait_for_no_plan(folder) if folder is not None else contextlib.nullcontext()), \
+            use_engine(Engine("compiled")):
         many = np.linspace(0.0, 2.0, side)
         evaluate_grid(surface, many, many)
         evaluate_points(surface, np.resize(many, COMPILED_POINTS), np.resize(many[::-1], COMPILED_POINTS))
 
 
 if __name__ == "__main__":
-    try:
-        os.nice(10)  # behind whatever the user runs next
-    except OSError:
-        pass
     folder = cache_folder()
     if folder is None:  # nowhere to keep the machine code: nothing to do for later commands
         sys.exit(0)
