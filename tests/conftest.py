@@ -115,3 +115,28 @@ def run_cli(capsys):
         return status, out.getvalue(), err.getvalue()
 
     return run
+
+
+def made_once(tmp_path_factory, name: str, make):
+    """``make()`` once for the whole run, shared by every pytest-xdist worker; the value (picklable) from then on.
+
+    A module fixture is made on each worker that runs one of the module's
+    tests: a job planned and read by rs274 took a minute of the run twice.
+    The first worker to ask makes it and keeps it in a file beside the
+    workers' temporary folders; the others wait for that one (a lock) and
+    load it.
+    """
+    import fcntl
+    import pickle
+
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the run's folder, above each worker's own
+    kept = root / f"made-once-{name}.pickle"
+    with open(root / f"made-once-{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if kept.exists():
+            return pickle.loads(kept.read_bytes())
+        value = make()
+        kept.write_bytes(pickle.dumps(value))
+        return value

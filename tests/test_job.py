@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import made_once
 from test_rough import exact_heights, sweep_flat
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -103,7 +104,7 @@ def run_job(d: Path, job_text: str, rs274, tools: str = TOOLS):
 @pytest.fixture(scope="module")
 def job_run(tmp_path_factory, rs274):
     """The example job's program, what the command printed, and rs274's moves tagged with the tool in the spindle."""
-    return run_job(tmp_path_factory.mktemp("job"), job_text(), rs274)
+    return made_once(tmp_path_factory, "job", lambda: run_job(tmp_path_factory.mktemp("job"), job_text(), rs274))
 
 
 @pytest.mark.slow
@@ -151,9 +152,12 @@ def _densified(moves, spacing):
 
 
 @pytest.fixture(scope="module")
-def machined(job_run):
+def machined(job_run, tmp_path_factory):
     """The block cut by the roughing, then by the finishing: grid, surface, and material left after each."""
-    _, _, moves, _ = job_run
+    return made_once(tmp_path_factory, "job-machined", lambda: _machined(job_run[2]))
+
+
+def _machined(moves):
     cell = 0.25
     gx = gy = np.arange(20.0, 100.0 + cell / 2, cell)  # the block is the box (no margin)
     fx, fy = np.meshgrid(gx, gy, indexing="ij")

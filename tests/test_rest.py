@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import made_once
 from test_job import EX4, _densified, run_job, stamp_ball
 from test_rough import exact_heights, sweep_flat
 
@@ -40,7 +41,8 @@ def rest_text(**changes) -> str:
 @pytest.fixture(scope="module")
 def rest_run(tmp_path_factory, rs274):
     """The program, what the command printed, and rs274's moves: (tool, feed?, x, y, z)."""
-    text, printed, moves, _ = run_job(tmp_path_factory.mktemp("rest"), rest_text(), rs274, TOOLS)
+    text, printed, moves, _ = made_once(tmp_path_factory, "rest-job",
+                                        lambda: run_job(tmp_path_factory.mktemp("rest"), rest_text(), rs274, TOOLS))
     return text, printed, moves
 
 
@@ -53,9 +55,12 @@ def _cut(h, gx, gy, moves, shape, radius):
 
 
 @pytest.fixture(scope="module")
-def maps(rest_run):
+def maps(rest_run, tmp_path_factory):
     """The surface, its slope factor, and the height map after the rough, after the rest and after each finish."""
-    _, _, moves = rest_run
+    return made_once(tmp_path_factory, "rest-maps", lambda: _maps(rest_run[2]))
+
+
+def _maps(moves):
     gx = gy = np.arange(20.0, 100.0 + CELL / 2, CELL)  # the block is the box (no margin)
     fx, fy = np.meshgrid(gx, gy, indexing="ij")
     f = exact_heights(EX4, fx, fy)
