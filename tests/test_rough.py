@@ -64,9 +64,10 @@ def sweep_flat(h, gx, gy, p0, p1, radius):
     lowest tip height over each cell it covers (nan elsewhere) and the cells' material above that before."""
     lo_x, hi_x = min(p0[0], p1[0]) - radius, max(p0[0], p1[0]) + radius
     lo_y, hi_y = min(p0[1], p1[1]) - radius, max(p0[1], p1[1]) + radius
-    ix = np.flatnonzero((gx >= lo_x) & (gx <= hi_x))
-    iy = np.flatnonzero((gy >= lo_y) & (gy <= hi_y))
-    if not len(ix) or not len(iy):
+    # The cells within the move's box: a window of the (increasing) axes, so the map is read and written in place.
+    ix = slice(np.searchsorted(gx, lo_x, "left"), np.searchsorted(gx, hi_x, "right"))
+    iy = slice(np.searchsorted(gy, lo_y, "left"), np.searchsorted(gy, hi_y, "right"))
+    if ix.stop <= ix.start or iy.stop <= iy.start:
         return 0.0
     qx, qy = np.meshgrid(gx[ix], gy[iy], indexing="ij")
     dx, dy = p1[0] - p0[0], p1[1] - p0[1]
@@ -84,9 +85,9 @@ def sweep_flat(h, gx, gy, p0, p1, radius):
         t1, t2 = np.clip(r1, 0, 1), np.clip(r2, 0, 1)
         z1, z2 = p0[2] + t1 * (p1[2] - p0[2]), p0[2] + t2 * (p1[2] - p0[2])
         zlow = np.minimum(z1, z2)
-    sub = h[np.ix_(ix, iy)]
+    sub = h[ix, iy]
     removed = np.where(cover, np.maximum(sub - zlow, 0), 0).max(initial=0.0)
-    h[np.ix_(ix, iy)] = np.where(cover, np.minimum(sub, zlow), sub)
+    h[ix, iy] = np.where(cover, np.minimum(sub, zlow), sub)
     return float(removed)
 
 

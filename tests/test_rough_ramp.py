@@ -82,14 +82,18 @@ def left_above_reach(mv, h):
     k = int(round(R / CELL))
     off = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1) if (i * i + j * j) * CELL * CELL <= R * R]
     pad = np.pad(f, k, constant_values=-np.inf)
-    cl = np.max([pad[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    cl = np.full(f.shape, -np.inf)  # the most over the offsets, one offset at a time
+    for i, j in off:
+        np.maximum(cl, pad[k + i:k + i + len(gx), k + j:k + j + len(gy)], out=cl)
     passed = np.zeros(cl.shape, dtype=bool)
     for _, x, y, _ in mv:
         i, j = int(round((x - gx[0]) / CELL)), int(round((y - gy[0]) / CELL))
         if 0 <= i < len(gx) and 0 <= j < len(gy):
             passed[i, j] = True
     padc = np.pad(np.where(passed, cl, np.inf), k, constant_values=np.inf)
-    reach = np.min([padc[k + i:k + i + len(gx), k + j:k + j + len(gy)] for i, j in off], axis=0)
+    reach = np.full(f.shape, np.inf)
+    for i, j in off:
+        np.minimum(reach, padc[k + i:k + i + len(gx), k + j:k + j + len(gy)], out=reach)
     assert (h[inbox] - f[inbox]).min() >= STOCK - 0.002, "the roughing cut into the stock to leave"
     return float((h[inbox] - (np.maximum(reach[inbox], f[inbox]) + STOCK)).max())
 
