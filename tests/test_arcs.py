@@ -43,7 +43,14 @@ def example4(x, y):
         z[np.searchsorted(xs, px), np.searchsorted(ys, py)] = pz
 
     def basis(nodes, t):
-        return np.array([np.prod([(t - m) / (n - m) for m in nodes if m != n], axis=0) for n in nodes])
+        rows = []
+        for n in nodes:
+            row = None  # the factors multiplied in order, as a product along a stack of them would
+            for m in nodes:
+                if m != n:
+                    row = (t - m) / (n - m) if row is None else row * ((t - m) / (n - m))
+            rows.append(row)
+        return np.array(rows)
 
     return np.einsum("ij,i...,j...->...", z, basis(xs, np.asarray(x)), basis(ys, np.asarray(y)))
 
