@@ -31,18 +31,3 @@ def test_a_start_up_benchmark_prints_its_ratios(script, base, rows, tmp_path):
     assert entry["command"].endswith(f"benchmarks/{script} --runs 1 --results {results}")
     assert entry["ratio"] > 0 and entry["date"] and entry["machine"]
 
-
-@pytest.mark.slow
-def test_the_first_run_benchmark_times_the_readme_commands_on_an_empty_cache(tmp_path):
-    """One run: the README's commands with a Numba cache of their own, the first toolpath and the warm ones after;
-    the same program both times; the headline recorded where it was asked (times are not checked)."""
-    import json
-
-    results = tmp_path / "results.json"
-    done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bench_first_run.py"), "--runs", "1",
-                           "--results", str(results)], cwd=ROOT, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
-    (row,) = [ln for ln in done.stdout.splitlines() if ln.startswith("| 1 |")]
-    assert row.count(" s |") == 6, row  # five commands and the warm toolpath, each timed
-    (entry,) = json.loads(results.read_text()).values()
-    assert 0 < entry["ratio"] < 1.5 and entry["peer"] == "the same toolpath warm"

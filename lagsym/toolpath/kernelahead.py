@@ -66,7 +66,8 @@ def compile_ahead() -> None:
     block if that is left early (an interrupt): none outlives it.
     """
     child = None
-    if (os.cpu_count() or 1) > 1:
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if cores > 1:
         try:
             # From the folder that holds this lagsym, as the background compile runs (see .warmup).
             child = subprocess.Popen([sys.executable, "-m", __name__, "newton"], stdin=subprocess.DEVNULL,

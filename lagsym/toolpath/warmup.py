@@ -36,7 +36,8 @@ import sys
 from .kernelcache import (KERNEL_FILE, cache_folder, compiling_in_background, holding_lock, kernel_cached,
                           wait_for_no_plan)
 
-__all__ = ["OFF", "cache_folder", "kernel_cached", "start_in_background", "compile_kernels"]
+__all__ = ["OFF", "cache_folder", "kernel_cached", "start_in_background", "compile_kernels", "compile_cutter_kernel",
+           "compile_evaluation_kernels"]
 
 OFF = "LAGSYM_NO_BACKGROUND_COMPILE"
 
@@ -62,31 +63,43 @@ def start_in_background() -> bool:
 
 
 def compile_kernels() -> None:
-    """Run the cutter kernel for each cutter shape, then (once no plan runs, at low priority) the evaluation
-    kernels, on a tiny surface: Numba caches them."""
+    """Run the cutter kernel for each cutter shape, then the evaluation kernels, on a tiny surface: Numba caches
+    them."""
+    compile_cutter_kernel()
+    compile_evaluation_kernels()
+
+
+def _tiny_surface():
+    from ..grid import grid_from_table
+    from ..lagrange import lagrange_surface
+
+    return lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 0]]))
+
+
+def compile_cutter_kernel() -> None:
+    """Run the cutter kernel for each cutter shape on a tiny surface, its heaviest callees compiled ahead on two
+    cores at once (:mod:`.kernelahead`)."""
+    import numpy as np
+
+    from .dropcutter import drop_cutter
+    from .kernelahead import compile_ahead
+
+    compile_ahead()
+    surface, xs = _tiny_surface(), np.linspace(0.0, 2.0, 5)
+    for shape, corner in (("ball", None), ("flat", None), ("bull", 0.1)):
+        drop_cutter(surface, xs, xs, 0.5, shape, corner=corner)
+
+
+def compile_evaluation_kernels() -> None:
+    """Run the evaluation kernels on a batch large enough to run compiled."""
     import numpy as np
 
     from ..evaluate import evaluate_grid, evaluate_points
     from ..evaluate.engine import COMPILED_POINTS, Engine, use_engine
-    from ..grid import grid_from_table
-    from ..lagrange import lagrange_surface
-    from .dropcutter import drop_cutter
-    from .kernelahead import compile_ahead
 
-    compile_ahead()  # the kernel's heaviest callees, on two cores at once
-    surface = lagrange_surface(grid_from_table([0, 1, 2], [0, 1, 2], [[0, 1, 0], [1, 2, 1], [0, 1, 0]]))
-    xs = np.linspace(0.0, 2.0, 5)
-    for shape, corner in (("ball", None), ("flat", None), ("bull", 0.1)):
-        drop_cutter(surface, xs, xs, 0.5, shape, corner=corner)
-    # The next plan waits for the cutter kernel, so it compiles at the user's priority; the evaluation kernels
-    # serve later commands only, so they run behind whatever the user runs next, and after any plan.
-    with contextlib.suppress(OSError):
-        os.nice(10)
-    side = int(COMPILED_POINTS ** 0.5) + 1  # a batch large enough to run compiled
-    folder = cache_folder()
-    with (wait_for_no_plan(folder) if folder is not None else contextlib.nullcontext()), \
-            use_engine(Engine("compiled")):
-        many = np.linspace(0.0, 2.0, side)
+    side = int(COMPILED_POINTS ** 0.5) + 1
+    surface, many = _tiny_surface(), np.linspace(0.0, 2.0, side)
+    with use_engine(Engine("compiled")):
         evaluate_grid(surface, many, many)
         evaluate_points(surface, np.resize(many, COMPILED_POINTS), np.resize(many[::-1], COMPILED_POINTS))
 
@@ -97,4 +110,9 @@ if __name__ == "__main__":
         sys.exit(0)
     with holding_lock(folder) as mine:
         if mine:
-            compile_kernels()
+            compile_cutter_kernel()  # at the user's priority: the next plan waits for it
+            # The evaluation kernels serve later commands only: behind whatever the user runs next, after any plan.
+            with contextlib.suppress(OSError):
+                os.nice(10)
+            with wait_for_no_plan(folder):
+                compile_evaluation_kernels()
