@@ -118,3 +118,42 @@ def test_garbage_answers_from_a_control_at_another_baud_rate_stop_the_send(line,
     assert status == 3, out + err
     assert "the control answered 0xE6" in err and "check the baud rate and format (19200 baud, 7E2)" in err
     assert err.count("\n") == 1
+
+
+class _Quiet:
+    """A line that took every byte at once and has nothing to read until told: the sender's looks, by hand."""
+
+    def __init__(self):
+        self.incoming = b""
+
+    def read(self, _n):
+        got, self.incoming = self.incoming, b""
+        return got
+
+
+def test_an_answer_vouches_only_for_what_had_left_a_settling_time_before_the_last_look_that_found_none():
+    """The way back takes time too: an answer read now may have been sent before the last look (which found
+    none) by up to the settling time, so it vouches for what had left by then, not for what left since.  A
+    control answering from the first blocks, its DC3 delivered late, used to be credited with blocks it never
+    held (a loaded machine's delivery, a USB adapter's latency timer)."""
+    from lagsym.dnc.sender import Sender
+
+    segments = [(n, f"N{n} G1 X{n}.\n".encode()) for n in range(1, 401)]
+    line = _Quiet()
+    sender = Sender(line, segments, profile("haas", baud=115200), "drip", "/dev/null", progress=None, log=None)
+    settle = sender.settle_s
+    first, second = 2000, 4000
+
+    def look(now, pos, answer=b""):
+        sender.pos, sender.line_free, sender.queued = pos, 0.0, 0  # everything written has left the line
+        line.incoming = answer
+        sender.poll(now)
+
+    look(10.0, first)
+    look(10.0 + 4 * settle, second)  # more has left since: the control's answer may be older than this look
+    look(10.0 + 4 * settle + 0.001, second, b"\x13")
+    assert sender.known == first < second
+    assert sender.last_sure_block() == max(n for end, n in sender.ends if end <= first)
+    look(10.0 + 8 * settle, second)
+    look(10.0 + 8 * settle + 0.001, second, b"\x11")  # a later answer vouches for what had left by then
+    assert sender.known == second

@@ -41,6 +41,7 @@ control cannot read what is sent either.
 
 from __future__ import annotations
 
+import collections
 import math
 import signal
 import time
@@ -93,6 +94,8 @@ class Sender:
         self.pos = 0  # bytes the operating system took
         self.left = 0  # bytes that have left the port (line clock, output queue, settling time)
         self.known = 0  # bytes that surely reached the control: left the port before it last answered
+        # (time of a look at the port, bytes that had left by then), the looks of the last few settling times
+        self.looks: collections.deque = collections.deque([(-math.inf, 0)])
         self.answers = 0  # flow-control answers heard from the control (DC1, DC3)
         # A watched carrier or CTS/DSR signal vouches for the control throughout; loop:// echoes what it got.
         self.vouched = bool(settings.carrier != "none" or _HARDWARE.get(settings.flow))
@@ -121,6 +124,15 @@ class Sender:
         """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
         clock = max(0.0, (self.line_free - now) * self.cps)
         return max(math.ceil(clock), self.queued)
+
+    def left_at(self, when: float) -> int:
+        """The bytes that had left the port by the last look at or before ``when`` (0 before any)."""
+        found = 0
+        for t, left in self.looks:
+            if t > when:
+                break
+            found = left
+        return found
 
     def unsettled(self, now: float) -> int:
         """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
@@ -209,12 +221,16 @@ class Sender:
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""
         incoming = self.line.read(4096)
-        # An answer read now may have been sent at any time since the last look found none, and the control may
-        # have taken only what had settled by then: answers vouch for that, not for what has left since.
-        vouched_for = self.left
+        # An answer read now was sent at the earliest a settling time before the last look that found none (the way
+        # back takes up to a settling time too: a USB adapter's latency timer, the kernel's delivery), and the
+        # control may have taken only what had settled by then: answers vouch for that, not for what left since.
+        vouched_for = self.left_at(self.looks[-1][0] - self.settle_s)
         # Everything that had left the line before this look has left the port; whether the control took it
         # only its answers show.
         self.left = max(self.left, self.pos - self.unsettled(now))
+        self.looks.append((now, self.left))
+        while len(self.looks) > 2 and self.looks[1][0] < now - 3 * self.settle_s:
+            self.looks.popleft()
         if self.vouched:
             self.known = self.left
         if self.echo and incoming:  # loop:// gives back what it took
