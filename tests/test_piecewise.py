@@ -345,3 +345,50 @@ def test_bad_files_are_refused_in_one_line(change, message):
     with pytest.raises(InputError, match=message) as e:
         parse_piecewise_json(__import__("json").dumps(doc), "bad.json")
     assert "\n" not in str(e.value)
+
+
+def test_a_pieces_evaluator_is_the_one_made_from_the_piece_bit_for_bit():
+    """The evaluator made straight from a piece's local coefficients equals the one made the long way, through
+    the piece as a Lagrange surface and its exact change of basis."""
+    from lagsym.evaluate import surface_evaluator
+
+    s = piecewise_surface(wavy_grid(9, 7))
+    for i, k in [(0, 0), (3, 2), (7, 5), (4, 0)]:
+        a, b = s.piece_evaluator(i, k), surface_evaluator(s.piece(i, k))
+        assert (a.x_offset, a.x_scale, a.y_offset, a.y_scale, a.data_range, a.bounds) == \
+            (b.x_offset, b.x_scale, b.y_offset, b.y_scale, b.data_range, b.bounds)
+        for name in ("coefficients", "x_nodes", "y_nodes", "x_exact", "y_exact", "node_values"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert s.piece_evaluator(3, 2) is s.piece_evaluator(3, 2)
+
+
+@pytest.mark.parametrize("parts", [1, 4])
+def test_no_point_of_a_part_lies_above_its_bound(parts):
+    """Each part's bound, checked against exact values of the piece at rational points of the part (corners,
+    edges and inside); the parts' bounds are no higher than the whole piece's."""
+    g = wavy_grid(6, 5)
+    s = piecewise_surface(g)
+    tops = s.evaluator.part_upper_heights(parts)
+    f = [Fraction(j, 8) for j in range(9)]
+    for i, k in [(0, 0), (2, 3), (4, 1)]:
+        x0, x1, y0, y1 = s.box(i, k)
+        for p in range(parts):
+            for q in range(parts):
+                u0, v0 = x0 + (x1 - x0) * Fraction(p, parts), y0 + (y1 - y0) * Fraction(q, parts)
+                du, dv = (x1 - x0) / parts, (y1 - y0) / parts
+                values = [s.exact_value(u0 + du * a, v0 + dv * b) for a in f for b in f]
+                assert max(values) <= Fraction(tops[i, k, p, q])
+        assert tops[i, k].max() <= s.evaluator.upper_heights[i, k] + 1e-9
+
+
+def test_drops_share_out_among_worker_processes_with_the_same_values():
+    from lagsym.toolpath.workers import Workers
+
+    s = piecewise_surface(wavy_grid(14, 12))
+    rng = np.random.default_rng(5)
+    cx, cy = rng.uniform(-1.7, 41.7, 6000), rng.uniform(-1.7, 41.7, 6000)
+    alone = drop_cutter(s, cx, cy, 2.5)
+    with Workers(s.evaluator, 2) as workers:
+        assert workers.parallel
+        shared = drop_cutter(s, cx, cy, 2.5, workers=workers)
+    assert np.array_equal(alone, shared)

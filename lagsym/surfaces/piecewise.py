@@ -226,6 +226,72 @@ class PiecewiseSurface:
         self._pieces[(i, k)] = s
         return s
 
+    def piece_evaluator(self, i: int, k: int):
+        """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use and kept.
+
+        The same evaluator as ``surface_evaluator(self.piece(i, k))``, bit for
+        bit, made without the piece: its exact Chebyshev coefficients on its
+        cell are ``Gx A Gy^T`` (``A`` its local coefficients, ``G`` each axis's
+        change from cell coordinates to the Chebyshev basis, one per column or row
+        of cells), each rounded once.
+        """
+        found = self._evaluators.get((i, k))
+        if found is None:
+            found = self._evaluators[i, k] = self._make_evaluator(i, k)
+        return found
+
+    @cached_property
+    def _evaluators(self) -> dict:
+        return {}
+
+    @cached_property
+    def _to_chebyshev(self) -> tuple[dict, dict]:
+        return {}, {}
+
+    def _axis_change(self, axis: int, j: int):
+        """``(offset, scale, G, nodes)`` of cell ``j`` along ``axis``: ``G`` maps cell-coordinate powers to the
+        Chebyshev basis of the cell's ``[-1, 1]`` map, ``nodes`` the cell's four thirds."""
+        from ..evaluate.chebyshev import chebyshev_transform
+
+        found = self._to_chebyshev[axis].get(j)
+        if found is None:
+            nodes = self.grid.x if axis == 0 else self.grid.y
+            a, b = nodes[j], nodes[j + 1]
+            thirds = [a + (b - a) * Fraction(p, 3) for p in range(4)]
+            offset, scale, d = chebyshev_transform(thirds)
+            found = self._to_chebyshev[axis][j] = (offset, scale, d * _to_power(a, b - a).transpose(), thirds)
+        return found
+
+    def _make_evaluator(self, i: int, k: int):
+        import numpy as np
+
+        from ..evaluate.chebyshev import data_range
+        from ..evaluate.surface import SurfaceEvaluator
+
+        (xo, xh, gx, xs), (yo, yh, gy, ys) = self._axis_change(0, i), self._axis_change(1, k)
+        a = self._local(i, k)
+        cheb = gx * a * gy.transpose()
+        values = _THIRDS * a * _THIRDS.transpose()  # the piece's heights on its 4 x 4 grid of thirds
+
+        def floats(mat, n=4, m=4):
+            # int / int is correctly rounded, as float(Fraction) is
+            out = np.array([[int(mat[p, q].p) / int(mat[p, q].q) for q in range(m)] for p in range(n)])
+            out.setflags(write=False)
+            return out
+
+        def nodes(v):
+            out = np.array([float(t) for t in v])
+            exact = np.array([Fraction(float(t)) == t for t in v])
+            out.setflags(write=False)
+            exact.setflags(write=False)
+            return out, exact
+
+        (xn, xe), (yn, ye), z = nodes(xs), nodes(ys), floats(values)
+        return SurfaceEvaluator(x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh, coefficients=floats(cheb),
+                                data_range=data_range(z.ravel()), bounds=(float(xs[0]), float(xs[-1]),
+                                                                          float(ys[0]), float(ys[-1])),
+                                x_nodes=xn, y_nodes=yn, x_exact=xe, y_exact=ye, node_values=z)
+
     def locate(self, x, y) -> tuple[int, int]:
         """The piece whose cell holds ``(x, y)`` (a point on a border: the piece above and right of it)."""
         g = self.grid

@@ -53,7 +53,6 @@ class PiecewiseEvaluator:
         n, m = surface.shape
         self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
                                          for k in range(m)] for i in range(n)]))
-        self._evaluators: dict = {}
         self._derivatives: dict = {}
 
     @cached_property
@@ -67,6 +66,33 @@ class PiecewiseEvaluator:
         b = np.einsum("ja,ikab,lb->ikjl", w, self.local, w)
         top = b.max(axis=(2, 3))
         return readonly(top + 1e-12 * (np.abs(b).max(axis=(2, 3)) + 1.0))
+
+    def part_upper_heights(self, parts: int) -> np.ndarray:
+        """``[i, k, p, q]``: no point of part ``(p, q)`` of piece ``(i, k)``, its cell cut in ``parts`` x ``parts``
+        equal parts, lies above this (the highest Bezier control point of the piece restricted to the part).
+
+        Closer than :attr:`upper_heights` to the piece's height over a part;
+        the float rounding of the change to each part's Bezier points is
+        covered by a relative ``1e-12`` of the piece's largest coefficient.
+        """
+        found = self._part_tops.get(parts)
+        if found is None:
+            w = np.array([[comb(j, a) / comb(3, a) if a <= j else 0.0 for a in range(4)] for j in range(4)])
+            edges = np.linspace(0.0, 1.0, parts + 1)
+            # restricted[a, u]: s**u on [lo, hi] in powers of the part's own coordinate (s = lo + (hi - lo) r)
+            change = [w @ np.array([[comb(u, a) * lo ** (u - a) * (hi - lo) ** a if a <= u else 0.0 for u in range(4)]
+                                    for a in range(4)]) for lo, hi in zip(edges[:-1], edges[1:])]
+            pad = 1e-12 * (np.abs(self.local).max(axis=(2, 3)) + 1.0)
+            found = np.empty(self.local.shape[:2] + (parts, parts))
+            for p, cx in enumerate(change):
+                for q, cy in enumerate(change):
+                    found[:, :, p, q] = np.einsum("ja,ikab,lb->ikjl", cx, self.local, cy).max(axis=(2, 3)) + pad
+            found = self._part_tops[parts] = readonly(found)
+        return found
+
+    @cached_property
+    def _part_tops(self) -> dict:
+        return {}
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -177,11 +203,6 @@ class PiecewiseEvaluator:
         return max(float(top.max()), 0.0), float(np.maximum(top, -low).max())
 
     def piece_evaluator(self, i: int, k: int):
-        """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use."""
-        from ..evaluate import surface_evaluator
-
-        found = self._evaluators.get((i, k))
-        if found is None:
-            piece = self.surface.piece(i, k)
-            found = self._evaluators[(i, k)] = (piece, surface_evaluator(piece))
-        return found
+        """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use (kept by the
+        surface, :meth:`~lagsym.surfaces.piecewise.PiecewiseSurface.piece_evaluator`)."""
+        return self.surface.piece_evaluator(i, k)

@@ -113,7 +113,15 @@ def drop_cutter(surface, x, y, radius: float, shape: str | None = None, *, corne
     corner = corner_radius(shape, radius, corner)
     ev = evaluator or evaluator_of(surface)
     if isinstance(ev, PiecewiseEvaluator):
-        return _drop_piecewise(ev, x, y, radius, corner, lattice=lattice, starts=starts, margin=margin)
+        return _drop_piecewise(ev, x, y, radius, corner, lattice=lattice, starts=starts, margin=margin,
+                               workers=workers)
+    return _drop_polynomial(ev, x, y, radius, corner, lattice=lattice, starts=starts, margin=margin, workers=workers,
+                            feature=feature)
+
+
+def _drop_polynomial(ev: SurfaceEvaluator, x, y, radius: float, corner: float, *, lattice: int, starts: int,
+                     margin: bool, workers: Workers | None = None, feature: float | None = None) -> np.ndarray:
+    """:func:`drop_cutter` on one polynomial's evaluator."""
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
     box = ev.bounds
@@ -145,66 +153,127 @@ def evaluator_of(surface):
 
 
 def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, *, lattice: int, starts: int,
-                    margin: bool) -> np.ndarray:
+                    margin: bool, workers: Workers | None = None) -> np.ndarray:
     """Drop-cutter on a piecewise surface: the highest of the drops onto every piece within the tool's reach.
 
     The box is the union of the cells, so the maximum over the disc and the
     box is the largest of the maxima over the disc and each cell; each is
     drop-cutter on the piece (a polynomial) restricted to its own cell, with
-    the same search and lattice as on one polynomial.  The piece under the
-    tool axis is dropped on first; another piece is searched only where it
-    could rise above that: where the highest of its Bezier control points
-    less the cutter's profile at the nearest point of its cell (a bound no
-    contact on it exceeds) is above the height found.  The margin is
-    :data:`CL_MARGIN` of the largest height scale of any piece, the same at
-    every position.
+    the same search and lattice as on one polynomial.  A piece is searched
+    only where it could rise above the height found: each position takes
+    its pieces in the order of a bound no contact on them exceeds (from the
+    Bezier control points of the parts of the piece, :func:`_piecewise_chunk`)
+    and stops where the next bound is not above the height found.  The
+    margin is :data:`CL_MARGIN` of the largest height scale of any piece, the
+    same at every position.  With ``workers``, the positions are shared out
+    among them in large chunks; the values are the same as without.
     """
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     shape_out = x.shape
     cx, cy = _inside_box(x.ravel(), y.ravel(), ev.bounds, radius)
     if radius == 0:
         return ev.fast_points(cx, cy).reshape(shape_out)
+    parallel = workers is not None and workers.parallel and workers.evaluator is ev
+    # Each position's value is independent of the chunk it is computed in; a chunk walks every column of pieces
+    # in Python, so chunks are large.
+    chunk = max(_PIECEWISE_CHUNK, -(-cx.size // (2 * workers.processes))) if parallel else cx.size
+    tasks = [(cx[s:s + chunk], cy[s:s + chunk], (radius, corner), (lattice, starts)) for s in range(0, cx.size, chunk)]
+    parts = workers.map(_piecewise_chunk, tasks) if parallel else [_piecewise_chunk(ev, *t) for t in tasks]
+    out = np.concatenate(parts) if parts else np.empty(0)
+    span = _piecewise_height_scale(ev) + radius + 1.0
+    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+
+
+_PIECEWISE_CHUNK = 2048  # positions per worker's task on a piecewise surface, at least
+
+
+def _piecewise_chunk(ev: PiecewiseEvaluator, cx, cy, cutter: tuple[float, float],
+                     search: tuple[int, int]) -> np.ndarray:
+    """The highest drop onto any piece at each of the positions ``cx, cy`` (inside the box's reach), no margin;
+    ``cutter`` is ``(radius, corner)``, ``search`` ``(lattice, starts)`` as :func:`drop_cutter` takes them.
+
+    Each piece within reach of a position has a bound no contact on it
+    exceeds: over each of its cell's :data:`_PARTS` x :data:`_PARTS` parts
+    within reach, the part's highest Bezier control point less the cutter's
+    profile at the part's nearest point, the largest of these.  In rounds,
+    each position drops onto its piece of highest bound not yet dropped on,
+    while that bound is above the height found; so the piece the tool rests
+    on usually comes first, and the rest are mostly ruled out by their bound.
+    """
+    (radius, corner), (lattice, starts) = cutter, search
     bx, by = ev.breaks_x, ev.breaks_y
-    eps = 1e-9 * max(bx[-1] - bx[0], by[-1] - by[0], radius)
-    reach = radius + eps
     # The pieces' joins are where the surface's nodes are, as a polynomial's features are its nodes' spacing.
     feature = 0.5 * min(np.diff(bx).min(), np.diff(by).min())
     scale = _piecewise_height_scale(ev)
+    # Drop-cutter on each piece as on one polynomial (_drop_polynomial), its arguments made once per piece.
+    from .kernel import drop_chunk
+
+    spacing = max(min(radius / lattice, feature / 2), radius / 40)
+    grid = [np.require(a, requirements="W") for a in _lattice(radius, spacing)]
+    settle = 0.01 * CL_MARGIN * (scale + radius + 1.0)  # one settling threshold for every piece, the whole surface's
+    surfaces = {}
+    pos, piece, bound = _piece_bounds(ev, cx, cy, radius, corner)
     out = np.full(cx.shape, -np.inf)
+    columns = len(by) - 1
+    while pos.size:
+        # The first pair of each position, by highest bound: its next piece to drop on.
+        order = np.lexsort((-bound, pos))
+        pos, piece, bound = pos[order], piece[order], bound[order]
+        first = np.ones(pos.size, dtype=bool)
+        first[1:] = pos[1:] != pos[:-1]
+        now_pos, now_piece = pos[first], piece[first]
+        by_piece = np.argsort(now_piece, kind="stable")
+        now_pos, now_piece = now_pos[by_piece], now_piece[by_piece]
+        cuts = np.flatnonzero(np.diff(now_piece)) + 1
+        for group, p in zip(np.split(now_pos, cuts), now_piece[np.r_[0, cuts]]):
+            i, k = divmod(int(p), columns)
+            found = surfaces.get(p)
+            if found is None:
+                found = surfaces[p] = _kernel_surface(ev.piece_evaluator(i, k), radius, corner, spacing, settle)
+            gx, gy = cx[group], cy[group]
+            nx, ny = np.clip(gx, bx[i], bx[i + 1]), np.clip(gy, by[k], by[k + 1])
+            gx, gy = _kept_within(gx, gy, nx, ny, np.hypot(gx - nx, gy - ny), radius)
+            z = drop_chunk(*found, gx, gy, *grid, int(starts), corner == radius)
+            out[group] = np.maximum(out[group], z)
+        keep = ~first & (bound > out[pos])
+        pos, piece, bound = pos[keep], piece[keep], bound[keep]
+    return out
 
-    def drop(i, k, idx):
-        piece, pev = ev.piece_evaluator(i, k)
-        _HEIGHT_SCALES.setdefault(pev, scale)  # one settling threshold for every piece, the whole surface's
-        z = drop_cutter(piece, cx[idx], cy[idx], radius, corner=corner, lattice=lattice, starts=starts,
-                        margin=False, evaluator=pev, feature=feature)
-        out[idx] = np.maximum(out[idx], z)
 
-    home_i, home_k, *_ = ev.locate(cx, cy)
-    home = home_i * (len(by) - 1) + home_k
-    order = np.argsort(home, kind="stable")
-    cuts = np.flatnonzero(np.diff(home[order])) + 1
-    for group in np.split(order, cuts):
-        if group.size:
-            drop(int(home_i[group[0]]), int(home_k[group[0]]), group)
-    top = ev.upper_heights + eps
-    # Positions sorted by x: the ones a column of cells can reach are one slice.
-    order = np.argsort(cx, kind="stable")
-    sx, sy = cx[order], cy[order]
-    for i in range(len(bx) - 1):
-        a, b = np.searchsorted(sx, bx[i] - reach, "left"), np.searchsorted(sx, bx[i + 1] + reach, "right")
-        if a == b:
-            continue
-        px, py, idx = sx[a:b], sy[a:b], order[a:b]
-        for k in range(len(by) - 1):
-            d2 = (px - np.clip(px, bx[i], bx[i + 1])) ** 2 + (py - np.clip(py, by[k], by[k + 1])) ** 2
-            near = (d2 <= reach * reach) & ((home_i[idx] != i) | (home_k[idx] != k))
-            if not near.any():
-                continue
-            near[near] = top[i, k] - cutter_profile(d2[near], radius, corner) > out[idx[near]]
-            if near.any():
-                drop(i, k, idx[near])
-    span = scale + radius + 1.0
-    return (out + (CL_MARGIN * span if margin else 0.0)).reshape(shape_out)
+_PARTS = 4  # parts of a piece's cell each way, for the bounds of what the piece can lift the tool to
+
+
+def _piece_bounds(ev: PiecewiseEvaluator, cx, cy, radius: float, corner: float):
+    """``(position, piece, bound)`` for every piece within the tool's reach of each position (``piece``
+    numbered ``i * columns + k``): no contact on the piece puts the tool tip above ``bound``."""
+    bx, by = ev.breaks_x, ev.breaks_y
+    eps = 1e-9 * max(bx[-1] - bx[0], by[-1] - by[0], radius)  # rounding, as the box's own reach allows
+    reach = radius + eps
+    ni, nk = len(bx) - 1, len(by) - 1
+    # The columns and rows of cells within reach of each position: lo..hi.
+    i_lo = np.clip(np.searchsorted(bx[1:], cx - reach, "left"), 0, ni - 1)
+    i_hi = np.clip(np.searchsorted(bx[:-1], cx + reach, "right") - 1, 0, ni - 1)
+    k_lo = np.clip(np.searchsorted(by[1:], cy - reach, "left"), 0, nk - 1)
+    k_hi = np.clip(np.searchsorted(by[:-1], cy + reach, "right") - 1, 0, nk - 1)
+    wi, wk = int((i_hi - i_lo).max()) + 1, int((k_hi - k_lo).max()) + 1
+    pos = np.repeat(np.arange(cx.size), wi * wk)
+    di, dk = np.divmod(np.tile(np.arange(wi * wk), cx.size), wk)
+    i, k = i_lo[pos] + di, k_lo[pos] + dk
+    inside = (i <= i_hi[pos]) & (k <= k_hi[pos])
+    pos, i, k = pos[inside], i[inside], k[inside]
+    tops = ev.part_upper_heights(_PARTS)[i, k] + eps  # (pairs, parts, parts)
+    f = np.arange(_PARTS + 1) / _PARTS
+    x_edges = bx[i, None] + (bx[i + 1] - bx[i])[:, None] * f  # (pairs, parts + 1)
+    y_edges = by[k, None] + (by[k + 1] - by[k])[:, None] * f
+    x_edges[:, -1], y_edges[:, -1] = bx[i + 1], by[k + 1]
+    px, py = cx[pos, None], cy[pos, None]
+    gx = px - np.clip(px, x_edges[:, :-1], x_edges[:, 1:])  # (pairs, parts): to each part's nearest x
+    gy = py - np.clip(py, y_edges[:, :-1], y_edges[:, 1:])
+    d2 = gx[:, :, None] ** 2 + gy[:, None, :] ** 2
+    lifted = np.where(d2 <= reach * reach, tops - cutter_profile(d2, radius, corner), -np.inf)
+    bound = lifted.max(axis=(1, 2))
+    near = bound > -np.inf
+    return pos[near], (i * nk + k)[near], bound[near]
 
 
 def _piecewise_height_scale(ev: PiecewiseEvaluator) -> float:
@@ -233,6 +302,11 @@ def _inside_box(cx, cy, box, radius=0.0):
                             f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}{reach}")
     if radius == 0:
         return nx, ny
+    return _kept_within(cx, cy, nx, ny, d, radius)
+
+
+def _kept_within(cx, cy, nx, ny, d, radius: float):
+    """Positions ``d`` from their nearest box points ``nx, ny`` moved towards them to at most ``radius``."""
     f = np.where(d > radius, radius / np.where(d > 0, d, 1.0), 1.0)
     return nx + (cx - nx) * f, ny + (cy - ny) * f
 
@@ -332,12 +406,16 @@ def _drop_chunk(ev, cx, cy, radius, corner, lattice, spacing, starts, settle):
     first use, so that importing lagsym loads no compiler."""
     from .kernel import drop_chunk
 
-    ball = corner == radius
-    c = np.ascontiguousarray(ev.coefficients, dtype=float)
-    jet = jet_coefficients(ev) if ball else np.zeros((6 * c.shape[1], c.shape[0]))
-    geo = kernel_geometry(ev, ev.bounds, radius, corner, spacing, settle)
+    c, jet, geo = _kernel_surface(ev, radius, corner, spacing, settle)
     # Writable arrays everywhere, as a worker process receives them: Numba compiles one version per kind of array,
     # and a read-only lattice here would leave the workers to compile their own.
     lattice = [np.require(a, requirements="W") for a in lattice]
     cx, cy = np.require(cx, float, "CW"), np.require(cy, float, "CW")
-    return drop_chunk(c, jet, geo, cx, cy, *lattice, int(starts), ball)
+    return drop_chunk(c, jet, geo, cx, cy, *lattice, int(starts), corner == radius)
+
+
+def _kernel_surface(ev, radius, corner, spacing, settle):
+    """The kernel's surface arguments: the coefficients, the ball's jet coefficients and the geometry."""
+    c = np.ascontiguousarray(ev.coefficients, dtype=float)
+    jet = jet_coefficients(ev) if corner == radius else np.zeros((6 * c.shape[1], c.shape[0]))
+    return c, jet, kernel_geometry(ev, ev.bounds, radius, corner, spacing, settle)

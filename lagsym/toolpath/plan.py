@@ -19,7 +19,6 @@ from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator
 from ..machine import Placement, ProgramFormat, RasterSpec, Tool
 from ..progress import Progress, Tally
-from ..surfaces.piecewise import PiecewiseEvaluator
 from ..values import positive
 from . import chordal
 from .arcs import Arcs, fit_arcs
@@ -167,8 +166,8 @@ def plan_toolpath(surface, tool: Tool, raster: RasterSpec, placement: Placement 
     # Drop-cutter's compiled kernel loaded here (the first time, compiled), before the workers fork: they share it.
     with telling_compiles(progress):
         cl(np.array([ev.bounds[0]]), np.array([ev.bounds[2]]))
-    # Worker processes on the other cores where the plan pays for them; a piecewise surface's run in this process.
-    one = isinstance(ev, PiecewiseEvaluator) or len(levels) * len(along) < MIN_POINTS
+    # Worker processes on the other cores where the plan pays for them.
+    one = len(levels) * len(along) < MIN_POINTS
     with Workers(ev, 1 if one else None) as workers:
         cl = replace(cl, workers=workers)
         path = _fine_path(cl, levels, along, raster.direction, fine, past=past, progress=progress)
