@@ -93,11 +93,16 @@ class SurfaceFit:
         return Fraction(self.residual_numerators[k], self.residual_denominator)
 
     @cached_property
+    def _square_sum(self) -> int:
+        """The sum of the squared residual numerators (over the denominator squared: the unweighted RSS)."""
+        return sum(r * r for r in self.residual_numerators)
+
+    @cached_property
     def rss(self) -> Fraction:
         """The (weighted) residual sum of squares, exact."""
         d = self.residual_denominator
         if self.weights is None:
-            return Fraction(sum(r * r for r in self.residual_numerators), d * d)
+            return Fraction(self._square_sum, d * d)
         return sum((w * r * r for w, r in zip(self.weights, self.residual_numerators)), Fraction(0)) / (d * d)
 
     @property
@@ -105,12 +110,11 @@ class SurfaceFit:
         """The largest ``|z_k - p(x_k, y_k)|``."""
         return float(Fraction(max(abs(r) for r in self.residual_numerators), self.residual_denominator))
 
-    @property
+    @cached_property
     def rms(self) -> float:
         """The root mean square residual (unweighted)."""
         d = self.residual_denominator
-        return math.sqrt(float(Fraction(sum(r * r for r in self.residual_numerators), d * d))
-                         / len(self.residual_numerators))
+        return math.sqrt(float(Fraction(self._square_sum, d * d)) / len(self.residual_numerators))
 
     @property
     def sigma(self) -> float:
