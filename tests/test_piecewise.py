@@ -392,3 +392,29 @@ def test_drops_share_out_among_worker_processes_with_the_same_values():
         assert workers.parallel
         shared = drop_cutter(s, cx, cy, 2.5, workers=workers)
     assert np.array_equal(alone, shared)
+
+
+@pytest.mark.parametrize("parts", [4, 16])
+@pytest.mark.parametrize("corner", [3.0, 1.0, 0.0])
+def test_what_a_piece_can_lift_the_tool_to_is_never_understated(parts, corner):
+    """The bound drop-cutter rules pieces out by, against the float reference surface (built apart from lagsym)
+    less the cutter's profile on a dense grid of each piece's cell within the tool's reach."""
+    from lagsym.toolpath.dropcutter import _piece_bounds, _piece_pairs
+
+    g = wavy_grid(9, 8)
+    s, ref, radius = piecewise_surface(g), reference_surface(g), 3.0
+    rng = np.random.default_rng(3)
+    cx, cy = rng.uniform(-2, 42, 25), rng.uniform(-2, 42, 25)
+    pos, i, k = _piece_pairs(s.evaluator, cx, cy, radius)
+    bound = _piece_bounds(s.evaluator, cx, cy, (pos, i, k), radius, corner, parts=parts)
+    t = np.linspace(0.0, 1.0, 61)
+    flat = radius - corner
+    for p, a, b, top in zip(pos, i, k, bound):
+        x0, x1, y0, y1 = (float(v) for v in s.box(int(a), int(b)))
+        px, py = np.meshgrid(x0 + (x1 - x0) * t, y0 + (y1 - y0) * t)
+        d = np.hypot(px - cx[p], py - cy[p])
+        near = d <= radius
+        if not near.any():
+            continue
+        prof = np.where(d <= flat, 0.0, corner - np.sqrt(np.maximum(corner**2 - (d - flat) ** 2, 0.0)))
+        assert (ref.evaluate(px[near], py[near]) - prof[near]).max() <= top + 1e-9

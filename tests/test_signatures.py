@@ -16,7 +16,8 @@ MAX_POSITIONAL = 6
 # Compiled by Numba in nopython mode, where keyword-only arguments and dataclasses are not free: these take
 # their arrays and numbers by position, and Python reaches each only through one thin wrapper
 # (kernel.drop_chunk through dropcutter._drop_chunk, kernel.newton_starts through newton.newton_ball,
-# compiled.points_kernel through the evaluator); the others are called only by other kernels.
+# compiled.points_kernel through the evaluator, piecekernel.part_bounds through dropcutter._piece_bounds); the
+# others are called only by other kernels.
 KERNELS = {
     "toolpath/kernel.py:_values",
     "toolpath/kernel.py:_jet",
@@ -29,6 +30,7 @@ KERNELS = {
     "toolpath/kernel.py:_refine",
     "toolpath/kernel.py:drop_chunk",
     "toolpath/kernel.py:newton_starts",
+    "toolpath/piecekernel.py:part_bounds",
     "evaluate/compiled.py:_basis",
     "evaluate/compiled.py:points_kernel",
     "evaluate/compiled.py:_first_terms",

@@ -177,6 +177,11 @@ class PiecewiseSurface:
         """``A[a][b]``: piece ``(i, k)`` is ``sum A[a][b] s**a t**b``, ``s, t`` the cell's coordinates on ``[0, 1]``."""
         return _rows(self._local(i, k))
 
+    def local_entries(self, i: int, k: int) -> list:
+        """The 16 exact local coefficients of piece ``(i, k)`` row by row (``A[0][0], A[0][1], ...``), as
+        python-flint rationals."""
+        return self._local(i, k).entries()
+
     def _local(self, i: int, k: int) -> flint.fmpq_mat:
         found = self._locals.get((i, k))
         if found is None:
@@ -296,7 +301,8 @@ class PiecewiseSurface:
         """The piece whose cell holds ``(x, y)`` (a point on a border: the piece above and right of it)."""
         g = self.grid
         n, m = self.shape
-        return min(max(bisect_right(g.x, Fraction(x)) - 1, 0), n - 1), min(max(bisect_right(g.y, Fraction(y)) - 1, 0), m - 1)
+        i = min(max(bisect_right(g.x, Fraction(x)) - 1, 0), n - 1)
+        return i, min(max(bisect_right(g.y, Fraction(y)) - 1, 0), m - 1)
 
     def exact_value(self, x, y) -> Fraction:
         """``F(x, y)`` exactly, from the piece whose cell holds the point."""

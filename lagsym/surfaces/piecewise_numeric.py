@@ -36,7 +36,8 @@ def _local_derivative(a: np.ndarray, d: int) -> np.ndarray:
 
 
 class PiecewiseEvaluator:
-    """The numeric (float64) evaluator of a :class:`~lagsym.surfaces.piecewise.PiecewiseSurface`, as the planner asks one.
+    """The numeric (float64) evaluator of a :class:`~lagsym.surfaces.piecewise.PiecewiseSurface`, as the planner
+    asks one.
 
     ``bounds``, ``fast_points`` (values and partial derivatives at scattered
     points) and ``curvature_bound`` answer as
@@ -51,8 +52,9 @@ class PiecewiseEvaluator:
         self.breaks_y = readonly(np.array([float(v) for v in g.y]))
         self.bounds = (float(g.x[0]), float(g.x[-1]), float(g.y[0]), float(g.y[-1]))
         n, m = surface.shape
-        self.local = readonly(np.array([[[[float(a) for a in row] for row in surface.local_coefficients(i, k)]
-                                         for k in range(m)] for i in range(n)]))
+        # int / int is correctly rounded, as float(Fraction) is
+        self.local = readonly(np.array([[[[int(v.p) / int(v.q) for v in surface.local_entries(i, k)[a:a + 4]]
+                                          for a in (0, 4, 8, 12)] for k in range(m)] for i in range(n)]))
         self._derivatives: dict = {}
 
     @cached_property
@@ -84,9 +86,10 @@ class PiecewiseEvaluator:
                                     for a in range(4)]) for lo, hi in zip(edges[:-1], edges[1:])]
             pad = 1e-12 * (np.abs(self.local).max(axis=(2, 3)) + 1.0)
             found = np.empty(self.local.shape[:2] + (parts, parts))
+            across = np.stack(change).transpose(0, 2, 1)  # (parts, 4, 4): [q, b, l]
             for p, cx in enumerate(change):
-                for q, cy in enumerate(change):
-                    found[:, :, p, q] = np.einsum("ja,ikab,lb->ikjl", cx, self.local, cy).max(axis=(2, 3)) + pad
+                nets = np.matmul(np.matmul(cx, self.local)[:, :, None], across)  # [i, k, q, j, l]: row p's parts
+                found[:, :, p, :] = nets.max(axis=(3, 4)) + pad[:, :, None]
             found = self._part_tops[parts] = readonly(found)
         return found
 

@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial import chebyshev as C
 
-from ..cutter import corner_radius, cutter_profile
+from ..cutter import corner_radius
 from ..errors import ToolpathError
 from ..evaluate import SurfaceEvaluator, surface_evaluator
 from ..progress import COMPILING, Progress
@@ -174,8 +174,10 @@ def _drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, 
     if radius == 0:
         return ev.fast_points(cx, cy).reshape(shape_out)
     parallel = workers is not None and workers.parallel and workers.evaluator is ev
-    # Each position's value is independent of the chunk it is computed in; a chunk walks every column of pieces
-    # in Python, so chunks are large.
+    for parts in (_PARTS, _fine_parts(ev)):  # made here once, not in each worker
+        ev.part_upper_heights(parts)
+    # Each position's value is independent of the chunk it is computed in; a chunk takes its pieces in rounds
+    # from Python, so chunks are large.
     chunk = max(_PIECEWISE_CHUNK, -(-cx.size // (2 * workers.processes))) if parallel else cx.size
     tasks = [(cx[s:s + chunk], cy[s:s + chunk], (radius, corner), (lattice, starts)) for s in range(0, cx.size, chunk)]
     parts = workers.map(_piecewise_chunk, tasks) if parallel else [_piecewise_chunk(ev, *t) for t in tasks]
@@ -193,12 +195,12 @@ def _piecewise_chunk(ev: PiecewiseEvaluator, cx, cy, cutter: tuple[float, float]
     ``cutter`` is ``(radius, corner)``, ``search`` ``(lattice, starts)`` as :func:`drop_cutter` takes them.
 
     Each piece within reach of a position has a bound no contact on it
-    exceeds: over each of its cell's :data:`_PARTS` x :data:`_PARTS` parts
-    within reach, the part's highest Bezier control point less the cutter's
-    profile at the part's nearest point, the largest of these.  In rounds,
-    each position drops onto its piece of highest bound not yet dropped on,
-    while that bound is above the height found; so the piece the tool rests
-    on usually comes first, and the rest are mostly ruled out by their bound.
+    exceeds (:mod:`.piecekernel`), from :data:`_PARTS` x :data:`_PARTS` parts
+    of its cell.  In rounds, each position drops onto its piece of highest
+    bound not yet dropped on, while that bound is above the height found; so
+    the piece the tool rests on usually comes first.  After the first round,
+    the pieces still in question get the closer bound of
+    :func:`_fine_parts` parts, which rules out most of them.
     """
     (radius, corner), (lattice, starts) = cutter, search
     bx, by = ev.breaks_x, ev.breaks_y
@@ -212,9 +214,13 @@ def _piecewise_chunk(ev: PiecewiseEvaluator, cx, cy, cutter: tuple[float, float]
     grid = [np.require(a, requirements="W") for a in _lattice(radius, spacing)]
     settle = 0.01 * CL_MARGIN * (scale + radius + 1.0)  # one settling threshold for every piece, the whole surface's
     surfaces = {}
-    pos, piece, bound = _piece_bounds(ev, cx, cy, radius, corner)
+    pos, i, k = _piece_pairs(ev, cx, cy, radius)
+    bound = _piece_bounds(ev, cx, cy, (pos, i, k), radius, corner, parts=_PARTS)
+    near = bound > -np.inf
+    pos, piece, bound = pos[near], (i * (len(by) - 1) + k)[near], bound[near]
     out = np.full(cx.shape, -np.inf)
     columns = len(by) - 1
+    fine = _fine_parts(ev)
     while pos.size:
         # The first pair of each position, by highest bound: its next piece to drop on.
         order = np.lexsort((-bound, pos))
@@ -237,18 +243,29 @@ def _piecewise_chunk(ev: PiecewiseEvaluator, cx, cy, cutter: tuple[float, float]
             out[group] = np.maximum(out[group], z)
         keep = ~first & (bound > out[pos])
         pos, piece, bound = pos[keep], piece[keep], bound[keep]
+        if fine > _PARTS and pos.size:
+            bound = _piece_bounds(ev, cx, cy, (pos, *np.divmod(piece, columns)), radius, corner, parts=fine)
+            keep = bound > out[pos]
+            pos, piece, bound = pos[keep], piece[keep], bound[keep]
+            fine = _PARTS
     return out
 
 
 _PARTS = 4  # parts of a piece's cell each way, for the bounds of what the piece can lift the tool to
 
 
-def _piece_bounds(ev: PiecewiseEvaluator, cx, cy, radius: float, corner: float):
-    """``(position, piece, bound)`` for every piece within the tool's reach of each position (``piece``
-    numbered ``i * columns + k``): no contact on the piece puts the tool tip above ``bound``."""
+def _fine_parts(ev: PiecewiseEvaluator) -> int:
+    """Parts each way of the closer bounds: 16 (256 bounds a piece kept) while the pieces are few enough for
+    them to take tens of megabytes at most, fewer for more pieces."""
+    pieces = (len(ev.breaks_x) - 1) * (len(ev.breaks_y) - 1)
+    return 16 if pieces <= 20_000 else 8 if pieces <= 80_000 else _PARTS
+
+
+def _piece_pairs(ev: PiecewiseEvaluator, cx, cy, radius: float):
+    """``(position, i, k)`` for every piece ``(i, k)`` whose cell's bounding columns and rows come within the
+    tool's reach of each position."""
     bx, by = ev.breaks_x, ev.breaks_y
-    eps = 1e-9 * max(bx[-1] - bx[0], by[-1] - by[0], radius)  # rounding, as the box's own reach allows
-    reach = radius + eps
+    reach = radius + _piece_eps(ev, radius)
     ni, nk = len(bx) - 1, len(by) - 1
     # The columns and rows of cells within reach of each position: lo..hi.
     i_lo = np.clip(np.searchsorted(bx[1:], cx - reach, "left"), 0, ni - 1)
@@ -260,20 +277,27 @@ def _piece_bounds(ev: PiecewiseEvaluator, cx, cy, radius: float, corner: float):
     di, dk = np.divmod(np.tile(np.arange(wi * wk), cx.size), wk)
     i, k = i_lo[pos] + di, k_lo[pos] + dk
     inside = (i <= i_hi[pos]) & (k <= k_hi[pos])
-    pos, i, k = pos[inside], i[inside], k[inside]
-    tops = ev.part_upper_heights(_PARTS)[i, k] + eps  # (pairs, parts, parts)
-    f = np.arange(_PARTS + 1) / _PARTS
-    x_edges = bx[i, None] + (bx[i + 1] - bx[i])[:, None] * f  # (pairs, parts + 1)
-    y_edges = by[k, None] + (by[k + 1] - by[k])[:, None] * f
-    x_edges[:, -1], y_edges[:, -1] = bx[i + 1], by[k + 1]
-    px, py = cx[pos, None], cy[pos, None]
-    gx = px - np.clip(px, x_edges[:, :-1], x_edges[:, 1:])  # (pairs, parts): to each part's nearest x
-    gy = py - np.clip(py, y_edges[:, :-1], y_edges[:, 1:])
-    d2 = gx[:, :, None] ** 2 + gy[:, None, :] ** 2
-    lifted = np.where(d2 <= reach * reach, tops - cutter_profile(d2, radius, corner), -np.inf)
-    bound = lifted.max(axis=(1, 2))
-    near = bound > -np.inf
-    return pos[near], (i * nk + k)[near], bound[near]
+    return pos[inside], i[inside], k[inside]
+
+
+def _piece_eps(ev: PiecewiseEvaluator, radius: float) -> float:
+    """Rounding allowed in reach and height, as the box's own reach allows."""
+    bx, by = ev.breaks_x, ev.breaks_y
+    return 1e-9 * max(bx[-1] - bx[0], by[-1] - by[0], radius)
+
+
+def _piece_bounds(ev: PiecewiseEvaluator, cx, cy, pairs, radius: float, corner: float, *, parts: int) -> np.ndarray:
+    """For each pair ``(position, i, k)`` of ``pairs``, a height no contact on piece ``(i, k)`` puts the tool
+    tip above at that position, from ``parts`` x ``parts`` parts of its cell (:mod:`.piecekernel`); ``-inf``
+    where no part is within reach."""
+    from .piecekernel import part_bounds
+
+    pos, i, k = (np.ascontiguousarray(a, dtype=np.int64) for a in pairs)
+    eps = _piece_eps(ev, radius)
+    tops = ev.part_upper_heights(parts)
+    return part_bounds(np.ascontiguousarray(cx, dtype=float), np.ascontiguousarray(cy, dtype=float), pos, i, k,
+                       np.ascontiguousarray(ev.breaks_x), np.ascontiguousarray(ev.breaks_y),
+                       np.ascontiguousarray(tops), float(radius), float(corner), (radius + eps) ** 2) + eps
 
 
 def _piecewise_height_scale(ev: PiecewiseEvaluator) -> float:
