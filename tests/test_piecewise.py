@@ -399,7 +399,7 @@ def test_drops_share_out_among_worker_processes_with_the_same_values():
 def test_what_a_piece_can_lift_the_tool_to_is_never_understated(parts, corner):
     """The bound drop-cutter rules pieces out by, against the float reference surface (built apart from lagsym)
     less the cutter's profile on a dense grid of each piece's cell within the tool's reach."""
-    from lagsym.toolpath.dropcutter import _piece_bounds, _piece_pairs
+    from lagsym.toolpath.droppieces import _piece_bounds, _piece_pairs
 
     g = wavy_grid(9, 8)
     s, ref, radius = piecewise_surface(g), reference_surface(g), 3.0
@@ -418,3 +418,15 @@ def test_what_a_piece_can_lift_the_tool_to_is_never_understated(parts, corner):
             continue
         prof = np.where(d <= flat, 0.0, corner - np.sqrt(np.maximum(corner**2 - (d - flat) ** 2, 0.0)))
         assert (ref.evaluate(px[near], py[near]) - prof[near]).max() <= top + 1e-9
+
+
+def test_every_pieces_jets_at_once_are_each_pieces_own():
+    """The jets made for all pieces at once (for the worker processes) are those of each piece's evaluator."""
+    from lagsym.toolpath.newton import jet_coefficients
+
+    s = piecewise_surface(wavy_grid(9, 7))
+    jets = s.evaluator.piece_jets
+    assert jets.shape == (8, 6, 24, 4)
+    for i in range(8):
+        for k in range(6):
+            assert np.array_equal(jets[i, k], jet_coefficients(s.piece_evaluator(i, k)))

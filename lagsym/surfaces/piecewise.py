@@ -192,15 +192,22 @@ class PiecewiseSurface:
     def _locals(self) -> dict:
         return {}
 
+    @cached_property
+    def _node_data(self) -> tuple:
+        """The heights, slopes, twists and cell widths as python-flint rationals, converted once."""
+        g = self.grid
+        tables = tuple([[_fmpq(v) for v in row] for row in t] for t in (g.z, self.zx, self.zy, self.zxy))
+        widths = tuple([_fmpq(b - a) for a, b in zip(v, v[1:])] for v in (g.x, g.y))
+        return tables, widths
+
     def _hermite(self, i: int, k: int) -> flint.fmpq_mat:
-        x0, x1, y0, y1 = self.box(i, k)
-        hx, hy = x1 - x0, y1 - y0
-        z, zx, zy, zxy = self.grid.z, self.zx, self.zy, self.zxy
+        (z, zx, zy, zxy), (wx, wy) = self._node_data
+        hx, hy = wx[i], wy[k]
         rows = (i, i + 1)
         cols = (k, k + 1)
         g = [[z[r][c] for c in cols] + [hy * zy[r][c] for c in cols] for r in rows]
         g += [[hx * zx[r][c] for c in cols] + [hx * hy * zxy[r][c] for c in cols] for r in rows]
-        return _M * flint.fmpq_mat([[_fmpq(v) for v in row] for row in g]) * _M.transpose()
+        return _M * flint.fmpq_mat(g) * _M.transpose()
 
     def coefficients(self, i: int, k: int) -> tuple[tuple[Fraction, ...], ...]:
         """``C[a][b]``: piece ``(i, k)`` is ``sum C[a][b] x**a y**b`` (the order of :class:`LagrangeSurface`)."""
@@ -254,8 +261,11 @@ class PiecewiseSurface:
         return {}, {}
 
     def _axis_change(self, axis: int, j: int):
-        """``(offset, scale, G, nodes)`` of cell ``j`` along ``axis``: ``G`` maps cell-coordinate powers to the
-        Chebyshev basis of the cell's ``[-1, 1]`` map, ``nodes`` the cell's four thirds."""
+        """``(offset, scale, G, floats, exact)`` of cell ``j`` along ``axis``: ``G`` maps cell-coordinate powers
+        to the Chebyshev basis of the cell's ``[-1, 1]`` map; ``floats`` are the cell's four thirds as floats
+        (read-only) and ``exact`` which of them are exact."""
+        import numpy as np
+
         from ..evaluate.chebyshev import chebyshev_transform
 
         found = self._to_chebyshev[axis].get(j)
@@ -264,7 +274,11 @@ class PiecewiseSurface:
             a, b = nodes[j], nodes[j + 1]
             thirds = [a + (b - a) * Fraction(p, 3) for p in range(4)]
             offset, scale, d = chebyshev_transform(thirds)
-            found = self._to_chebyshev[axis][j] = (offset, scale, d * _to_power(a, b - a).transpose(), thirds)
+            floats = np.array([float(t) for t in thirds])
+            exact = np.array([Fraction(float(t)) == t for t in thirds])
+            floats.setflags(write=False)
+            exact.setflags(write=False)
+            found = self._to_chebyshev[axis][j] = (offset, scale, d * _to_power(a, b - a).transpose(), floats, exact)
         return found
 
     def _make_evaluator(self, i: int, k: int):
@@ -273,28 +287,21 @@ class PiecewiseSurface:
         from ..evaluate.chebyshev import data_range
         from ..evaluate.surface import SurfaceEvaluator
 
-        (xo, xh, gx, xs), (yo, yh, gy, ys) = self._axis_change(0, i), self._axis_change(1, k)
+        (xo, xh, gx, xn, xe), (yo, yh, gy, yn, ye) = self._axis_change(0, i), self._axis_change(1, k)
         a = self._local(i, k)
         cheb = gx * a * gy.transpose()
         values = _THIRDS * a * _THIRDS.transpose()  # the piece's heights on its 4 x 4 grid of thirds
 
-        def floats(mat, n=4, m=4):
+        def floats(mat):
             # int / int is correctly rounded, as float(Fraction) is
-            out = np.array([[int(mat[p, q].p) / int(mat[p, q].q) for q in range(m)] for p in range(n)])
+            out = np.array([int(v.p) / int(v.q) for v in mat.entries()]).reshape(4, 4)
             out.setflags(write=False)
             return out
 
-        def nodes(v):
-            out = np.array([float(t) for t in v])
-            exact = np.array([Fraction(float(t)) == t for t in v])
-            out.setflags(write=False)
-            exact.setflags(write=False)
-            return out, exact
-
-        (xn, xe), (yn, ye), z = nodes(xs), nodes(ys), floats(values)
+        z = floats(values)
         return SurfaceEvaluator(x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh, coefficients=floats(cheb),
-                                data_range=data_range(z.ravel()), bounds=(float(xs[0]), float(xs[-1]),
-                                                                          float(ys[0]), float(ys[-1])),
+                                data_range=data_range(z.ravel()), bounds=(float(xn[0]), float(xn[-1]),
+                                                                          float(yn[0]), float(yn[-1])),
                                 x_nodes=xn, y_nodes=yn, x_exact=xe, y_exact=ye, node_values=z)
 
     def locate(self, x, y) -> tuple[int, int]:

@@ -27,6 +27,25 @@ def _axis(breaks: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return i, (v - breaks[i]) / (breaks[i + 1] - breaks[i])
 
 
+def _chebder(c: np.ndarray, cnt: int, scl) -> np.ndarray:
+    """:func:`numpy.polynomial.chebyshev.chebder` along the first axis with ``scl`` an array over the others:
+    the same operations in the same order, so each slice is what ``chebder`` gives it with its own ``scl``."""
+    c = np.array(c, dtype=float)
+    n = len(c)
+    for _ in range(cnt):
+        n = n - 1
+        c *= scl
+        der = np.empty((n,) + c.shape[1:])
+        for j in range(n, 2, -1):
+            der[j - 1] = (2 * j) * c[j]
+            c[j - 2] += (j * c[j]) / (j - 2)
+        if n > 1:
+            der[1] = 4 * c[2]
+        der[0] = c[1]
+        c = der
+    return c
+
+
 def _local_derivative(a: np.ndarray, d: int) -> np.ndarray:
     """Coefficients along the last axis of ``a`` differentiated ``d`` times (the same length, zero-padded)."""
     for _ in range(d):
@@ -53,8 +72,8 @@ class PiecewiseEvaluator:
         self.bounds = (float(g.x[0]), float(g.x[-1]), float(g.y[0]), float(g.y[-1]))
         n, m = surface.shape
         # int / int is correctly rounded, as float(Fraction) is
-        self.local = readonly(np.array([[[[int(v.p) / int(v.q) for v in surface.local_entries(i, k)[a:a + 4]]
-                                          for a in (0, 4, 8, 12)] for k in range(m)] for i in range(n)]))
+        self.local = readonly(np.array([[[int(v.p) / int(v.q) for v in surface.local_entries(i, k)]
+                                         for k in range(m)] for i in range(n)]).reshape(n, m, 4, 4))
         self._derivatives: dict = {}
 
     @cached_property
@@ -204,6 +223,28 @@ class PiecewiseEvaluator:
         top = 0.5 * (xx_hi + yy_hi) + np.sqrt(0.25 * (xx_hi - yy_hi) ** 2 + b * b)
         low = 0.5 * (xx_lo + yy_lo) - np.sqrt(0.25 * (xx_lo - yy_lo) ** 2 + b * b)
         return max(float(top.max()), 0.0), float(np.maximum(top, -low).max())
+
+    @cached_property
+    def piece_jets(self) -> np.ndarray:
+        """``[i, k]``: piece ``(i, k)``'s Chebyshev coefficients of ``F, F_x, F_y, F_xx, F_xy, F_yy`` stacked
+        ``(24, 4)``, as :func:`lagsym.toolpath.newton.jet_coefficients` gives them (bit for bit), for every piece
+        at once; each piece's evaluator is made on the way (:meth:`piece_evaluator`)."""
+        n, m = self.local.shape[:2]
+        evs = [[self.piece_evaluator(i, k) for k in range(m)] for i in range(n)]
+        c = np.array([[e.coefficients for e in row] for row in evs])  # (n, m, 4, 4)
+        sx = np.array([row[0].x_scale for row in evs])[:, None, None]  # per column of cells, over (n, m, 4)
+        sy = np.array([evs[0][k].y_scale for k in range(m)])[None, :, None]
+        parts = []
+        for dx, dy in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
+            d = c
+            if dx:
+                d = np.moveaxis(_chebder(np.moveaxis(d, 2, 0), dx, 1.0 / sx), 0, 2)
+            if dy:
+                d = np.moveaxis(_chebder(np.moveaxis(d, 3, 0), dy, 1.0 / sy), 0, 3)
+            pad = np.zeros((n, m, 4, 4))
+            pad[:, :, :d.shape[2], :d.shape[3]] = d
+            parts.append(np.swapaxes(pad, 2, 3))
+        return readonly(np.ascontiguousarray(np.concatenate(parts, axis=2)))
 
     def piece_evaluator(self, i: int, k: int):
         """The :class:`~lagsym.evaluate.SurfaceEvaluator` of piece ``(i, k)``, made on first use (kept by the

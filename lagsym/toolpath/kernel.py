@@ -409,7 +409,7 @@ def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton)
     """Drop-cutter values (tip heights, no margin) at the tool positions ``cx, cy``.
 
     ``offsets``, ``reach2``, ``nb`` and ``nearest`` are the lattice and rim
-    (:func:`.dropcutter._lattice`); ``starts`` candidates are refined, with
+    (:func:`.droplattice._lattice`); ``starts`` candidates are refined, with
     ``newton`` (a ball) first by Newton steps.
     """
     n, m = c.shape
