@@ -136,10 +136,11 @@ def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
     den = _common_denominator([c for row in coefficients for c in row])
     P, Q = len(coefficients) - 1, len(coefficients[0]) - 1
     n = len(s.X)
-    col = flint.fmpz_mat((P + 1) * (Q + 1), 1, [int(c * den) for row in coefficients for c in row])
-    xs = [[x ** a * s.dx ** (P - a) for a in range(P + 1)] for x in s.X]
-    ys = [[y ** b * s.dy ** (Q - b) for b in range(Q + 1)] for y in s.Y]
-    basis = flint.fmpz_mat(n, (P + 1) * (Q + 1), [u * v for rx, ry in zip(xs, ys) for u in rx for v in ry])
-    values = basis * col
+    # inner[k, a] = sum_b C[a][b] Y_k**b dy**(Q-b): one integer matrix product; then each point's sum over a.
+    ys = flint.fmpz_mat(n, Q + 1, [y ** b * s.dy ** (Q - b) for y in s.Y for b in range(Q + 1)])
+    cs = flint.fmpz_mat(Q + 1, P + 1, [int(coefficients[a][b] * den) for b in range(Q + 1) for a in range(P + 1)])
+    inner = (ys * cs).entries()
+    xs = [s.dx ** (P - a) for a in range(P + 1)]
+    values = [sum(int(inner[k * (P + 1) + a]) * x ** a * xs[a] for a in range(P + 1)) for k, x in enumerate(s.X)]
     scale = den * s.dx ** P * s.dy ** Q
-    return tuple(z * scale - int(values[k, 0]) * s.dz for k, z in enumerate(s.Z)), scale * s.dz
+    return tuple(z * scale - v * s.dz for z, v in zip(s.Z, values)), scale * s.dz
