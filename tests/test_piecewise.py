@@ -274,8 +274,10 @@ def test_the_measured_data_page_quotes_the_figures(tmp_path, monkeypatch):
     out, err = io.StringIO(), io.StringIO()
     main(["check", str(src)], out, err)
     amp = re.search(r"surface amplification of data errors: (\S+) ", out.getvalue()).group(1)
-    over = re.search(r"overshoot between nodes: (\S+) \((\S+) of the data range", out.getvalue()).groups()
-    assert f"up to {amp} times" in page and f"overshoots by {over[0]} ({over[1]} of the data range)" in page
+    over = re.search(r"overshoot between nodes: (\S+) sampled, .*; at most (\S+) \((\S+) of the data range",
+                     out.getvalue()).groups()
+    assert f"up to {amp} times" in page
+    assert f"overshoots by {over[0]} (at most {over[1]}, {over[2]} of the data range)" in page
     monkeypatch.chdir(tmp_path)
     (tmp_path / "examples").symlink_to(EXAMPLES)
     out, err = io.StringIO(), io.StringIO()

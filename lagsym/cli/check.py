@@ -17,7 +17,8 @@ conditioned at any degree), the spacing ratio between the directions, the
 Lebesgue constant of each node set, the surface's amplification of errors in
 its points (their product; a fitted surface file's own figure), which the
 commands that machine or export a surface refuse above 100, and the overshoot
-of the interpolant between the nodes.  Warnings go to standard output; the
+of the interpolant between the nodes (sampled, and at most, certified from its
+Bezier form).  Warnings go to standard output; the
 exit status is 0, or 1 with --strict when there is a warning.
 
 examples:
