@@ -22,15 +22,15 @@ from fractions import Fraction
 
 import numpy as np
 
-from .cad.extremes import height_bounds
+from .cad.extremes import Overshoot, overshoot
 from .errors import ConditioningError
-from .evaluate import evaluate_grid, surface_evaluator
+from .evaluate import surface_evaluator
 from .grid import ControlGrid
 from .lagrange import LagrangeSurface
 
 __all__ = [
     "Finding", "CheckReport", "check_surface", "check_curve", "float_error_bound", "lebesgue_constant",
-    "DEGREE_LIMIT", "SPACING_LIMIT", "LEBESGUE_LIMIT", "OVERSHOOT_LIMIT", "FLOAT_ERROR_LIMIT",
+    "DEGREE_LIMIT", "SPACING_LIMIT", "LEBESGUE_LIMIT", "OVERSHOOT_LIMIT", "OVERSHOOT_REFUSED", "FLOAT_ERROR_LIMIT",
     "AMPLIFICATION_LIMIT", "Amplification", "amplification", "require_conditioning", "lebesgue_maximum",
 ]
 
@@ -43,6 +43,7 @@ LEBESGUE_LIMIT = 10.0  # data errors amplified more than tenfold
 # degree lagsym fits (12x12 of them: 6.2).
 AMPLIFICATION_LIMIT = 100.0
 OVERSHOOT_LIMIT = 0.10  # the surface leaves the data range by more than 10 % of it
+OVERSHOOT_REFUSED = 1.0  # ... by more than the whole range: what the commands that machine or export refuse
 FLOAT_ERROR_LIMIT = 1e-12  # numeric samples trusted to this fraction of the data range
 EPS = float(np.finfo(float).eps)
 # Neighbouring nodes closer than this fraction of their span (64 units of rounding at the span's end) are refused:
@@ -305,6 +306,30 @@ def require_conditioning(surface, *, accept: bool = False, limit: float = AMPLIF
     return a
 
 
+def require_overshoot(surface: LagrangeSurface, *, accept: bool = False,
+                      limit: float = OVERSHOOT_REFUSED) -> Overshoot:
+    """The interpolant's :class:`~lagsym.cad.extremes.Overshoot`, refused above ``limit`` (a share of the data
+    range, certified) unless ``accept``: a surface that leaves its points' heights by more than their whole
+    range between them is not the part they describe.
+
+    Raises
+    ------
+    ConditioningError
+        Naming the figure, where it was seen, and the ways out.
+    """
+    o = overshoot(surface)
+    if o.share > limit and not accept:
+        g = surface.grid
+        raise ConditioningError(
+            f"{g.source}: the surface leaves its points' heights by up to {o.most:.4g} between them "
+            f"({100 * o.share:.3g}% of their range {o.data_range:.4g}, certified; seen near (x, y) = "
+            f"({o.at[0]:.4g}, {o.at[1]:.4g})), "
+            f"above lagsym's limit of {100 * limit:g}%; fit the points instead (lagsym fit {g.source} -o "
+            f"surface.json), join them by smooth pieces (lagsym piecewise {g.source} -o pieces.json), or give "
+            f"--accept-conditioning to use it as it is")
+    return o
+
+
 def float_error_bound(surface: LagrangeSurface, box: tuple[float, float, float, float] | None = None) -> float:
     """A bound on the floating-point error of the numeric evaluator, as a fraction of the data range.
 
@@ -366,23 +391,12 @@ def check_surface(surface: LagrangeSurface, samples_per_interval: int = 24) -> C
                    f"points 'lagsym piecewise'"
                    if amp.exceeds else f" (limit {AMPLIFICATION_LIMIT:g})"))
     )
-    xs = np.linspace(g.x_array[0], g.x_array[-1], dx * samples_per_interval + 1)
-    ys = np.linspace(g.y_array[0], g.y_array[-1], dy * samples_per_interval + 1)
-    zs = evaluate_grid(surface, xs, ys)
-    zmin, zmax = float(g.z_array.min()), float(g.z_array.max())
-    zrange = zmax - zmin
-    over = max(float(zs.max()) - zmax, zmin - float(zs.min()), 0.0)
-    i, j = np.unravel_index(np.argmax(np.maximum(zs - zmax, zmin - zs)), zs.shape)
-    # The samples show how far it goes at least; the Bezier form bounds how far it can go (the figure judged).
-    lo, hi = height_bounds(surface, reached=(float(zs.min()), float(zs.max())),
-                           tolerance=1e-3 * max(zrange, abs(zmax), abs(zmin), 1e-300))
-    most = max(hi - zmax, zmin - lo, over, 0.0)
-    rel = most / zrange if zrange > 0 else (0.0 if most <= 1e-9 * max(abs(zmax), 1.0) else float("inf"))
+    o = overshoot(surface, samples_per_interval)
     findings.append(
-        Finding("overshoot", rel, OVERSHOOT_LIMIT, rel > OVERSHOOT_LIMIT,
-                f"overshoot between nodes: {over:.4g} sampled, worst near (x, y) = ({xs[i]:.4g}, {ys[j]:.4g}); "
-                f"at most {most:.4g} ({100 * rel:.3g}% of the data range {zrange:.4g}), certified from the "
-                f"Bezier form")
+        Finding("overshoot", o.share, OVERSHOOT_LIMIT, o.share > OVERSHOOT_LIMIT,
+                f"overshoot between nodes: {o.sampled:.4g} sampled, worst near (x, y) = ({o.at[0]:.4g}, "
+                f"{o.at[1]:.4g}); at most {o.most:.4g} ({100 * o.share:.3g}% of the data range "
+                f"{o.data_range:.4g}), certified from the Bezier form")
     )
     err = float_error_bound(surface)
     bad = err > FLOAT_ERROR_LIMIT

@@ -142,3 +142,70 @@ def test_the_override_is_recorded_in_the_macro_header(run_cli, tmp_path, noisy):
                              "--stepover", "10", "--step", "10", "-o", prog, "--accept-conditioning")
     assert status == 0, err
     assert "(CONDITIONING 2623X ABOVE 100 ACCEPTED --ACCEPT-CONDITIONING)" in prog.read_text().splitlines()[:8]
+
+
+def checkerboard(tmp_path):
+    """7 x 7 nodes of 0 and 1 alternating: well-spaced enough (amplification 20.7), but the interpolant swings
+    between them far beyond its points' heights."""
+    src = tmp_path / "checker.json"
+    n = 7
+    src.write_text(json.dumps({"x": [2 * i for i in range(n)], "y": [2 * k for k in range(n)],
+                               "z": [[(i + k) % 2 for k in range(n)] for i in range(n)]}))
+    return src
+
+
+def brute_interpolant(nodes, z, t):
+    """The interpolant on the grid ``t x t``, from the Lagrange basis as the plain product formula."""
+    nodes = np.asarray(nodes, dtype=float)
+    basis = np.array([np.prod([(t - xj) / (xi - xj) for j, xj in enumerate(nodes) if j != i], axis=0)
+                      for i, xi in enumerate(nodes)])
+    return basis.T @ np.asarray(z, dtype=float) @ basis
+
+
+def test_the_checkerboard_really_leaves_its_heights_by_more_than_their_range():
+    n = 7
+    swing = brute_interpolant([2 * i for i in range(n)], [[(i + k) % 2 for k in range(n)] for i in range(n)],
+                              np.linspace(0, 12, 1201))
+    assert swing.max() - 1 > 1.0 or 0 - swing.min() > 1.0  # more than the whole range of 1 beyond it
+
+
+@pytest.mark.parametrize("command, extra", [
+    ("toolpath", ("--tool-diameter", "2")), ("macro", ("--tool-diameter", "2")), ("sample", ("--nx", "5")),
+    ("export", ()), ("rough", ("--stock-above", "2", "--tool-diameter", "4")),
+])
+def test_commands_refuse_a_surface_that_overshoots_its_points_by_more_than_their_range(run_cli, tmp_path, command,
+                                                                                         extra):
+    src = checkerboard(tmp_path)
+    assert amplification(read_points(src)).value < AMPLIFICATION_LIMIT
+    out_file = tmp_path / ("o.step" if command == "export" else "o.csv" if command == "sample" else "o.nc")
+    status, out, err = run_cli(command, src, "-o", out_file, *extra)
+    assert status == 2 and err.count("\n") == 1 and err.startswith("lagsym: error:"), err
+    assert "leaves its points' heights by up to 7.099 between them (710% of their range 1, certified" in err
+    assert "lagsym fit" in err and "--accept-conditioning" in err and not out_file.exists()
+
+
+def test_an_overshoot_accepted_is_said_and_recorded_in_the_program_header(run_cli, tmp_path):
+    src = checkerboard(tmp_path)
+    status, out, err = run_cli("toolpath", src, "--tool-diameter", "2", "--stepover", "2", "-o", tmp_path / "o.nc",
+                               "--accept-conditioning")
+    assert status == 0 and "above the limit of 100%: accepted with --accept-conditioning" in err
+    head = (tmp_path / "o.nc").read_text()[:3000].upper()
+    assert "(OVERSHOOT 710 PERCENT OF THE DATA RANGE ABOVE 100 PERCENT ACCEPTED --ACCEPT-CONDITIONING)" in head
+
+
+def test_the_measured_data_page_quotes_the_overshoot_figures(run_cli, tmp_path, monkeypatch):
+    from conftest import ROOT
+
+    from lagsym.cad.extremes import overshoot
+
+    text = (ROOT / "docs" / "measured-data.md").read_text()
+    page = " ".join(text.split())
+    src = checkerboard(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_cli("toolpath", "checker.json", "-o", "part.nc")
+    assert status == 2 and err.strip() in text.splitlines()
+    amp, o = amplification(read_points(src)), overshoot(lagrange_surface(read_points(src)))
+    assert f"amplify {amp.value:.3g} times, yet the interpolant reaches {o.most:.2g} beyond them" in page
+    papers = max(overshoot(lagrange_surface(read_points(EXAMPLES / f"paper-example-{k}.json"))).share
+                 for k in (1, 2, 3, 4))
+    assert f"(the paper's examples reach {100 * papers:.0f} %)" in page and papers < 1.0

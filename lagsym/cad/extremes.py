@@ -17,12 +17,14 @@ whole, so a pad of ``1e-10`` of the largest control point covers them all.
 from __future__ import annotations
 
 import heapq
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..evaluate import evaluate_grid
 from .convert import bezier_patch
 
-__all__ = ["height_bounds", "MAX_PATCHES"]
+__all__ = ["height_bounds", "MAX_PATCHES", "Overshoot", "overshoot"]
 
 MAX_PATCHES = 4000
 """Patches halved at most for each bound: beyond it the bound stated is the highest control point left."""
@@ -82,3 +84,38 @@ def _halves(net: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
         right[n - 1 - k] = rows[n - 1 - k]
         rows[:n - 1 - k] = 0.5 * (rows[:n - 1 - k] + rows[1:n - k])
     return np.moveaxis(left, 0, axis), np.moveaxis(right, 0, axis)
+
+
+@dataclass(frozen=True)
+class Overshoot:
+    """How far a surface leaves its control points' height range over their box.
+
+    ``sampled`` is the most seen on a grid of samples (near ``at``),
+    ``most`` the certified bound (:func:`height_bounds`), ``share`` that bound
+    over the data range, the figure judged.
+    """
+
+    sampled: float
+    most: float
+    share: float
+    at: tuple[float, float]
+    data_range: float
+
+
+def overshoot(surface, samples_per_interval: int = 24) -> Overshoot:
+    """The overshoot of the interpolant ``surface`` between its nodes: sampled on ``samples_per_interval``
+    points between nodes each way, and bounded from its Bezier form within 0.1 % of the heights."""
+    g = surface.grid
+    dx, dy = g.degree
+    xs = np.linspace(g.x_array[0], g.x_array[-1], dx * samples_per_interval + 1)
+    ys = np.linspace(g.y_array[0], g.y_array[-1], dy * samples_per_interval + 1)
+    zs = evaluate_grid(surface, xs, ys)
+    zmin, zmax = float(g.z_array.min()), float(g.z_array.max())
+    zrange = zmax - zmin
+    over = max(float(zs.max()) - zmax, zmin - float(zs.min()), 0.0)
+    i, j = np.unravel_index(np.argmax(np.maximum(zs - zmax, zmin - zs)), zs.shape)
+    lo, hi = height_bounds(surface, reached=(float(zs.min()), float(zs.max())),
+                           tolerance=1e-3 * max(zrange, abs(zmax), abs(zmin), 1e-300))
+    most = max(hi - zmax, zmin - lo, over, 0.0)
+    share = most / zrange if zrange > 0 else (0.0 if most <= 1e-9 * max(abs(zmax), 1.0) else float("inf"))
+    return Overshoot(over, most, share, (float(xs[i]), float(ys[j])), zrange)

@@ -136,8 +136,8 @@ def read_piecewise(path: str):
     return read_piecewise_file(path)
 
 
-ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points more than lagsym's limit "
-                            "(see 'lagsym check'); the program header records it")
+ACCEPT_CONDITIONING_HELP = ("use a surface that amplifies errors in its points, or leaves their heights between "
+                            "them, more than lagsym's limits (see 'lagsym check'); the program header records it")
 
 
 def measured_points(path: str, columns=None):
@@ -159,24 +159,37 @@ def add_conditioning_argument(p) -> None:
     p.add_argument("--accept-conditioning", action="store_true", help=ACCEPT_CONDITIONING_HELP)
 
 
-def conditioning_notes(grid, args, err: IO[str]) -> tuple[str, ...]:
-    """Refuse ``grid`` if it amplifies data errors beyond the limit, unless ``--accept-conditioning``.
+def conditioning_notes(grid, args, err: IO[str], surface=None) -> tuple[str, ...]:
+    """Refuse ``grid`` if it amplifies data errors beyond the limit, or if its interpolant (``surface``, made
+    here if not given) overshoots their heights by more than the limit, unless ``--accept-conditioning``.
 
-    Returns the program header's note when accepted above the limit (and says
+    Returns the program header's notes when accepted above a limit (and says
     so on ``err``), else nothing.
     """
-    from ..conditioning import require_conditioning
+    from ..conditioning import OVERSHOOT_REFUSED, require_conditioning, require_overshoot
     from ..exactsize import check_exact_size
+    from ..lagrange import lagrange_surface
 
-    if grid.amplification is None:  # an interpolant still to be made: its size is refused before its conditioning
+    accept = getattr(args, "accept_conditioning", False)
+    interpolant = grid.amplification is None  # a fitted surface's file states its own figure
+    if interpolant and surface is None:  # still to be made: its size is refused before its conditioning
         check_exact_size(f"surface through {grid.shape[0]} x {grid.shape[1]} nodes", grid.source, grid.x, grid.y,
                          [v for row in grid.z for v in row], exact_limit(args))
-    a = require_conditioning(grid, accept=getattr(args, "accept_conditioning", False))
-    if not a.exceeds:
-        return ()
-    say(err, f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
-             f"accepted with --accept-conditioning")
-    return (a.header_note(),)
+    a = require_conditioning(grid, accept=accept)
+    notes = []
+    if a.exceeds:
+        say(err, f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
+                 f"accepted with --accept-conditioning")
+        notes.append(a.header_note())
+    if interpolant:
+        o = require_overshoot(surface or lagrange_surface(grid, max_mb=exact_limit(args)), accept=accept)
+        if o.share > OVERSHOOT_REFUSED:
+            say(err, f"lagsym: warning: {grid.source}: the surface leaves its points' heights by up to "
+                     f"{o.most:.4g} ({100 * o.share:.3g}% of their range), above the limit of "
+                     f"{100 * OVERSHOOT_REFUSED:g}%: accepted with --accept-conditioning")
+            notes.append(f"overshoot {100 * o.share:.3g} percent of the data range, above {100 * OVERSHOOT_REFUSED:g} "
+                         f"percent, accepted (--accept-conditioning)")
+    return tuple(notes)
 
 
 # Every numeric option is checked here, once, as argparse reads it: finite and within a range that

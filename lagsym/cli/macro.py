@@ -100,7 +100,7 @@ def run(args, out, err) -> int:
                          f"has {a * b} pieces, which the control would have to pick between at every point: lagsym "
                          f"writes no such program; use 'lagsym toolpath {args.file}' (a point list)")
     surface = lagrange_surface(read_points(args.file), max_mb=exact_limit(args))
-    notes = conditioning_notes(surface.grid, args, err)
+    notes = conditioning_notes(surface.grid, args, err, surface)
     settings, raster, tool = settings_from(args, surface.grid)
     settings = replace(settings, notes=notes)
     program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,

@@ -106,7 +106,7 @@ def run(args, out, err) -> int:
         raise InputError(f"{args.file}: rounding error of the samples may reach {rel:.1e} times the data range, so the "
                          f"heights could be anything; use fewer or Chebyshev-spaced nodes, exact values from "
                          f"'lagsym equation', or --accept-rounding to write them anyway")
-    conditioning_notes(surface.grid, args, err)
+    conditioning_notes(surface.grid, args, err, surface)
     if rel > FLOAT_ERROR_LIMIT:
         err.write(f"lagsym: warning: rounding error of the samples may reach {rel:.1e} of the data range "
                   f"(trusted limit {FLOAT_ERROR_LIMIT:g}): the {surface.grid.shape[0]} x {surface.grid.shape[1]} nodes are "
