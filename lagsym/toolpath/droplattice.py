@@ -97,5 +97,6 @@ def _kernel_surface(ev, radius, corner, spacing, settle, *, jets=None, at=None):
     if corner != radius:
         jet = np.zeros((6 * c.shape[1], c.shape[0]))
     else:
-        jet = jet_coefficients(ev) if jets is None else jets[at]
+        # A writable copy: Numba compiles the kernel once for each kind of array, read-only ones included.
+        jet = jet_coefficients(ev) if jets is None else np.require(jets[at], requirements="CW")
     return c, jet, kernel_geometry(ev, ev.bounds, radius, corner, spacing, settle)

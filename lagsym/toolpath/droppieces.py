@@ -41,8 +41,8 @@ def drop_piecewise(ev: PiecewiseEvaluator, x, y, radius: float, corner: float, *
     if radius == 0:
         return ev.fast_points(cx, cy).reshape(shape_out)
     parallel = workers is not None and workers.parallel and workers.evaluator is ev
-    for parts in (_PARTS, _fine_parts(ev)):  # made here once, not in each worker
-        ev.part_upper_heights(parts)
+    for n in (_PARTS, _fine_parts(ev)):  # made here once, not in each worker
+        ev.part_upper_heights(n)
     if parallel and corner == radius:
         ev.piece_jets  # noqa: B018 (every piece's evaluator and a ball's jets at once, here, not in each worker)
     # Each position's value is independent of the chunk it is computed in; a chunk takes its pieces in rounds
