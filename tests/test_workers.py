@@ -123,6 +123,37 @@ def test_the_workers_end_silently_under_the_commands_signal_handlers(tmp_path):
     assert out.split() == ["2"] and err == "", err[-2000:]
 
 
+def test_a_worker_that_dies_or_fails_is_told_not_waited_for(tmp_path):
+    # A worker killed by the system (SIGKILL: out of memory) is named in one error; one killed by SIGTERM stops
+    # the command as that signal does; an error in a chunk reaches the command as itself; none waits.
+    out = _fresh(
+        "import os, signal\n"
+        "from lagsym.errors import LagsymError, Terminated\n"
+        "from lagsym.toolpath.workers import Workers\n"
+        "def chunk(ev, k):\n"
+        "    if k == 3:\n"
+        "        os.kill(os.getpid(), signal.SIGKILL)\n"
+        "    if k == 4:\n"
+        "        os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    if k == 5:\n"
+        "        raise ZeroDivisionError('chunk 5')\n"
+        "    return k * k\n"
+        "for bad in (3, 4, 5):\n"
+        "    with Workers(None, 2) as w:\n"
+        "        assert w.map(chunk, [(k,) for k in (0, 1, 2, 6, 7)]) == [0, 1, 4, 36, 49]\n"
+        "        try:\n"
+        "            w.map(chunk, [(k,) for k in (0, 1, bad, 6)])\n"
+        "        except LagsymError as e:\n"
+        "            print('error', e)\n"
+        "        except Terminated as e:\n"
+        "            print('terminated', e.signum)\n"
+        "        except ZeroDivisionError as e:\n"
+        "            print('raised', e)\n", tmp_path)
+    lines = out.splitlines()
+    assert lines[0].startswith("error a worker process of the plan ended without its result (signal 9;"), out
+    assert lines[1:] == ["terminated 15", "raised chunk 5"], out
+
+
 def test_a_chunk_reaches_the_kernel_as_a_worker_receives_it(monkeypatch):
     # Numba compiles one version of the kernel per kind of argument (a read-only array is another kind):
     # the arguments of a chunk computed here must be of the kinds a worker unpickles, or the workers compile
