@@ -166,6 +166,12 @@ def conditioning_notes(grid, args, err: IO[str], surface=None) -> tuple[str, ...
     Returns the program header's notes when accepted above a limit (and says
     so on ``err``), else nothing.
     """
+    return guarded_surface(grid, args, err, surface)[1]
+
+
+def guarded_surface(grid, args, err: IO[str], surface=None) -> tuple[object, tuple[str, ...]]:
+    """:func:`conditioning_notes`, and the exact surface through ``grid`` (made here if not given, after the
+    refusals of its size and of the grid's amplification, which need no exact work)."""
     from ..conditioning import OVERSHOOT_REFUSED, require_conditioning, require_overshoot
     from ..exactsize import check_exact_size
     from ..lagrange import lagrange_surface
@@ -181,15 +187,17 @@ def conditioning_notes(grid, args, err: IO[str], surface=None) -> tuple[str, ...
         say(err, f"lagsym: warning: {grid.source}: {a.text()}, above the limit of {a.limit:g}: "
                  f"accepted with --accept-conditioning")
         notes.append(a.header_note())
+    if surface is None:
+        surface = lagrange_surface(grid, max_mb=exact_limit(args))
     if interpolant:
-        o = require_overshoot(surface or lagrange_surface(grid, max_mb=exact_limit(args)), accept=accept)
+        o = require_overshoot(surface, accept=accept)
         if o.share > OVERSHOOT_REFUSED:
             say(err, f"lagsym: warning: {grid.source}: the surface leaves its points' heights by up to "
                      f"{o.most:.4g} ({100 * o.share:.3g}% of their range), above the limit of "
                      f"{100 * OVERSHOOT_REFUSED:g}%: accepted with --accept-conditioning")
             notes.append(f"overshoot {100 * o.share:.3g} percent of the data range, above {100 * OVERSHOOT_REFUSED:g} "
                          f"percent, accepted (--accept-conditioning)")
-    return tuple(notes)
+    return surface, tuple(notes)
 
 
 # Every numeric option is checked here, once, as argparse reads it: finite and within a range that

@@ -9,9 +9,8 @@ from ..errors import InputError
 from ..export.cad import CAD_FORMATS, cad_format_of, write_cad
 from ..export.cadtext import UNITS
 from ..io import read_points
-from ..lagrange import lagrange_surface
-from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument,
-                      conditioning_notes, count, read_piecewise)
+from ._common import (add_file_points_limit, add_exact_limit, add_conditioning_argument,
+                      guarded_surface, count, read_piecewise)
 from ._lines import say
 
 DESCRIPTION = f"""Write the exact surface through the control points in FILE as a CAD file:
@@ -76,10 +75,9 @@ def run(args, out, err) -> int:
     if piecewise is not None:  # local pieces amplify the points' errors little: no guard rail
         patch = piecewise_patch(piecewise)
     else:
-        if args.method == "lagrange":  # the other methods do not interpolate, so do not amplify the points' errors
-            conditioning_notes(grid, args, err)
-        patch = cad_patch(lagrange_surface(grid, max_mb=exact_limit(args)) if args.method == "lagrange" else grid, args.method,
-                          degree=args.degree or 3)
+        # the other methods do not interpolate, so do not amplify the points' errors
+        source = guarded_surface(grid, args, err)[0] if args.method == "lagrange" else grid
+        patch = cad_patch(source, args.method, degree=args.degree or 3)
     write_cad(args.output, patch, base_z=base, units=units, source=args.file)
     lo, hi = grid.z_range()
     rel = double_error_bound(patch, hi - lo)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..io import check_not_input, write_text
 from ._lines import say
-from ._common import add_file_points_limit, add_conditioning_argument, conditioning_notes, cusp_note, exact_limit
+from ._common import add_file_points_limit, add_conditioning_argument, guarded_surface, cusp_note, exact_limit
 
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
@@ -66,10 +66,10 @@ def run(args, out, err) -> int:
         return _probe_program(spec, args, out, err)
     if args.measured:
         spec = measured_job(spec, args.measured, err)
-    spec = guard_job(spec, args, err)
+    spec, surface = guard_job(spec, args, err)
     with progress_bar(err) as progress:
         planned = plan_job(spec, args.max_points, args.max_samples, progress=progress,
-                           max_exact_mb=exact_limit(args))
+                           max_exact_mb=exact_limit(args), surface=surface)
     prog = job_program(planned)
     if args.output and args.output != "-":
         write_text(args.output, prog.text, newline="")
@@ -80,16 +80,19 @@ def run(args, out, err) -> int:
 
 
 def guard_job(spec, args, err):
-    """The job, refused if its surface amplifies data errors beyond the limit (unless accepted, then noted)."""
+    """The job, refused if its surface amplifies data errors beyond the limit (unless accepted, then noted),
+    and its exact surface."""
     from dataclasses import replace
 
     from ..export.piecewisejson import read_piecewise_file
     from ..io import read_points
 
-    if spec.grid is None and read_piecewise_file(spec.points) is not None:
-        return spec  # local pieces: each point moves the surface near it only, so no guard rail
+    pieces = read_piecewise_file(spec.points) if spec.grid is None else None
+    if pieces is not None:
+        return spec, pieces  # local pieces: each point moves the surface near it only, so no guard rail
     grid = spec.grid if spec.grid is not None else read_points(spec.points)
-    return replace(spec, notes=spec.notes + conditioning_notes(grid, args, err))
+    surface, notes = guarded_surface(grid, args, err)
+    return replace(spec, notes=spec.notes + notes), surface
 
 
 def _probe_program(spec, args, out, err) -> int:

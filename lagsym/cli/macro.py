@@ -6,13 +6,12 @@ from dataclasses import replace
 
 from ..errors import InputError
 from ..io import read_points
-from ..lagrange import lagrange_surface
 from ..machine import MachineSettings, RasterSpec, Tool
 from ..macro import (FORMS, MACRO_DIALECTS, PRECISIONS, macro_program, planned_points, points_at, program_stats,
                      sample_positions)
 from ..gcode.limits import VARIABLE_PROFILES
 from ..macro.program import MAX_MACRO_POINTS
-from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
+from ._common import (add_file_points_limit, add_exact_limit, add_conditioning_argument, guarded_surface, read_piecewise, dialect_help, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM, TOOL_MM,
                       DECIMALS, add_program_arguments, count, emit, program_settings)
 
 STATS_POINTS = 2_000_000  # above this --stats estimates the point list from a sample
@@ -99,8 +98,7 @@ def run(args, out, err) -> int:
         raise InputError(f"{args.file}: a macro evaluates one polynomial on the control, and this piecewise surface "
                          f"has {a * b} pieces, which the control would have to pick between at every point: lagsym "
                          f"writes no such program; use 'lagsym toolpath {args.file}' (a point list)")
-    surface = lagrange_surface(read_points(args.file), max_mb=exact_limit(args))
-    notes = conditioning_notes(surface.grid, args, err, surface)
+    surface, notes = guarded_surface(read_points(args.file), args, err)
     settings, raster, tool = settings_from(args, surface.grid)
     settings = replace(settings, notes=notes)
     program = macro_program(surface, settings, raster, tool, precision=args.precision, tolerance_mm=args.tolerance,

@@ -6,14 +6,13 @@ from dataclasses import replace
 
 from ..controls import names
 from ..io import read_points, write_text
-from ..lagrange import lagrange_surface
 from ..machine import (BOUNDARIES, DEFAULT_TOLERANCE_MM, DIRECTIONS, TOOL_SHAPES, UNITS, MachineSettings, RasterSpec,
                        Tool)
 from ..post.program import point_program, write_program
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.waterline import BAND_DEG, STRATEGIES
 
-from ._common import (add_file_points_limit, add_exact_limit, exact_limit, add_conditioning_argument, conditioning_notes, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
+from ._common import (add_file_points_limit, add_exact_limit, add_conditioning_argument, guarded_surface, read_piecewise, dialect_help, CORNER_MM, FEED_MM_MIN, HEIGHT_MM, PROGRAM_NUMBER, SMALL_MM, SPINDLE_RPM, STEP_MM, STOCK_MM,
                       TOOL_MM, DECIMALS, add_program_arguments, count, cusp_note, program_settings)
 from ._lines import say
 from ._progress import progress_bar
@@ -113,8 +112,7 @@ def run(args, out, err) -> int:
         grid, surface, notes = piecewise.grid, piecewise, ()
     else:
         grid = read_points(args.file)
-        notes = conditioning_notes(grid, args, err)
-        surface = lagrange_surface(grid, max_mb=exact_limit(args))
+        surface, notes = guarded_surface(grid, args, err)
     settings = replace(settings_from(args, args.dialect, grid), notes=notes)
     tool = Tool(args.tool_shape, args.tool_diameter, args.corner_radius)
     stepover = args.stepover if args.stepover is not None else (None if args.scallop is not None else 0.5)

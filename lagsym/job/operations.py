@@ -106,19 +106,21 @@ def _settings(spec: JobSpec, op: OperationSpec | None = None, stock_mm: float = 
 
 def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
              max_samples: int | None = MAX_ROUGH_SAMPLES, *, progress: Progress | None = None,
-             max_exact_mb: float | None = MAX_EXACT_MB) -> PlannedJob:
+             max_exact_mb: float | None = MAX_EXACT_MB, surface=None) -> PlannedJob:
     """Read the points, build the block and plan every operation in order.
 
     Each operation is estimated before it is planned: at most ``max_points``
     points, and a roughing level at most ``max_samples`` drop-cutter samples;
-    the exact surface at most ``max_exact_mb`` (:mod:`lagsym.exactsize`).
+    the exact surface at most ``max_exact_mb`` (:mod:`lagsym.exactsize`);
+    ``surface``, when given, is the job's surface already made (:func:`job_surface`).
     ``progress`` is told the operations planned (stage ``operations``) and
     each planner's own stages after the operation's label
     (``rough T1: dropping the tool``; :mod:`lagsym.progress`).
     """
     if spec.grid is None and spec.points is None:
         raise InputError(f"{spec.source}: the job's surface is measured: fit the measurement first (--measured)")
-    surface = job_surface(spec, max_exact_mb)
+    if surface is None:
+        surface = job_surface(spec, max_exact_mb)
     ev = evaluator_of(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:
