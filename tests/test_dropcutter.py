@@ -6,7 +6,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from lagsym.errors import ToolpathError
@@ -74,6 +74,8 @@ def test_positions_outside_the_box_are_refused(example4):
 
 
 @given(surfaces(), st.floats(0.05, 2.5), st.sampled_from(["ball", "flat"]), st.integers(0, 2**31))
+@example(lagrange_surface(grid_from_table([0, 2], [0, Fraction(3, 2), 3], [[0, Fraction(-5, 2), -1], [0, -1, -1]])),
+         1.9483091451355088, "flat", 346)  # the edge y = 3 level at -1: its points took every start (3.3e-4 low)
 def test_cutter_location_never_below_the_exact_value(surf, radius, shape, seed):
     x0, x1, y0, y1 = (float(v) for v in surf.grid.bounds)
     rng = np.random.default_rng(seed)
@@ -87,6 +89,29 @@ def test_cutter_location_never_below_the_exact_value(surf, radius, shape, seed):
     assert np.all(z <= ref + 100 * CL_MARGIN * span)
     for k in range(2):
         assert z[k] >= brute(surf, x[k], y[k], radius, shape, n=161) - 1e-12 * span
+
+
+@pytest.mark.parametrize("shape, cx, cy", [("flat", 3.53125, 2.36875), ("bull", 3.775, 2.5374999999999996)])
+def test_a_level_box_edge_does_not_take_every_start(shape, cx, cy):
+    # Example 3's nodes are mostly at height 1: its box edges and corners give many candidates of exactly that
+    # height, which took every start; the true contact, a hollow's rim 6e-4 (flat) and 3.4e-3 (bull) higher
+    # between two lattice points, was missed by that much (68 um at scale 20).  Checked by a dense polar lattice
+    # on the polynomial's power form.
+    surf = lagrange_surface(read_points(EXAMPLES / "paper-example-3.json"))
+    x0, x1, y0, y1 = (float(v) for v in surf.grid.bounds)
+    r = 0.2 * min(x1 - x0, y1 - y0)
+    corner = r / 4 if shape == "bull" else 0.0
+    d = r * np.sqrt(np.linspace(0, 1, 1001))[:, None]
+    a = np.linspace(0, 2 * np.pi, 2001)[None, :]
+    px, py, d = (cx + d * np.cos(a)).ravel(), (cy + d * np.sin(a)).ravel(), np.broadcast_to(d, (1001, 2001)).ravel()
+    ok = (px >= x0) & (px <= x1) & (py >= y0) & (py <= y1)
+    px, py, d = px[ok], py[ok], d[ok]
+    rim = np.clip(d - (r - corner), 0, None)
+    lower = corner - np.sqrt(np.maximum(corner**2 - rim**2, 0))  # the bull's profile: 0 across its flat
+    heights = np.polynomial.polynomial.polyval2d(px, py, np.array(surf.coefficients, dtype=float))  # power basis
+    true = float(np.max(heights - lower))
+    z = float(drop_cutter(surf, cx, cy, r, shape, corner=corner if shape == "bull" else None, margin=False))
+    assert true - 1e-9 <= z <= true + 1e-5, (z, true)
 
 
 @pytest.mark.parametrize("cx, cy", [(6.0, 3.6541353383458643), (0.0, 4.443609022556391)])

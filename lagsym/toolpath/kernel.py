@@ -2,10 +2,9 @@
 
 :mod:`.dropcutter` states what is computed and :mod:`.newton` the rules of a
 ball's Newton steps; this module computes them one tool position at a time in
-machine code.  Numba compiles it on first use (some seconds) and keeps it in
-its cache beside this file, which later processes load in a fraction of a
-second.  One module holds every compiled function: the cache checks the file
-of the function it loads, not the files of the functions that one calls.
+machine code, compiled by Numba once and kept in its cache beside this file.
+One module holds every compiled function: the cache checks the file of the
+function it loads, not the files of the functions that one calls.
 
 The candidates of a position, and the eight steps of a pattern-search round,
 are evaluated together, a SIMD lane each (:func:`_values`).  The geometry is
@@ -129,16 +128,11 @@ def _edge_point(e, cx, cy, geo):
     x0, x1, y0, y1, radius = geo[4], geo[5], geo[6], geo[7], geo[8]
     if e < 4:
         return (x0 if e < 2 else x1), (y0 if e % 2 == 0 else y1)
-    e -= 4
-    side, k = e // 3, e % 3
+    side, k = (e - 4) // 3, (e - 4) % 3
     off = 0.0 if k == 0 else (1.0 if k == 1 else -1.0)
-    if side < 2:  # vertical edges x = x0, x1
-        a = x0 if side == 0 else x1
-        w = math.sqrt(max(radius * radius - (cx - a) ** 2, 0.0))
-        return a, cy + off * w
-    b = y0 if side == 2 else y1
-    w = math.sqrt(max(radius * radius - (cy - b) ** 2, 0.0))
-    return cx + off * w, b
+    a = (x0, x1, y0, y1)[side]  # the edge x = x0, x1, y = y0 or y1
+    w = off * math.sqrt(max(radius * radius - ((cx if side < 2 else cy) - a) ** 2, 0.0))
+    return (a, cy + w) if side < 2 else (cx + w, a)
 
 
 @_compiled
@@ -189,13 +183,12 @@ def _heights(c, geo, xs, ys, d2, count, out, work):
 
 
 @_compiled
-def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, rank, top, far, chosen):
+def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, tie, rank, top, far, chosen):
     """The candidates the search starts from, into ``chosen``: the best of all, then the best of distinct basins.
 
-    Among the first ``8 starts + 32`` candidates in the order of
-    :func:`_ranked` come, in turn, the first at least ``apart`` from those
-    already chosen, or where none is that far the next in order.  Those that
-    head no basin are ranked only where needed, which is rare.
+    Among the first ``8 starts + 32`` candidates in the order of :func:`_ranked` come, in turn, the first
+    :func:`_distinct` from those already chosen, or where none is the next in order.  Those that head no basin
+    are ranked only where needed, which is rare.
     """
     many = min(moved.size, 8 * starts + 32)
     count = _ranked(val, moved, nb, nearest, nlat, rank, top, many)
@@ -213,10 +206,10 @@ def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, rank, top, far
                 for u in range(count, grown):
                     far[u] = True
                     for q in range(s - 1):
-                        far[u] = far[u] and math.hypot(px[top[u]] - px[chosen[q]], py[top[u]] - py[chosen[q]]) >= apart
+                        far[u] = far[u] and _distinct(val, px, py, top[u], chosen[q], apart, tie)
                 count = grown
             if far[t]:
-                far[t] = math.hypot(px[top[t]] - px[chosen[s - 1]], py[top[t]] - py[chosen[s - 1]]) >= apart
+                far[t] = _distinct(val, px, py, top[t], chosen[s - 1], apart, tie)
                 if far[t]:
                     pick = t
             t += 1
@@ -225,6 +218,14 @@ def _starts(val, px, py, moved, nb, nearest, nlat, starts, apart, rank, top, far
                 count = _ranked_rest(val, rank, top, count, many)
             pick = min(s, count - 1)
         chosen[s] = top[pick]
+
+
+@_inline
+def _distinct(val, px, py, k, q, apart, tie):
+    """Whether candidate ``k`` may head another basin than chosen ``q``: ``apart`` from it and not within ``tie`` of
+    its height (one as high likely lies on the same plateau, a level box edge, say: where every start went there,
+    a basin whose peak lies between the lattice's points was missed)."""
+    return math.hypot(px[k] - px[q], py[k] - py[q]) >= apart and abs(val[k] - val[q]) > tie
 
 
 @_compiled
@@ -428,7 +429,7 @@ def drop_chunk(c, jc, geo, cx, cy, offsets, reach2, nb, nearest, starts, newton)
     out = np.empty(cx.size)
     for p in range(cx.size):
         _candidates(c, geo, cx[p], cy[p], offsets, reach2, val, px, py, d2, moved, work)
-        _starts(val, px, py, moved, nb, nearest, nlat, starts, 2.5 * spacing, rank, top, far, chosen)
+        _starts(val, px, py, moved, nb, nearest, nlat, starts, 2.5 * spacing, geo[11], rank, top, far, chosen)
         best = val[chosen[0]]  # the best candidate of all
         for s in range(starts):
             k = chosen[s]

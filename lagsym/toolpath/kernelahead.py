@@ -44,7 +44,7 @@ def signatures() -> dict[str, tuple]:
         "_newton": (a(f8, 2), i8, row, f8, f8, f8, f8, f8, row, row, row),
         "_refine": (coefficients, row, f8, f8, f8, f8, f8, f8, b1, a(f8, 2), row, row, row, row),
         "_candidates": (coefficients, row, f8, f8, a(f8, 2), row, row, row, row, row, a(b1, 1), a(f8, 2)),
-        "_starts": (row, row, row, a(b1, 1), a(i8, 2), a(i8, 1), i8, i8, f8, a(i8, 1), a(i8, 1), a(b1, 1),
+        "_starts": (row, row, row, a(b1, 1), a(i8, 2), a(i8, 1), i8, i8, f8, f8, a(i8, 1), a(i8, 1), a(b1, 1),
                     a(i8, 1)),
     }
 
