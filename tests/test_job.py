@@ -193,6 +193,44 @@ def _tight_hollows(f, cell, radius):
     return half + np.sqrt(np.maximum(half ** 2 - (a * d - b * c), 0)) >= 1 / radius, np.sqrt(w2)
 
 
+def finish_excess(fx, fy, f, left, finish_moves, printed, cell=0.25):
+    """Material left normal to the surface above the finish's own prediction for the rows there (with its chordal
+    tolerance 0.005 and 0.002 for the map), over the box a ball radius inside its edges and away from hollows
+    tighter than the ball; checks the job's printed figures.  ``(excess, 1 / cosine of the slope, worst)``."""
+    from scipy.ndimage import binary_dilation, maximum_filter1d
+
+    from lagsym.evaluate import surface_evaluator
+    from lagsym.io import read_points
+    from lagsym.lagrange import lagrange_surface
+    from lagsym.toolpath.scallop import gap_cusps
+
+    m = re.search(r"finish T2: \d+ moves, about [\d.]+ min, worst predicted cusp ([\d.]+) mm normal to the "
+                  r"surface at X([\d.]+) Y([\d.]+) outside hollows tighter than the ball \(([\d.]+) % of the box\)",
+                  printed)
+    assert m, printed
+    ys, counts = np.unique(np.round([mv[3] for mv in finish_moves if mv[1]], 3), return_counts=True)
+    rows = ys[counts > 50]
+    assert np.allclose(np.diff(rows), 0.5, atol=0.002), np.diff(rows)
+    ev = surface_evaluator(lagrange_surface(read_points(EX4)))
+    along, cusps = gap_cusps(ev, "x", rows / 20, R_BALL, 20.0, 0.5)
+    assert float(m.group(1)) == pytest.approx(np.nanmax(cusps), rel=0.01)  # the rows rounded to 0.001 mm
+    along_mm = along * 20
+    spacing = along_mm[1] - along_mm[0]
+    # The cusp at a point comes from the passes a tool radius either side of it along the rows too.
+    band = maximum_filter1d(np.nan_to_num(cusps, nan=np.inf), 2 * int(np.ceil(R_BALL / spacing)) + 1, axis=1)
+    gap = np.clip(np.searchsorted(rows, fy, side="right") - 1, 0, len(rows) - 2)
+    predicted = band[gap, np.clip(np.rint((fx - along_mm[0]) / spacing).astype(int), 0, len(along) - 1)]
+    tight, w = _tight_hollows(f, cell, R_BALL)
+    near = binary_dilation(tight, iterations=int(R_BALL / cell))
+    inner = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL) & ~near
+    assert tight.any() and inner.sum() > 0.9 * (74 / cell) ** 2
+    assert np.isinf(predicted[inner]).sum() < 0.001 * inner.sum()  # cells the prediction leaves out as tight
+    assert 0 < float(m.group(4)) < 5
+    over = np.where(inner, left / w - predicted - 0.005 - 0.002, -np.inf)
+    worst = np.unravel_index(np.argmax(over), over.shape)
+    return over, w, (left[worst] / w[worst], predicted[worst], fx[worst], fy[worst])
+
+
 @pytest.mark.slow
 def test_the_job_leaves_at_most_the_finishing_guarantee(machined, job_run):
     """What the finish leaves is at most the cusp it states for its rows, plus its chordal tolerance.
@@ -210,46 +248,15 @@ def test_the_job_leaves_at_most_the_finishing_guarantee(machined, job_run):
     races along the hollow), twice the tolerance: 0.023 mm was left where
     0.012 was predicted.
     """
-    from scipy.ndimage import binary_dilation, maximum_filter1d
-
-    from lagsym.evaluate import surface_evaluator
-    from lagsym.io import read_points
-    from lagsym.lagrange import lagrange_surface
-    from lagsym.toolpath.scallop import gap_cusps
-
     fx, fy, f, _, left = machined
     _, printed, moves, _ = job_run
-    cell = 0.25
-    m = re.search(r"finish T2: \d+ moves, about [\d.]+ min, worst predicted cusp ([\d.]+) mm normal to the "
-                  r"surface at X([\d.]+) Y([\d.]+) outside hollows tighter than the ball \(([\d.]+) % of the box\)",
-                  printed)
-    assert m, printed
-    ys, counts = np.unique(np.round([mv[3] for mv in moves if mv[0] == 2 and mv[1]], 3), return_counts=True)
-    rows = ys[counts > 50]
-    assert np.allclose(np.diff(rows), 0.5, atol=0.002), np.diff(rows)
-    ev = surface_evaluator(lagrange_surface(read_points(EX4)))
-    along, cusps = gap_cusps(ev, "x", rows / 20, R_BALL, 20.0, 0.5)
-    assert float(m.group(1)) == pytest.approx(np.nanmax(cusps), rel=0.01)  # the rows rounded to 0.001 mm
-    along_mm = along * 20
-    spacing = along_mm[1] - along_mm[0]
-    # The cusp at a point comes from the passes a tool radius either side of it along the rows too.
-    band = maximum_filter1d(np.nan_to_num(cusps, nan=np.inf), 2 * int(np.ceil(R_BALL / spacing)) + 1, axis=1)
-    gap = np.clip(np.searchsorted(rows, fy, side="right") - 1, 0, len(rows) - 2)
-    predicted = band[gap, np.clip(np.rint((fx - along_mm[0]) / spacing).astype(int), 0, len(along) - 1)]
-    tight, w = _tight_hollows(f, cell, R_BALL)
-    near = binary_dilation(tight, iterations=int(R_BALL / cell))
-    inner = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL) & ~near
-    assert tight.any() and inner.sum() > 0.9 * (74 / cell) ** 2
-    over = np.where(inner, left / w - predicted - 0.005 - 0.002, -np.inf)
-    worst = np.unravel_index(np.argmax(over), over.shape)
-    assert over.max() <= 0, (left[worst] / w[worst], predicted[worst], fx[worst], fy[worst])
-    assert np.isinf(predicted[inner]).sum() < 0.001 * inner.sum()  # cells the prediction leaves out as tight
-    assert 0 < float(m.group(4)) < 5
+    over, w, at = finish_excess(fx, fy, f, left, [mv for mv in moves if mv[0] == 2], printed)
+    assert over.max() <= 0, at
     # docs/roughing.md: on the flanks beside y = 20 the rows leave up to 0.1 mm normal (0.32 mm above).
     box = (fx >= 20 + R_BALL) & (fx <= 100 - R_BALL) & (fy >= 20 + R_BALL) & (fy <= 100 - R_BALL)
     at = np.unravel_index(np.argmax(np.where(box, left, -np.inf)), left.shape)
     assert round(float((left / w)[box].max()), 2) == 0.1 and round(float(left[at]), 2) == 0.32, left[at]
-    assert fy[at] < 30 and np.degrees(np.arctan(np.gradient(f, cell, axis=1)[at])) == pytest.approx(72, abs=1)
+    assert fy[at] < 30 and np.degrees(np.arctan(np.gradient(f, 0.25, axis=1)[at])) == pytest.approx(72, abs=1)
 
 
 def _sideways_after_changes(calls, safe_z: float):

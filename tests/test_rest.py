@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import made_once
-from test_job import EX4, _densified, run_job, stamp_ball
+from test_job import EX4, _densified, finish_excess, run_job, stamp_ball
 from test_rough import exact_heights, sweep_flat
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -155,6 +155,19 @@ def test_with_the_rest_stage_the_finishing_ball_takes_at_most_half_a_millimetre(
     page = " ".join((Path(__file__).parents[1] / "docs" / "roughing.md").read_text().split())
     assert ("up to 17.17 mm vertically (5.58 mm normal to the surface" in page
             and "more than 0.5 mm normal over 40.5 % of the box" in page and "at most 0.46 mm normal" in page)
+
+
+@pytest.mark.slow
+def test_after_the_rest_stage_the_finish_meets_its_stated_cusp(rest_run, maps):
+    """The rest job's finish leaves at most the cusp it states for its rows (with its chordal tolerance), as
+    the plain job's does, measured the same way; and the rest stage leaves no more anywhere than rough and
+    finish alone (it only takes material, and the finish passes where it passed without it)."""
+    _, printed, moves = rest_run
+    f, finished = maps["f"], maps["finished"]
+    over, w, at = finish_excess(maps["fx"], maps["fy"], f, finished - f, [m for m in moves if m[0] == 2], printed)
+    assert over.max() <= 0, at
+    assert np.all(finished <= maps["plain"] + 1e-9)
+    assert np.min(finished - f) >= -0.002  # and no gouge
 
 
 @pytest.mark.slow
