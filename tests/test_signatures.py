@@ -24,6 +24,7 @@ KERNELS = {
     "toolpath/kernel.py:_candidates",
     "toolpath/kernel.py:_heights",
     "toolpath/kernel.py:_starts",
+    "toolpath/kernel.py:_distinct",
     "toolpath/kernel.py:_ranked",
     "toolpath/kernel.py:_contact",
     "toolpath/kernel.py:_newton",
