@@ -201,7 +201,8 @@ def test_rest_rapids_go_through_no_material(rest_run, maps):
 BAD = [
     ({"kind = \"rough\"\ntool = \"rougher\"": "kind = \"rough\"\nrest = true\ntool = \"rougher\""},
      "operations[0].rest = true: no earlier operation leaves a stock to rest-rough"),
-    ({"stepover = 0.5": "stepover = 0.5\nrest = true"}, "operations[2].rest does not apply to a finish operation"),
+    ({"stepover = 0.5": "stepover = 0.5\nrest_above = 0.01"},
+     "operations[2].rest_above applies to a rest finish (rest = true)"),
     ({"rest = true": "rest = true\nmacro = true"}, "operations[1].rest = true: rest roughing runs point-list raster "
                                                    "rows, not a roughing macro (macro = true)"),
     ({"rest = true": "rest = true\npattern = \"offset\"\nmilling = \"climb\"", 'direction = "y"\n': ""},

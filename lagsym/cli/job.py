@@ -142,5 +142,7 @@ def report(planned, prog, err) -> None:
     """One line per operation (moves and minutes, for a ball's raster the cusp it leaves) and the total."""
     for op, m in zip(planned.operations, prog.minutes):
         cusp = cusp_note(op.path) if getattr(op.path, "cusp_mm", None) is not None else ""
+        if getattr(op.path, "runs", None) is not None:  # a rest finish
+            cusp = f", in {op.path.runs} runs over {100 * op.path.share:.1f} % of its raster"
         say(err, f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min{cusp}")
     err.write(f"cycle time about {prog.total_minutes:.1f} min (rapids at {planned.spec.rapid_mm_min:g} mm/min)\n")

@@ -28,6 +28,7 @@ from ..toolpath import plan_toolpath
 from ..toolpath.dropcutter import evaluator_of
 from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.rest import rest_toolpath
+from ..toolpath.restfinish import REST_ABOVE_MM, rest_finish
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
 from .rest import stock_left
 from .spec import JobSpec, OperationSpec, ToolSpec
@@ -177,6 +178,9 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
     tp = plan_toolpath(surface, tool.tool, raster, s.placement, s.program, evaluator=ev, max_points=limits[0],
                        stock_to_leave_mm=s.stock_to_leave_mm, progress=progress)
     _check_reach(tool, stock, tp.points_mm[:, 2].min())
+    if o.get("rest"):  # only where the operations before left material above what this ball reaches
+        rf = rest_finish(tp, stock_left(done, stock), stock.top_mm + 2.0, above_mm=o.get("rest_above", REST_ABOVE_MM))
+        return Operation(op, tool, rf.points_mm, rf.kinds, rf)
     p = tp.points_mm
     above = stock.top_mm + 2.0
     pts = np.vstack([[p[0, 0], p[0, 1], above], p, [p[-1, 0], p[-1, 1], above]])

@@ -58,7 +58,7 @@ _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float,
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
-       "pattern": str, "rest": bool}
+       "pattern": str, "rest": bool, "rest_above": float}
 _REQUIRED_OP = ("kind", "tool")
 
 
@@ -183,7 +183,7 @@ _RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plung
            "reach": (0.0, 1e4), "plunge_angle": (0.0, 90.0),
            "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
            "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
-           "tolerance": (1e-6, 1000.0)}
+           "tolerance": (1e-6, 1000.0), "rest_above": (0.0, 100.0)}
 _ABOVE = {"scallop", "tolerance"}  # above the low end, as --scallop and --tolerance
 _LENGTH_MM = 1e5  # safe_z, origin and block coordinates: within 100 m
 
@@ -226,7 +226,7 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
         raise InputError(f"{source}: operations is empty")
     if ops[0].options.get("rest"):
         raise InputError(f"{source}: operations[0].rest = true: no earlier operation leaves a stock to rest-rough; "
-                         "rest = true goes on a later roughing")
+                         "rest = true goes on a later roughing or finishing")
     ranks = [KINDS.index(op.kind) for op in ops]
     for i in range(1, len(ops)):
         if ranks[i] < ranks[i - 1]:
@@ -358,7 +358,7 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
     _choice(table["tool"], tuple(tools), where + "tool", source)
     allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling", "macro",
                "precision", "pattern", "rest"} if kind == "rough" else \
-        {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction"}
+        {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction", "rest", "rest_above"}
     opts = {}
     for key, value in table.items():
         if key in ("kind", "tool", "spindle", "feed", "plunge_feed", "coolant"):
@@ -389,6 +389,8 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
     if opts.get("rest") and (opts.get("macro") or opts.get("pattern") == "offset"):
         raise InputError(f"{source}: {where}rest = true: rest roughing runs point-list raster rows, not "
                          f"{'a roughing macro (macro = true)' if opts.get('macro') else 'pattern = offset'}")
+    if "rest_above" in opts and not opts.get("rest"):
+        raise InputError(f"{source}: {where}rest_above applies to a rest finish (rest = true)")
     if "precision" in opts and not opts.get("macro"):
         raise InputError(f"{source}: {where}precision applies to a roughing macro only (macro = true)")
     return OperationSpec(
