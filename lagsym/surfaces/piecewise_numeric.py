@@ -224,6 +224,10 @@ class PiecewiseEvaluator:
         low = 0.5 * (xx_lo + yy_lo) - np.sqrt(0.25 * (xx_lo - yy_lo) ** 2 + b * b)
         return max(float(top.max()), 0.0), float(np.maximum(top, -low).max())
 
+    def jets_if_made(self) -> np.ndarray | None:
+        """:attr:`piece_jets` if something has made them already, else None (nothing is made here)."""
+        return self.__dict__.get("piece_jets")
+
     @cached_property
     def piece_jets(self) -> np.ndarray:
         """``[i, k]``: piece ``(i, k)``'s Chebyshev coefficients of ``F, F_x, F_y, F_xx, F_xy, F_yy`` stacked

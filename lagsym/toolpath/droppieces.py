@@ -105,7 +105,7 @@ def _piecewise_chunk(ev: PiecewiseEvaluator, cx, cy, cutter: tuple[float, float]
             found = surfaces.get(p)
             if found is None:
                 found = surfaces[p] = _kernel_surface(ev.piece_evaluator(i, k), radius, corner, spacing, settle,
-                                                      jets=ev.__dict__.get("piece_jets"), at=(i, k))
+                                                      jets=ev.jets_if_made(), at=(i, k))
             gx, gy = cx[group], cy[group]
             nx, ny = np.clip(gx, bx[i], bx[i + 1]), np.clip(gy, by[k], by[k + 1])
             gx, gy = _kept_within(gx, gy, nx, ny, np.hypot(gx - nx, gy - ny), radius)
