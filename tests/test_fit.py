@@ -95,6 +95,26 @@ def test_a_fit_to_a_polynomial_of_the_fitted_degree_returns_it_exactly(weighted)
     assert fit.surface.coefficients == coeffs
 
 
+@pytest.mark.parametrize("weighted", [False, True])
+def test_the_statistics_in_floats_agree_with_the_exact_residuals_and_a_threshold_is_exact(weighted):
+    # Statistics come from residuals in floating point (exact ones of many points are integers of thousands of
+    # digits); they agree with the exact residuals, and a threshold equal to a residual is decided exactly.
+    points = noisy_scatter(60, seed=7)
+    weights = [Fraction(1 + k % 3, 2) for k in range(60)] if weighted else None
+    fit = fit_surface(points, (3, 2), weights=weights)
+    exact = [horner2(fit.coefficients, x, y) for x, y, _ in points]
+    res = [z - v for (_, _, z), v in zip(points, exact)]
+    assert [fit.residual(k) for k in range(60)] == res
+    assert np.allclose(fit.float_residuals, [float(r) for r in res], rtol=0, atol=1e-12)
+    assert fit.max_residual == pytest.approx(float(max(abs(r) for r in res)), rel=1e-12)
+    assert fit.rms == pytest.approx(float(sum(r * r for r in res) / 60) ** 0.5, rel=1e-12)
+    rss = sum((w if weighted else 1) * r * r for w, r in zip(weights or [1] * 60, res))
+    assert fit.rss == rss and fit.sigma == pytest.approx(float(rss / (60 - 12)) ** 0.5, rel=1e-12)
+    t = sorted(abs(r) for r in res)[-4]  # the 4th largest: strictly beyond it are 3 points (no tie here)
+    assert fit.beyond(t) == tuple(sorted((k for k in range(60) if abs(res[k]) > t), key=lambda k: -abs(res[k])))
+    assert len(fit.beyond(t)) == 3
+
+
 def test_the_residuals_and_normal_equations_hold_exactly():
     points = noisy_scatter(30, seed=2)
     fit = fit_surface(points, (2, 1))

@@ -144,3 +144,38 @@ def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
     values = [sum(int(inner[k * (P + 1) + a]) * x ** a * xs[a] for a in range(P + 1)) for k, x in enumerate(s.X)]
     scale = den * s.dx ** P * s.dy ** Q
     return tuple(z * scale - v * s.dz for z, v in zip(s.Z, values)), scale * s.dz
+
+
+def float_residuals(points, coefficients):
+    """``z - p(x, y)`` for every point in floating point, for the fit's statistics (its RMS, largest residual and
+    score), where the exact residuals of many points are integers of thousands of digits.
+
+    ``p`` is taken to the monomials of coordinates normalized to ``[-1, 1]`` over the points' box exactly, its
+    coefficients rounded once; on that interval the monomials of the degrees fitted (at most 8 by default)
+    lose few digits.
+    """
+    import numpy as np
+
+    xs = [p[0] for p in points]
+    ys = [p[1] for p in points]
+    (xm, hx), (ym, hy) = ((Fraction(min(v) + max(v), 2), Fraction(max(v) - min(v), 2) or Fraction(1))
+                          for v in (xs, ys))
+
+    def mat(rows):
+        entries = [flint.fmpq(v.numerator, v.denominator) for r in rows for v in r]
+        return flint.fmpq_mat(len(rows), len(rows[0]), entries)
+
+    c = mat(coefficients)
+    tx, ty = mat(_normalizing(xm, hx, c.nrows() - 1)), mat(_normalizing(ym, hy, c.ncols() - 1))
+    ct = tx * c * ty.transpose()
+    cf = np.array([[int(ct[a, b].p) / int(ct[a, b].q) for b in range(ct.ncols())] for a in range(ct.nrows())])
+    t = np.array([float((x - xm) / hx) for x in xs])
+    u = np.array([float((y - ym) / hy) for y in ys])
+    z = np.array([float(p[2]) for p in points])
+    return z - np.polynomial.polynomial.polyval2d(t, u, cf)
+
+
+def _normalizing(mid: Fraction, half: Fraction, degree: int) -> list[list[Fraction]]:
+    """``T[e][a]``: the coefficient of ``t**e`` in ``x**a`` with ``x = mid + half * t``."""
+    return [[math.comb(a, e) * mid ** (a - e) * half ** e if e <= a else Fraction(0) for a in range(degree + 1)]
+            for e in range(degree + 1)]

@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from functools import cached_property
 
 import flint
+import numpy as np
 
+from .._arrays import readonly
 from ..errors import GridError, InputError
 from ..grid import ControlGrid, grid_from_table
 from ..lagrange import LagrangeSurface
 from ..values import as_exact, choice
-from .exact import _residuals, _Scaled, _solve
+from .exact import _residuals, _Scaled, _solve, float_residuals
 from .hull import convex_hull, inside_hull, polygon_area
 from .select import AMPLIFICATION_SAMPLES, CRITERIA, amplification, leave_one_out, parse_degree, samples_for
 from .select import scores as score_all
@@ -40,15 +42,10 @@ class SurfaceFit:
         The data, in the order given.
     weights : tuple of Fraction or None
         The weights, when given.
-    residual_numerators : tuple of int
-        ``z_k - p(x_k, y_k)`` times :attr:`residual_denominator`, in the order
-        of the points (:attr:`residuals` gives them as fractions).
-    residual_denominator : int
-        The one denominator of every residual.
     criterion : str or None
         ``"gcv"`` or ``"loo"`` when the degrees were chosen, else None.
     score : float or None
-        The chosen degrees' score under ``criterion`` (from the exact residuals).
+        The chosen degrees' score under ``criterion`` (from :attr:`float_residuals`).
     scores : tuple of ((int, int), float)
         Every candidate's score, lowest first (empty when the degrees were given).
     hull : tuple of (Fraction, Fraction)
@@ -69,19 +66,39 @@ class SurfaceFit:
     degree: tuple[int, int]
     points: tuple[tuple[Fraction, Fraction, Fraction], ...]
     weights: tuple[Fraction, ...] | None
-    residual_numerators: tuple[int, ...]
-    residual_denominator: int
     criterion: str | None = None
     score: float | None = None
     scores: tuple[tuple[tuple[int, int], float], ...] = ()
     hull: tuple[tuple[Fraction, Fraction], ...] = ()
     amplification: float = 1.0
     samples: int = AMPLIFICATION_SAMPLES
+    scaled: object = field(default=None, repr=False, compare=False)  # the points in integers (.exact._Scaled)
 
     @property
     def terms(self) -> int:
         """The number of coefficients, ``(P + 1) (Q + 1)``."""
         return (self.degree[0] + 1) * (self.degree[1] + 1)
+
+    @cached_property
+    def _exact_residuals(self) -> tuple[tuple[int, ...], int]:
+        # Made when asked only: with many points each is an integer of thousands of digits.
+        return _residuals(self.scaled if self.scaled is not None else _Scaled.of(self.points, self.weights),
+                          self.coefficients)
+
+    @property
+    def residual_numerators(self) -> tuple[int, ...]:
+        """``z_k - p(x_k, y_k)`` times :attr:`residual_denominator`, exactly, in the order of the points."""
+        return self._exact_residuals[0]
+
+    @property
+    def residual_denominator(self) -> int:
+        """The one denominator of every exact residual."""
+        return self._exact_residuals[1]
+
+    @cached_property
+    def float_residuals(self) -> np.ndarray:
+        """``z_k - p(x_k, y_k)`` in floating point (:func:`.exact.float_residuals`): the statistics' residuals."""
+        return readonly(float_residuals(self.points, self.coefficients))
 
     @cached_property
     def residuals(self) -> tuple[Fraction, ...]:
@@ -90,37 +107,39 @@ class SurfaceFit:
 
     def residual(self, k: int) -> Fraction:
         """The residual of point ``k`` (0-based), exact."""
-        return Fraction(self.residual_numerators[k], self.residual_denominator)
-
-    @cached_property
-    def _square_sum(self) -> int:
-        """The sum of the squared residual numerators (over the denominator squared: the unweighted RSS)."""
-        return sum(r * r for r in self.residual_numerators)
+        if "_exact_residuals" in self.__dict__:
+            return Fraction(self.residual_numerators[k], self.residual_denominator)
+        return self._exact_residual(k)
 
     @cached_property
     def rss(self) -> Fraction:
         """The (weighted) residual sum of squares, exact."""
         d = self.residual_denominator
         if self.weights is None:
-            return Fraction(self._square_sum, d * d)
+            return Fraction(sum(r * r for r in self.residual_numerators), d * d)
         return sum((w * r * r for w, r in zip(self.weights, self.residual_numerators)), Fraction(0)) / (d * d)
 
     @property
     def max_residual(self) -> float:
         """The largest ``|z_k - p(x_k, y_k)|``."""
-        return float(Fraction(max(abs(r) for r in self.residual_numerators), self.residual_denominator))
+        return float(np.abs(self.float_residuals).max())
 
     @cached_property
     def rms(self) -> float:
         """The root mean square residual (unweighted)."""
-        d = self.residual_denominator
-        return math.sqrt(float(Fraction(self._square_sum, d * d)) / len(self.residual_numerators))
+        return math.sqrt(math.fsum(self.float_residuals ** 2) / len(self.points))
+
+    @cached_property
+    def float_rss(self) -> float:
+        """The (weighted) residual sum of squares from :attr:`float_residuals`."""
+        w = 1.0 if self.weights is None else np.array([float(v) for v in self.weights])
+        return math.fsum(w * self.float_residuals ** 2)
 
     @property
     def sigma(self) -> float:
         """The noise estimate ``sqrt(RSS / (N - k))`` (weighted residuals; 0 when the fit interpolates)."""
-        dof = len(self.residual_numerators) - self.terms
-        return math.sqrt(float(self.rss) / dof) if dof > 0 else 0.0
+        dof = len(self.points) - self.terms
+        return math.sqrt(self.float_rss / dof) if dof > 0 else 0.0
 
     @property
     def box(self) -> tuple[Fraction, Fraction, Fraction, Fraction]:
@@ -141,9 +160,16 @@ class SurfaceFit:
     def beyond(self, threshold) -> tuple[int, ...]:
         """The 0-based indices of the points whose ``|residual|`` exceeds ``threshold``, largest first."""
         t = as_exact(threshold, "threshold")
-        limit = t * self.residual_denominator
-        out = [k for k, r in enumerate(self.residual_numerators) if abs(r) > limit]
-        return tuple(sorted(out, key=lambda k: -abs(self.residual_numerators[k])))
+        size = np.abs(self.float_residuals)
+        # The float residuals decide but near the threshold, where a point's exact residual does.
+        near = 1e-9 * max(1.0, float(np.abs([float(p[2]) for p in self.points]).max()))
+        out = [int(k) for k in np.flatnonzero(size > float(t) + near)]
+        out += [int(k) for k in np.flatnonzero(np.abs(size - float(t)) <= near) if abs(self._exact_residual(k)) > t]
+        return tuple(sorted(out, key=lambda k: -size[k]))
+
+    def _exact_residual(self, k: int) -> Fraction:
+        x, y, z = self.points[k]
+        return z - sum(c * x ** a * y ** b for a, row in enumerate(self.coefficients) for b, c in enumerate(row))
 
     def report(self, threshold=None, limit: int = 10) -> str:
         """The residual report as lines of text: degrees, score, max, RMS, points beyond ``threshold``, extrapolation.
@@ -226,12 +252,12 @@ def _check_points(points, source: str) -> tuple[tuple[Fraction, Fraction, Fracti
     return tuple(out)
 
 
-def _exact_score(fit: SurfaceFit, criterion: str) -> float:
-    """The chosen degrees' score from the exact residuals (leverages, for leave-one-out, in floating point)."""
+def _score(fit: SurfaceFit, criterion: str) -> float:
+    """The chosen degrees' score from the residuals in floating point (as the candidates' scores are)."""
     n, k = len(fit.points), fit.terms
     if criterion == "gcv":
-        return float(n * fit.rss / (n - k) ** 2)
-    return leave_one_out(fit.points, fit.weights, fit.residuals, fit.degree)
+        return n * fit.float_rss / (n - k) ** 2
+    return leave_one_out(fit.points, fit.weights, fit.float_residuals, fit.degree)
 
 
 def _weights(weights, n: int, source: str) -> tuple[Fraction, ...] | None:
@@ -313,18 +339,18 @@ def fit_surface(points, degree=None, *, criterion: str | None = None, weights=No
         chosen = scores[0][0]
     scaled = _Scaled.of(pts, w)
     coeffs = _solve(scaled, chosen, source)
-    numerators, denominator = _residuals(scaled, coeffs)
     x0, x1 = min(p[0] for p in pts), max(p[0] for p in pts)
     y0, y1 = min(p[1] for p in pts), max(p[1] for p in pts)
     samples = samples_for(len(pts))
     amp = amplification(pts, w, chosen, samples)
     fit = SurfaceFit(surface=_surface(coeffs, (x0, x1, y0, y1), source, units, amp), coefficients=coeffs,
-                     degree=chosen, points=pts, weights=w, residual_numerators=numerators,
-                     residual_denominator=denominator, hull=_hull(scaled), amplification=amp,
-                     samples=samples)
+                     degree=chosen, points=pts, weights=w, hull=_hull(scaled), amplification=amp,
+                     samples=samples, scaled=scaled)
     if not scores:
         return fit
-    return replace(fit, criterion=criterion, score=_exact_score(fit, criterion), scores=tuple(scores))
+    scored = replace(fit, criterion=criterion, score=_score(fit, criterion), scores=tuple(scores))
+    scored.__dict__["float_residuals"] = fit.float_residuals  # computed for the score: not computed again
+    return scored
 
 
 def _surface(coeffs, box, source: str, units: str | None, amp: float | None = None) -> LagrangeSurface:

@@ -1,7 +1,7 @@
 """A fitted surface and its residuals: each measured point on a stem from the surface, coloured by its residual.
 
-The residual of point ``k`` is ``r_k = z_k - p(x_k, y_k)``, exact in the fit
-(:attr:`lagsym.fit.SurfaceFit.residuals`) and drawn in floats.  A stem runs
+The residual of point ``k`` is ``r_k = z_k - p(x_k, y_k)`` of the exact fit
+(:attr:`lagsym.fit.SurfaceFit.float_residuals`), drawn in floats.  A stem runs
 from the surface at ``(x_k, y_k)`` to the point; residuals of a fit to measured
 points are far smaller than the part, so the stems are drawn
 ``residual_exaggeration`` times their length (by default so that the longest
@@ -70,7 +70,7 @@ def residuals_figure(fit_result, *, samples: int = 61, units: str | None = None,
     n = check_samples(samples)
     w, h = check_window_size(window_size)
     pts = np.array([[float(v) for v in p] for p in fit_result.points])
-    res = np.array([float(r) for r in fit_result.residuals])
+    res = np.array(fit_result.float_residuals)
     xs = np.linspace(pts[:, 0].min(), pts[:, 0].max(), n)
     ys = np.linspace(pts[:, 1].min(), pts[:, 1].max(), n)
     surface = fit_result.surface
