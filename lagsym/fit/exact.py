@@ -148,11 +148,12 @@ def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
 
 def float_residuals(points, coefficients):
     """``z - p(x, y)`` for every point in floating point, for the fit's statistics (its RMS, largest residual and
-    score), where the exact residuals of many points are integers of thousands of digits.
+    score), where the exact residuals of many points are integers of thousands of digits; and a bound on how far
+    any of them may be from the exact one.
 
     ``p`` is taken to the monomials of coordinates normalized to ``[-1, 1]`` over the points' box exactly, its
-    coefficients rounded once; on that interval the monomials of the degrees fitted (at most 8 by default)
-    lose few digits.
+    coefficients rounded once; on that interval each term is at most its coefficient, so the rounding errors of
+    the sums are within ``(2 (P + Q) + 8) u (sum |c| + |z|)`` (``u`` the unit roundoff), doubled here.
     """
     import numpy as np
 
@@ -172,7 +173,9 @@ def float_residuals(points, coefficients):
     t = np.array([float((x - xm) / hx) for x in xs])
     u = np.array([float((y - ym) / hy) for y in ys])
     z = np.array([float(p[2]) for p in points])
-    return z - np.polynomial.polynomial.polyval2d(t, u, cf)
+    steps = 2 * (ct.nrows() + ct.ncols()) + 8
+    bound = 2 * steps * np.finfo(float).eps / 2 * (float(np.abs(cf).sum()) + float(np.abs(z).max()))
+    return z - np.polynomial.polynomial.polyval2d(t, u, cf), bound
 
 
 def _normalizing(mid: Fraction, half: Fraction, degree: int) -> list[list[Fraction]]:

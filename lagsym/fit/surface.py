@@ -96,9 +96,14 @@ class SurfaceFit:
         return self._exact_residuals[1]
 
     @cached_property
+    def _floats(self) -> tuple[np.ndarray, float]:
+        found, bound = float_residuals(self.points, self.coefficients)
+        return readonly(found), bound
+
+    @property
     def float_residuals(self) -> np.ndarray:
         """``z_k - p(x_k, y_k)`` in floating point (:func:`.exact.float_residuals`): the statistics' residuals."""
-        return readonly(float_residuals(self.points, self.coefficients))
+        return self._floats[0]
 
     @cached_property
     def residuals(self) -> tuple[Fraction, ...]:
@@ -161,8 +166,8 @@ class SurfaceFit:
         """The 0-based indices of the points whose ``|residual|`` exceeds ``threshold``, largest first."""
         t = as_exact(threshold, "threshold")
         size = np.abs(self.float_residuals)
-        # The float residuals decide but near the threshold, where a point's exact residual does.
-        near = 1e-9 * max(1.0, float(np.abs([float(p[2]) for p in self.points]).max()))
+        # The float residuals decide but within their error bound of the threshold, where the exact one does.
+        near = self._floats[1] + abs(float(t)) * 1e-15
         out = [int(k) for k in np.flatnonzero(size > float(t) + near)]
         out += [int(k) for k in np.flatnonzero(np.abs(size - float(t)) <= near) if abs(self._exact_residual(k)) > t]
         return tuple(sorted(out, key=lambda k: -size[k]))
@@ -349,7 +354,7 @@ def fit_surface(points, degree=None, *, criterion: str | None = None, weights=No
     if not scores:
         return fit
     scored = replace(fit, criterion=criterion, score=_score(fit, criterion), scores=tuple(scores))
-    scored.__dict__["float_residuals"] = fit.float_residuals  # computed for the score: not computed again
+    scored.__dict__["_floats"] = fit._floats  # computed for the score: not computed again
     return scored
 
 
