@@ -135,13 +135,14 @@ def rest_toolpath(surface, tool: Tool, stock: Stock, left: StockMap, spec: Rough
     return RoughPath(np.array(pts), np.array(kinds, dtype=np.int8), np.array(floor), z_levels, tool, stock, spec)
 
 
-def _runs(cutting: np.ndarray, along: np.ndarray, join_mm: float) -> list[tuple[int, int]]:
-    """``(lo, hi)`` sample ranges to cut: each run of cutting samples with the clear sample either side, runs whose
-    gap is shorter than ``join_mm`` joined."""
+def cut_runs(cutting: np.ndarray, along: np.ndarray, join_mm: float) -> list[tuple[int, int]]:
+    """``(lo, hi)`` sample ranges to cut: each run of cutting samples with the clear sample either side (where the
+    row has one), runs whose gap along the row (``along``, the samples' positions on it) is shorter than
+    ``join_mm`` joined."""
     edges = np.flatnonzero(np.diff(np.concatenate([[0], cutting.astype(np.int8), [0]])))
-    out = []
+    out: list[tuple[int, int]] = []
     for p, q in zip(edges[::2], edges[1::2]):
-        lo, hi = p - 1, q  # the row's ends lie beside the block, clear of everything: 0 < p, q < n
+        lo, hi = max(int(p) - 1, 0), min(int(q), len(cutting) - 1)  # a roughing row's ends are clear: 0 < p, q < n
         if out and abs(along[lo] - along[out[-1][1]]) < join_mm:
             out[-1] = (out[-1][0], hi)
         else:
@@ -182,7 +183,7 @@ def assemble_rest(rows, samples: tuple, z_levels, stock: Stock, spec: RoughSpec,
             else:
                 fwd = climb_forward(spec.direction, 1 if k % 2 == 0 else -1) == (spec.milling == "climb")
             idx = np.arange(len(r.along)) if fwd else np.arange(len(r.along))[::-1]
-            for lo, hi in _runs(cutting[idx], r.along[idx], 2 * (top - zl)):
+            for lo, hi in cut_runs(cutting[idx], r.along[idx], 2 * (top - zl)):
                 seg = idx[lo:hi + 1]
                 visits, low = ramped(np.abs(np.diff(r.along[seg])), want[seg], mat[seg], tan_a)
                 mat[seg] = np.minimum(mat[seg], low)

@@ -31,7 +31,7 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..errors import ToolpathError
-from .rest import StockMap, material_under
+from .rest import StockMap, cut_runs, material_under
 from .rough import FEED, PLUNGE, RAPID
 
 __all__ = ["RestFinish", "rest_finish", "REST_ABOVE_MM"]
@@ -83,7 +83,8 @@ def rest_finish(path, left: StockMap, top_mm: float, clearance_mm: float = 1.0,
     count = 0
     bounds = np.flatnonzero(np.diff(rows)) + 1
     for lo, hi in zip(np.concatenate([[0], bounds]), np.concatenate([bounds, [len(p)]])):
-        for a, b in _runs(cutting[lo:hi], p[lo:hi], 2 * (top_mm - float(p[lo:hi, 2].min()))):
+        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p[lo:hi, :2], axis=0).T))])
+        for a, b in cut_runs(cutting[lo:hi], along, 2 * (top_mm - float(p[lo:hi, 2].min()))):
             first, last = p[lo + a], p[lo + b]
             entry = max(float(first[2]), float(mat[lo + a])) + clearance_mm
             pts += [(first[0], first[1], top_mm)]
@@ -97,16 +98,3 @@ def rest_finish(path, left: StockMap, top_mm: float, clearance_mm: float = 1.0,
     return RestFinish(np.array(pts, dtype=float), np.array(kinds, dtype=np.int8), count,
                       float(cutting.mean()))
 
-
-def _runs(cutting: np.ndarray, row: np.ndarray, join_mm: float) -> list[tuple[int, int]]:
-    """``(first, last)`` location of each run of cutting locations along a row, with the location either side
-    where there is one; runs whose gap along the row is shorter than ``join_mm`` joined."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], cutting.astype(np.int8), [0]])))
-    out: list[tuple[int, int]] = []
-    for s, e in zip(edges[::2], edges[1::2]):
-        a, b = max(s - 1, 0), min(int(e), len(cutting) - 1)
-        if out and np.hypot(*(row[a, :2] - row[out[-1][1], :2])) < join_mm:
-            out[-1] = (out[-1][0], b)
-        else:
-            out.append((a, b))
-    return out
