@@ -41,7 +41,7 @@ def _powers(values: Sequence[int], top: int) -> list[list[int]]:
     return rows
 
 
-def _shift_matrix(scale: int, shift: int, degree: int) -> list[list[int]]:
+def _shift_matrix(scale, shift, degree: int) -> list:
     """``T[a][e]``: the coefficient of ``x**e`` in ``(scale * x - shift)**a``."""
     return [[math.comb(a, e) * scale ** e * (-shift) ** (a - e) if e <= a else 0 for e in range(degree + 1)]
             for a in range(degree + 1)]
@@ -167,8 +167,9 @@ def float_residuals(points, coefficients):
         return flint.fmpq_mat(len(rows), len(rows[0]), entries)
 
     c = mat(coefficients)
-    tx, ty = mat(_normalizing(xm, hx, c.nrows() - 1)), mat(_normalizing(ym, hy, c.ncols() - 1))
-    ct = tx * c * ty.transpose()
+    # x = xm + hx t: the coefficient of t**e in x**a is T[a][e] of the shift matrix of (hx t - (-xm))**a.
+    tx, ty = mat(_shift_matrix(hx, -xm, c.nrows() - 1)), mat(_shift_matrix(hy, -ym, c.ncols() - 1))
+    ct = tx.transpose() * c * ty
     cf = np.array([[int(ct[a, b].p) / int(ct[a, b].q) for b in range(ct.ncols())] for a in range(ct.nrows())])
     t = np.array([float((x - xm) / hx) for x in xs])
     u = np.array([float((y - ym) / hy) for y in ys])
@@ -177,8 +178,3 @@ def float_residuals(points, coefficients):
     bound = 2 * steps * np.finfo(float).eps / 2 * (float(np.abs(cf).sum()) + float(np.abs(z).max()))
     return z - np.polynomial.polynomial.polyval2d(t, u, cf), bound
 
-
-def _normalizing(mid: Fraction, half: Fraction, degree: int) -> list[list[Fraction]]:
-    """``T[e][a]``: the coefficient of ``t**e`` in ``x**a`` with ``x = mid + half * t``."""
-    return [[math.comb(a, e) * mid ** (a - e) * half ** e if e <= a else Fraction(0) for a in range(degree + 1)]
-            for e in range(degree + 1)]

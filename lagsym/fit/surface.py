@@ -13,7 +13,7 @@ import numpy as np
 from .._arrays import readonly
 from ..errors import GridError, InputError
 from ..grid import ControlGrid, grid_from_table
-from ..lagrange import LagrangeSurface
+from ..lagrange import LagrangeSurface, horner2
 from ..values import as_exact, choice
 from .exact import _residuals, _Scaled, _solve, float_residuals
 from .hull import convex_hull, inside_hull, polygon_area
@@ -174,7 +174,7 @@ class SurfaceFit:
 
     def _exact_residual(self, k: int) -> Fraction:
         x, y, z = self.points[k]
-        return z - sum(c * x ** a * y ** b for a, row in enumerate(self.coefficients) for b, c in enumerate(row))
+        return z - horner2(self.coefficients, x, y)
 
     def report(self, threshold=None, limit: int = 10) -> str:
         """The residual report as lines of text: degrees, score, max, RMS, points beyond ``threshold``, extrapolation.
