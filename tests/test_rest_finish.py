@@ -17,8 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import made_once
-from test_job import EX4, _densified, _tight_hollows, run_job, stamp_ball
-from test_rough import exact_heights, sweep_flat
+from test_job import EX4, _densified, _machined, _tight_hollows, run_job, stamp_ball
 
 from lagsym.errors import ToolpathError
 from lagsym.machine import Tool
@@ -28,7 +27,7 @@ from lagsym.toolpath.restfinish import rest_finish
 ROOT = Path(__file__).resolve().parent.parent
 JOB = ROOT / "examples" / "example-4-rest-finish-job.toml"
 TOOLS = "T1 P1 Z0 D10 ;rougher\nT2 P2 Z0 D6 ;ball6\nT3 P3 Z0 D2 ;ball2\n"
-R_FLAT, R_BALL, R_SMALL = 5.0, 3.0, 1.0
+R_BALL, R_SMALL = 3.0, 1.0
 CELL = 0.25
 
 
@@ -46,15 +45,11 @@ def runs(tmp_path_factory, rs274):
 
 
 def _maps(moves_rest, moves_full):
-    gx = gy = np.arange(20.0, 100.0 + CELL / 2, CELL)  # the block is the box (no margin)
-    fx, fy = np.meshgrid(gx, gy, indexing="ij")
-    f = exact_heights(EX4, fx, fy)
-    h = np.full(f.shape, float(f.max()) + 2 + 1e-3)
-    rough = [m for m in moves_rest if m[0] == 1]
-    for a, b in zip(rough[:-1], rough[1:]):
-        sweep_flat(h, gx, gy, a[2:], b[2:], R_FLAT)
-    stamp_ball(h, gx, gy, _densified([m for m in moves_rest if m[0] == 2], 0.1), R_BALL)
-    before = h.copy()
+    # The rough and the 6 mm finish, as the plain job's test cuts them (the same tools, numbers and cells).
+    fx, fy, f, _, left = _machined(moves_rest)
+    gx, gy = fx[:, 0], fy[0, :]
+    before = f + left
+    h = before.copy()
     stamp_ball(h, gx, gy, _densified([m for m in moves_rest if m[0] == 3], 0.1), R_SMALL)
     full = before.copy()
     stamp_ball(full, gx, gy, _densified([m for m in moves_full if m[0] == 3], 0.1), R_SMALL)
