@@ -165,16 +165,20 @@ class SimControl:
         Cut the line as soon as this many bytes have arrived.
     xon_after_s : float or None
         Send DC1 this long after starting, as a Fanuc does when READ is pressed.
-    hold_on_xoff : bool
-        A feed hold at the first XOFF: the machine stops emptying the buffer
-        (and, with ``ignore_xon``, never asks for more).  ``executed`` counts
-        the characters the machine took from the buffer.
+    hold_on_xoff : bool or int
+        A feed hold at the first XOFF (or at XOFF number ``hold_on_xoff``):
+        the machine stops emptying the buffer, so it never asks for more.
+        ``executed`` counts the characters the machine took from the buffer.
     discard_after_bytes : int or None
         Keep reading the line but record nothing after this many bytes: a
         control that stopped taking the program while its port stays up.
     garble_answers : bool
         Answer with what a line at another baud rate makes of DC3 and DC1
         (characters no control sends), as a control set up differently does.
+    late_answers_s : float
+        Each DC3 and DC1 reaches the sender this long after the control sent
+        it, as a loaded computer's own delivery (its kernel's input work, a USB
+        adapter's latency timer) can hold it back.
     pair : PtyPair
         What to hang up when cutting the line.
     """
@@ -260,7 +264,7 @@ class _Control:
     def __init__(self, path, socat_pid, count, halt, baud=9600, bytesize=7, parity="even", stopbits=2,
                  buffer_chars=256, high_water=192, low_water=64, drain_cps=None, tolerance=10, ignore_xon=False,
                  drop_on_xoff=None, drop_settle_s=1.0, drop_after_bytes=None, xon_after_s=None, hold_on_xoff=False,
-                 discard_after_bytes=None, garble_answers=False):
+                 discard_after_bytes=None, garble_answers=False, late_answers_s=0.0):
         self.cps = chars_per_s(baud, bytesize, parity, stopbits)
         self.buffer_chars, self.high, self.low = buffer_chars, high_water, low_water
         self.drain_cps, self.tolerance, self.ignore_xon = drain_cps, tolerance, ignore_xon
@@ -270,6 +274,7 @@ class _Control:
         self.hold_on_xoff, self.discard_after_bytes = hold_on_xoff, discard_after_bytes
         # DC3 (0x13) and DC1 (0x11) sent at 4800 baud and read at 9600 come out as other characters.
         self.xoff_byte, self.xon_byte = (b"\xe6", b"\x9e") if garble_answers else (DC3, DC1)
+        self.late_s, self.on_the_way = late_answers_s, []  # answers sent, not yet delivered: (when due, byte)
         self.buffered = 0.0
         self.count_in = 0  # every character taken from the line, recorded or not
         self.port = _FdPort(path) if isinstance(path, int) else serial.Serial(path, baudrate=baud, timeout=0)
@@ -315,8 +320,11 @@ class _Control:
         program (``discard_after_bytes``) stops only after its last answer:
         an answer vouches for everything that had come before it.
         """
-        self.port.write(byte)
         sent = time.monotonic()
+        if self.late_s:
+            self.on_the_way.append((sent + self.late_s, byte))
+        else:
+            self.port.write(byte)
         if self.drop_after_bytes is not None:
             return line_t
         more = min(self.port.in_waiting, int((sent - line_t) * self.cps))
@@ -353,6 +361,8 @@ class _Control:
             now = time.monotonic()
             gap = now - last
             last = now
+            while self.on_the_way and self.on_the_way[0][0] <= now:
+                self.port.write(self.on_the_way.pop(0)[1])
             if xon_at is not None and now >= xon_at:
                 self.port.write(DC1)  # READ pressed: the control asks for the program
                 xon_at = None
@@ -361,7 +371,7 @@ class _Control:
                 self.count.value = len(self.received)
                 self.cut()
                 return
-            held = self.hold_on_xoff and self.xoffs > 0
+            held = self.hold_on_xoff and self.xoffs >= self.hold_on_xoff
             deficit = 0.0  # characters the machine wanted in this gap beyond what the buffer held
             if not held:
                 if self.drain_cps is not None:

@@ -42,9 +42,9 @@ The port is a device or a pyserial URL: /dev/ttyUSB0, COM3,
 socket://host:4001, rfc2217://host:4001, loop://; a device is opened
 exclusively.  Exit status 3 on a line fault, a stall, a busy port, Ctrl-C,
 SIGTERM or SIGHUP; the message says which --start-block resumes.  A block
-surely reached the control only when the control answered (XOFF/XON) after
-it left the port, or a --carrier signal or hardware flow control watched the
-line; the summary and the faults word apart what left the port and what
+surely reached the control only when the control's answers prove it (an XOFF
+after the XON that ended a pause: everything sent before that pause), or a
+--carrier signal or hardware flow control watched the line; the summary and the faults word apart what left the port and what
 surely arrived.  A drip feed the control never answered at all is a fault
 (exit 3) unless --no-handshake-expected; so are answers no control sends
 (check the baud rate and format).
@@ -217,13 +217,14 @@ def run(args, out, err) -> int:
     if not args.quiet:
         say(out, f"sent {result.blocks} blocks ({result.bytes} bytes) to {args.port} in {result.elapsed_s:.1f} s, "
                  f"{100 * result.throughput:.1f}% of the line rate, {result.xoff_count} XOFF")
-        if not result.confirmed and result.answered_to_end:
-            out.write(f"the control answered XON/XOFF {result.answers} times, the last after the last block\n")
+        if not result.confirmed and result.sure_to_end:
+            out.write(f"the control answered XON/XOFF {result.answers} times, which show that it took every block\n")
         elif not result.confirmed and result.answers:
-            out.write(f"the control answered XON/XOFF {result.answers} times, the last after block "
-                      f"{result.last_answered_block}: block {result.last_answered_block} surely reached it; the "
-                      "blocks after it left the port but nothing shows that the control holds them: check that it "
-                      "holds the last block (a --carrier signal watches the line)\n")
+            sure = (f"block {result.last_sure_block} surely reached it" if result.last_sure_block
+                    else "no block surely reached it (only an XOFF after an XON shows what it took)")
+            out.write(f"the control answered XON/XOFF {result.answers} times, which show that {sure}; the blocks "
+                      "after it left the port but nothing shows that the control holds them: check that it holds "
+                      "the last block (a --carrier signal watches the line)\n")
         elif not result.confirmed:
             out.write("the control confirmed nothing: it never answered XON/XOFF, so nothing shows it took the "
                       "program; check it holds the last block (a --carrier signal watches the line)\n")

@@ -39,9 +39,9 @@ class TransferResult:
     ``confirmed`` is True when a hardware signal (the carrier, or CTS/DSR
     flow control) showed the control on the line throughout; over XON/XOFF
     alone only the control's answers show what it took: ``answers`` counts
-    them (DC3 and DC1) and ``last_answered_block`` is the last block that had
-    left the port when the control last answered (what surely reached it);
-    ``answered_to_end`` says the control answered after the last block.
+    them (DC3 and DC1) and ``last_sure_block`` is the last block they prove
+    it took (see :mod:`lagsym.dnc.sender`); ``sure_to_end`` says they prove
+    it took every block.
     """
 
     blocks: int
@@ -52,8 +52,8 @@ class TransferResult:
     chars_per_s: float
     confirmed: bool = False
     answers: int = 0
-    last_answered_block: int = 0
-    answered_to_end: bool = False
+    last_sure_block: int = 0
+    sure_to_end: bool = False
 
     @property
     def throughput(self) -> float:

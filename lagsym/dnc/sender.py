@@ -17,13 +17,23 @@ fewer in flight, which leaves room for the DC3 to travel back.
 Two counts are kept apart.  What the sender knows for itself: the bytes the
 operating system took (written) and the bytes that have *left the port* (by
 the line clock and the driver's output queue, plus a short settling time).
-What the control holds, which only the control can show: a block *surely
-reached the control* only when the control answered after it had left the
-port (a DC3 or DC1, or a watched carrier or CTS/DSR signal that stayed up).
-A control that dies while its line stays up (a pseudo-terminal relay, a
-UART that drains into nothing) takes everything the port sends and answers
-nothing, so only the answers count.  A drip feed that the control never
-answered at all is a fault (``LineSettings.handshake_expected``).
+What the control holds, which only the control can show.  The way back has no
+bound the sender can rely on: an answer waits in the computer's own delivery
+(the kernel's input work, a USB adapter's latency timer) for as long as a
+loaded machine makes it wait, so when an answer was sent cannot be told from
+when it was read, and an answer vouches only for what the protocol proves.
+An XOFF (DC3) that follows an XON (DC1) proves that the control's buffer rose
+from its XON mark to its XOFF mark in between, so it took at least that span
+after its XON; and the sender wrote nothing while it waited for that XON.
+So an XOFF that comes after an XON which ended a pause vouches for every
+byte written before that pause (if no more arrived after the control's
+XOFF than the span between its marks: beyond its headroom a control
+alarms).  A block *surely reached the control* only so, or with a watched
+carrier or CTS/DSR signal that stayed up.  A control that dies while its
+line stays up (a pseudo-terminal relay, a UART that drains into nothing)
+takes everything the port sends and answers nothing, so only the answers
+count.  A drip feed that the control never answered at all is a fault
+(``LineSettings.handshake_expected``).
 
 In a drip feed a block that reached the control is not yet a block that ran:
 up to ``LineSettings.buffer_chars`` characters may wait in the control's
@@ -41,7 +51,6 @@ control cannot read what is sent either.
 
 from __future__ import annotations
 
-import collections
 import math
 import signal
 import time
@@ -93,9 +102,8 @@ class Sender:
         self.settle_s = _SETTLE_NETWORK_S if network else _SETTLE_S
         self.pos = 0  # bytes the operating system took
         self.left = 0  # bytes that have left the port (line clock, output queue, settling time)
-        self.known = 0  # bytes that surely reached the control: left the port before it last answered
-        # (time of a look at the port, bytes that had left by then), the looks of the last few settling times
-        self.looks: collections.deque = collections.deque([(-math.inf, 0)])
+        self.known = 0  # bytes that surely reached the control (the answers prove it)
+        self.resumed: int | None = None  # bytes written when an XON last ended a pause
         self.answers = 0  # flow-control answers heard from the control (DC1, DC3)
         # A watched carrier or CTS/DSR signal vouches for the control throughout; loop:// echoes what it got.
         self.vouched = bool(settings.carrier != "none" or _HARDWARE.get(settings.flow))
@@ -124,15 +132,6 @@ class Sender:
         """Bytes written but not yet gone from the line, by the line clock and the driver's queue."""
         clock = max(0.0, (self.line_free - now) * self.cps)
         return max(math.ceil(clock), self.queued)
-
-    def left_at(self, when: float) -> int:
-        """The bytes that had left the port by the last look at or before ``when`` (0 before any)."""
-        found = 0
-        for t, left in self.looks:
-            if t > when:
-                break
-            found = left
-        return found
 
     def unsettled(self, now: float) -> int:
         """Bytes that may not have reached the far side yet: in flight, or left less than the settling time ago."""
@@ -175,8 +174,8 @@ class Sender:
         last, left, sent = self.last_sure_block(), self.last_left_block(), self.last_sent_block()
         where = f"block {last} surely reached the control" if last else "no block surely reached the control"
         if left > last:
-            where += f"; blocks {last + 1} to {left} left the port, but the control did not answer after them, " \
-                     "so nothing shows that it holds them"
+            where += f"; blocks {last + 1} to {left} left the port, but no answer of the control " \
+                     "shows that it holds them"
         if sent > max(left, last):
             where += f" (blocks {max(left, last) + 1} to {sent} were on their way and may have arrived too)"
         return where
@@ -221,16 +220,9 @@ class Sender:
     def poll(self, now: float) -> None:
         """Read what the control sent; a read that fails is a lost line."""
         incoming = self.line.read(4096)
-        # An answer read now was sent at the earliest a settling time before the last look that found none (the way
-        # back takes up to a settling time too: a USB adapter's latency timer, the kernel's delivery), and the
-        # control may have taken only what had settled by then: answers vouch for that, not for what left since.
-        vouched_for = self.left_at(self.looks[-1][0] - self.settle_s)
         # Everything that had left the line before this look has left the port; whether the control took it
         # only its answers show.
         self.left = max(self.left, self.pos - self.unsettled(now))
-        self.looks.append((now, self.left))
-        while len(self.looks) > 2 and self.looks[1][0] < now - 3 * self.settle_s:
-            self.looks.popleft()
         if self.vouched:
             self.known = self.left
         if self.echo and incoming:  # loop:// gives back what it took
@@ -241,7 +233,10 @@ class Sender:
         for index, byte in enumerate(incoming):
             if byte in (DC1, DC3) and self.settings.flow == "xonxoff":
                 self.answers += 1
-                self.known = max(self.known, vouched_for)
+                if byte == DC3 and self.resumed is not None:
+                    # Its buffer rose by the span between its marks since the XON that ended the last pause:
+                    # past what had been written before that pause.  When it was sent is not known.
+                    self.known = max(self.known, self.resumed)
             elif byte not in _HARMLESS:
                 if self.stray is not None:
                     self.stray(bytes(self.unflow[-_UNFLOW_KEPT:]) + incoming[index:])
@@ -264,6 +259,7 @@ class Sender:
             elif byte == DC1 and self.settings.flow == "xonxoff":
                 if self.paused:
                     self.log(f"XON after {now - self.pause_since:.3f} s")
+                    self.resumed = self.pos  # nothing was written while paused
                 self.paused = False
         if self.hardware:
             ready = self.line.signal(self.hardware)
@@ -365,7 +361,7 @@ class Sender:
                              "nothing)", "check what the control holds; for a control that never sends XOFF give "
                              "--no-handshake-expected")
         self.log(f"done: {total} bytes in {elapsed:.2f} s, {self.xoffs} XOFF, {self.answers} answers from the "
-                 f"control, the last after block {self.last_sure_block()}")
+                 f"control, which show that block {self.last_sure_block()} surely reached it")
         return TransferResult(self.blocks_total, total, elapsed, self.xoffs, self.max_in_flight, self.cps,
-                              confirmed=self.vouched, answers=self.answers, last_answered_block=self.last_sure_block(),
-                              answered_to_end=self.blocks_within(self.known) == self.blocks_total)
+                              confirmed=self.vouched, answers=self.answers, last_sure_block=self.last_sure_block(),
+                              sure_to_end=self.blocks_within(self.known) == self.blocks_total)
