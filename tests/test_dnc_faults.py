@@ -80,6 +80,41 @@ def test_a_signal_stops_a_receive_with_exit_3_and_nothing_saved(tmp_path):
     assert "stopped by SIGTERM; nothing was saved" in err and not target.exists()
 
 
+@pytest.mark.parametrize("command", ["receive", "send"])
+def test_a_signal_while_the_port_opens_is_exit_3_and_leaves_the_port_free(monkeypatch, tmp_path, command):
+    # The signal lands after the device is open but before the transfer has begun (a CI run caught a
+    # receive there, exit 143 with a generic message): the command stops as it does a moment later.
+    import serial
+
+    from lagsym.dnc import receive_program
+    from lagsym.dnc.lock import release_lock_file, take_lock_file
+    from lagsym.errors import Terminated, TransferError
+
+    opened = serial.Serial.open
+
+    def open_then_signal(self):
+        opened(self)
+        raise Terminated(signal.SIGTERM)
+
+    with KernelPty() as pair:
+        monkeypatch.setattr(serial.Serial, "open", open_then_signal)
+        with pytest.raises(TransferError) as info:
+            if command == "receive":
+                receive_program(pair.near, profile("fanuc"), start_timeout_s=5)
+            else:
+                send_program(pair.near, parse_program(PROGRAM), profile("fanuc"))
+        monkeypatch.undo()
+        assert info.value.exit_status == 3
+        assert ("stopped by SIGTERM; nothing was saved" if command == "receive"
+                else "stopped by SIGTERM while opening") in str(info.value)
+        device = os.path.realpath(pair.near)
+        held = [fd for fd in os.listdir("/proc/self/fd") if os.path.realpath(f"/proc/self/fd/{fd}") == device]
+        assert len(held) == 1  # the pair's own end only: the command's is closed
+        lock, holder = take_lock_file(pair.near)  # and its lock file removed
+        release_lock_file(lock)
+        assert holder is None
+
+
 # -- 5: the port is opened exclusively ----------------------------------------------------------------------
 
 

@@ -9,6 +9,7 @@ on purpose: lagsym reads DC1/DC3 itself (see :mod:`lagsym.dnc.transfer`).
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import select
@@ -59,6 +60,7 @@ class Port:
                 release_lock_file(self._lock_file)
                 raise TransferError(f"cannot open {name}: the port is in use by another program ({'; '.join(others)}); "
                                     "close it and try again")
+        ser = None
         try:
             ser = serial.serial_for_url(name, do_not_open=True)
             ser.baudrate = settings.baud
@@ -85,6 +87,12 @@ class Port:
         except (ValueError, KeyError, *LINE_ERRORS) as e:  # KeyError: pyserial formatting its own URL message
             release_lock_file(self._lock_file)
             raise TransferError(_open_failure(name, e)) from None
+        except BaseException:  # Ctrl-C or a signal while opening: nothing left open or locked
+            if ser is not None:
+                with contextlib.suppress(Exception):
+                    ser.close()
+            release_lock_file(self._lock_file)
+            raise
         self._ser = ser
         # A local device can be waited on: the sender sleeps until the control says something or the line needs
         # more, instead of polling.  A URL port (RFC 2217, socket, loop) buffers in pyserial and is polled.

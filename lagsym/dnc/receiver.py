@@ -118,10 +118,11 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
     from .port import LINE_ERRORS, Port
 
     owned = line is None
-    if owned:
-        line = Port(port, settings, write_timeout=1.0)
     punch = _Punch(inbox or Inbox(), sink, max_bytes)
     try:
+        if owned:
+            line = None  # a signal while the port opens stops the receive as one after it does
+            line = Port(port, settings, write_timeout=1.0)
         if ready:
             ready()
         _collect(line, port, settings, punch, start_timeout_s=start_timeout_s, idle_timeout_s=idle_timeout_s,
@@ -138,7 +139,7 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
                            "reconnect and punch the program again", bytes(punch.wire), f"line lost ({e})",
                            line_lost=True) from None
     finally:
-        if owned:
+        if owned and line is not None:
             line.close()
     try:
         return _program_text(bytes(punch.raw), punch.percents, port, settings)
