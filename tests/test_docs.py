@@ -53,9 +53,46 @@ def _draws(line: str) -> bool:
     return line.startswith("lagsym plot ") or " --plot " in line
 
 
+def _files(line: str) -> tuple[set[str], set[str]]:
+    """The files in the working folder an example reads and those it writes (``-o``)."""
+    words = shlex.split(line)[2:]
+    written = {w for k, w in enumerate(words[1:]) if words[k] in ("-o", "--output")}
+    read = {w for w in words if "." in w and "/" not in w and not w.startswith("-") and " " not in w} - written
+    return read, written
+
+
+def _example_groups() -> dict[str, list[str]]:
+    """Each command's examples, after the earlier examples (of any command) that write the files they read."""
+    examples = [line for _, line in _examples()]
+    files = [_files(line) for line in examples]
+    groups: dict[str, set[int]] = {}
+    for k, (name, _) in enumerate(_examples()):
+        wanted, todo = {k}, [k]
+        while todo:
+            j = todo.pop()
+            for f in files[j][0]:
+                makers = [i for i in range(j) if f in files[i][1]]
+                if makers and makers[-1] not in wanted:
+                    wanted.add(makers[-1])
+                    todo.append(makers[-1])
+        groups.setdefault(name, set()).update(wanted)
+    return {name: [examples[k] for k in sorted(ks)] for name, ks in groups.items()}
+
+
+def test_each_example_group_holds_what_its_examples_read():
+    groups = _example_groups()
+    assert set(groups) == {name for name, _ in _examples()}
+    verify = groups["verify"]
+    assert any(" -o O1000.nc" in line and line.startswith("lagsym toolpath") for line in verify)
+    assert any(line.startswith("lagsym job examples/example-4-job.toml") for line in verify)
+    assert any(line.startswith("lagsym macro") and "-o O1000.nc" in line for line in groups["simulate"])
+
+
 @pytest.mark.slow
-def test_cli_examples_run(tmp_path, monkeypatch):
-    """Run every example of every command, in order, in one folder (later ones use earlier outputs).
+@pytest.mark.parametrize("command", sorted({name for name, _ in _examples()}))
+def test_cli_examples_run(command, tmp_path, monkeypatch):
+    """Run every example of a command, in order, in a folder of its own, after the examples of other commands
+    that write the files they read.
 
     Without an OpenGL the examples that draw are left out and the test skips at the end, naming them
     and the packages to install (the others have run by then)."""
@@ -63,7 +100,7 @@ def test_cli_examples_run(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     can_draw = can_render()
     left_out = []
-    for name, line in _examples():
+    for line in _example_groups()[command]:
         if _draws(line) and not can_draw:
             left_out.append(line)
             continue
