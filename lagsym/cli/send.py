@@ -44,8 +44,8 @@ exclusively.  Exit status 3 on a line fault, a stall, a busy port, Ctrl-C,
 SIGTERM or SIGHUP; the message says which --start-block resumes.  A block
 surely reached the control only when the control's answers prove it (an XOFF
 after the XON that ended a pause: everything sent before that pause), or a
---carrier signal or hardware flow control watched the line; the summary and the faults word apart what left the port and what
-surely arrived.  A drip feed the control never answered at all is a fault
+--carrier signal or hardware flow control watched the line; the summary and
+the faults word apart what left the port and what surely arrived.  A drip feed the control never answered at all is a fault
 (exit 3) unless --no-handshake-expected; so are answers no control sends
 (check the baud rate and format).
 

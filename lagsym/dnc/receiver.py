@@ -120,8 +120,7 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
     owned = line is None
     punch = _Punch(inbox or Inbox(), sink, max_bytes)
     try:
-        if owned:
-            line = None  # a signal while the port opens stops the receive as one after it does
+        if owned:  # inside: a signal while the port opens stops the receive as one after it does
             line = Port(port, settings, write_timeout=1.0)
         if ready:
             ready()
