@@ -179,3 +179,20 @@ def test_the_cli_says_how_a_table_was_read_and_stays_quiet_for_plain_ones(tmp_pa
     assert run_cli("curve", curve, "--columns", "2,3")[1] == "y = -2*x**2 + 8*x - 5\n"
     status, _, err = run_cli("equation", plain, "--columns", "1,2")
     assert status == 2 and "give 3 column numbers" in err
+
+
+def test_quoted_and_plain_cells_read_alike(tmp_path):
+    # A file with no quote anywhere is split without the csv module; one with quotes goes through it.
+    plain = "x,y,z\n" + "".join(f"{a},{b},{c}\n" for a, b, c in POINTS)
+    quoted = '"x","y","z"\n' + "".join(f'"{a}","{b}",{c}\n' for a, b, c in POINTS)
+    a, b = (read_point_file(write(tmp_path, n, t.encode())) for n, t in (("a.csv", plain), ("b.csv", quoted)))
+    assert a.points == b.points
+
+
+def test_two_heights_at_one_place_are_refused_however_the_place_is_written(tmp_path):
+    from lagsym.io import read_scattered_points
+
+    text = "x,y,z\n0,0,1\n1.50,2,3\n4,5,6\n3/2,2.000,7\n"
+    with pytest.raises(InputError, match=r"points 2 and 4 are both at \(x, y\) = \(1\.5, 2\)"):
+        read_scattered_points(write(tmp_path, "s.csv", text.encode()))
+    assert len(read_scattered_points(write(tmp_path, "t.csv", b"x,y,z\n0,0,1\n1.5,2,3\n1.5,2.0001,3\n")).points) == 3

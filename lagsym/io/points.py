@@ -363,12 +363,15 @@ def read_scattered_points(path: str | os.PathLike, columns=None) -> ScatteredPoi
     if isinstance(points, ControlGrid):
         units = units or points.units
         points = points.points()
-    seen: dict[tuple[Fraction, Fraction], int] = {}
+    seen: dict[tuple[int, int, int, int], int] = {}
     for idx, pt in enumerate(points):
-        if (pt[0], pt[1]) in seen:
-            raise InputError(f"{name}: points {seen[(pt[0], pt[1])] + 1} and {idx + 1} are both at (x, y) = "
+        # Keyed by the lowest-terms integers: a Fraction's own hash takes a modular inverse, which is most of
+        # the time of this loop on a million points.
+        key = (pt[0].numerator, pt[0].denominator, pt[1].numerator, pt[1].denominator)
+        if key in seen:
+            raise InputError(f"{name}: points {seen[key] + 1} and {idx + 1} are both at (x, y) = "
                              f"({float(pt[0]):g}, {float(pt[1]):g}); average them or drop one")
-        seen[(pt[0], pt[1])] = idx
+        seen[key] = idx
     return ScatteredPoints(tuple(tuple(pt) for pt in points), name, units, layout, plain)
 
 
