@@ -23,6 +23,23 @@ from ..errors import GridError
 __all__ = ["fit_coefficients"]
 
 
+def _middle_and_half(lo: Fraction, hi: Fraction) -> tuple[Fraction, Fraction]:
+    return Fraction(lo + hi, 2), Fraction(hi - lo, 2) or Fraction(1)
+
+
+def _normalized(values: Sequence[Fraction], middle: Fraction, half: Fraction):
+    """``(v - middle) / half`` for each value, each rounded once to the nearest float.
+
+    In integers: ``(n/d - mn/md) / (hn/hd) = (n md hd - mn hd d) / (d md hn)``, and Python divides two
+    integers correctly rounded, so each is ``float((v - middle) / half)`` without building a Fraction a point.
+    """
+    import numpy as np
+
+    a, b, c = middle.denominator * half.denominator, middle.numerator * half.denominator, \
+        middle.denominator * half.numerator
+    return np.array([(v.numerator * a - b * v.denominator) / (v.denominator * c) for v in values])
+
+
 def _common_denominator(values: Sequence[Fraction]) -> int:
     d = 1
     for v in values:
@@ -159,8 +176,7 @@ def float_residuals(points, coefficients):
 
     xs = [p[0] for p in points]
     ys = [p[1] for p in points]
-    (xm, hx), (ym, hy) = ((Fraction(min(v) + max(v), 2), Fraction(max(v) - min(v), 2) or Fraction(1))
-                          for v in (xs, ys))
+    (xm, hx), (ym, hy) = (_middle_and_half(min(v), max(v)) for v in (xs, ys))
 
     def mat(rows):
         entries = [flint.fmpq(v.numerator, v.denominator) for r in rows for v in r]
@@ -171,8 +187,7 @@ def float_residuals(points, coefficients):
     tx, ty = mat(_shift_matrix(hx, -xm, c.nrows() - 1)), mat(_shift_matrix(hy, -ym, c.ncols() - 1))
     ct = tx.transpose() * c * ty
     cf = np.array([[int(ct[a, b].p) / int(ct[a, b].q) for b in range(ct.ncols())] for a in range(ct.nrows())])
-    t = np.array([float((x - xm) / hx) for x in xs])
-    u = np.array([float((y - ym) / hy) for y in ys])
+    t, u = _normalized(xs, xm, hx), _normalized(ys, ym, hy)
     z = np.array([float(p[2]) for p in points])
     steps = 2 * (ct.nrows() + ct.ncols()) + 8
     bound = 2 * steps * np.finfo(float).eps / 2 * (float(np.abs(cf).sum()) + float(np.abs(z).max()))
