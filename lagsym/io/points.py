@@ -365,8 +365,7 @@ def read_scattered_points(path: str | os.PathLike, columns=None) -> ScatteredPoi
         points = points.points()
     seen: dict[tuple[int, int, int, int], int] = {}
     for idx, pt in enumerate(points):
-        # Keyed by the lowest-terms integers: a Fraction's own hash takes a modular inverse, which is most of
-        # the time of this loop on a million points.
+        # the lowest-terms integers: a Fraction's own hash takes a modular inverse, most of this loop's time
         key = (pt[0].numerator, pt[0].denominator, pt[1].numerator, pt[1].denominator)
         if key in seen:
             raise InputError(f"{name}: points {seen[key] + 1} and {idx + 1} are both at (x, y) = "
