@@ -163,20 +163,20 @@ def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
     return tuple(z * scale - v * s.dz for z, v in zip(s.Z, values)), scale * s.dz
 
 
-def float_residuals(points, coefficients):
+def float_residuals(points, coefficients, box):
     """``z - p(x, y)`` for every point in floating point, for the fit's statistics (its RMS, largest residual and
     score), where the exact residuals of many points are integers of thousands of digits; and a bound on how far
     any of them may be from the exact one.
 
-    ``p`` is taken to the monomials of coordinates normalized to ``[-1, 1]`` over the points' box exactly, its
+    ``p`` is taken to the monomials of coordinates normalized to ``[-1, 1]`` over the points' ``box``
+    (``x0, x1, y0, y1``, exact) exactly, its
     coefficients rounded once; on that interval each term is at most its coefficient, so the rounding errors of
     the sums are within ``(2 (P + Q) + 8) u (sum |c| + |z|)`` (``u`` the unit roundoff), doubled here.
     """
     import numpy as np
 
-    xs = [p[0] for p in points]
-    ys = [p[1] for p in points]
-    (xm, hx), (ym, hy) = (_middle_and_half(min(v), max(v)) for v in (xs, ys))
+    x0, x1, y0, y1 = box
+    (xm, hx), (ym, hy) = _middle_and_half(x0, x1), _middle_and_half(y0, y1)
 
     def mat(rows):
         entries = [flint.fmpq(v.numerator, v.denominator) for r in rows for v in r]
@@ -187,7 +187,7 @@ def float_residuals(points, coefficients):
     tx, ty = mat(_shift_matrix(hx, -xm, c.nrows() - 1)), mat(_shift_matrix(hy, -ym, c.ncols() - 1))
     ct = tx.transpose() * c * ty
     cf = np.array([[int(ct[a, b].p) / int(ct[a, b].q) for b in range(ct.ncols())] for a in range(ct.nrows())])
-    t, u = _normalized(xs, xm, hx), _normalized(ys, ym, hy)
+    t, u = _normalized([p[0] for p in points], xm, hx), _normalized([p[1] for p in points], ym, hy)
     z = np.array([float(p[2]) for p in points])
     steps = 2 * (ct.nrows() + ct.ncols()) + 8
     bound = 2 * steps * np.finfo(float).eps / 2 * (float(np.abs(cf).sum()) + float(np.abs(z).max()))

@@ -97,7 +97,7 @@ class SurfaceFit:
 
     @cached_property
     def _floats(self) -> tuple[np.ndarray, float]:
-        found, bound = float_residuals(self.points, self.coefficients)
+        found, bound = float_residuals(self.points, self.coefficients, self.box)
         return readonly(found), bound
 
     @property
@@ -344,8 +344,9 @@ def fit_surface(points, degree=None, *, criterion: str | None = None, weights=No
         chosen = scores[0][0]
     scaled = _Scaled.of(pts, w)
     coeffs = _solve(scaled, chosen, source)
-    x0, x1 = min(p[0] for p in pts), max(p[0] for p in pts)
-    y0, y1 = min(p[1] for p in pts), max(p[1] for p in pts)
+    # the box from the integers of the common denominators: no comparison of two Fractions a point
+    x0, x1 = Fraction(min(scaled.X), scaled.dx), Fraction(max(scaled.X), scaled.dx)
+    y0, y1 = Fraction(min(scaled.Y), scaled.dy), Fraction(max(scaled.Y), scaled.dy)
     samples = samples_for(len(pts))
     amp = amplification(pts, w, chosen, samples)
     fit = SurfaceFit(surface=_surface(coeffs, (x0, x1, y0, y1), source, units, amp), coefficients=coeffs,
