@@ -9,6 +9,7 @@ request, 3 for hardware and line faults.
 from __future__ import annotations
 
 import enum
+import signal
 
 
 class ExitStatus(enum.IntEnum):
@@ -71,6 +72,11 @@ class Terminated(KeyboardInterrupt):
     def __init__(self, signum: int):
         super().__init__(signum)
         self.signum = signum
+
+
+def stopped_by(e: KeyboardInterrupt) -> str:
+    """``"stopped by SIGTERM"`` (the signal's name) for :class:`Terminated`, ``"stopped by the user"`` for Ctrl-C."""
+    return f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated) else "stopped by the user"
 
 
 class TransferError(LagsymError, OSError):

@@ -16,12 +16,11 @@ stays there for the next call, and ``sink`` sees every byte as it arrives.
 
 from __future__ import annotations
 
-import signal
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ..errors import Terminated, TransferError
+from ..errors import TransferError, stopped_by
 from .blocks import DC1, DC2, DC3, DC4, ISO_840
 from .settings import LineSettings
 
@@ -127,7 +126,7 @@ def receive_program(port: str, settings: LineSettings, *, start_timeout_s: float
         _collect(line, port, settings, punch, start_timeout_s=start_timeout_s, idle_timeout_s=idle_timeout_s,
                  progress=progress, log=log or (lambda _m: None), should_stop=should_stop)
     except KeyboardInterrupt as e:
-        what = f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated) else "stopped by the user"
+        what = stopped_by(e)
         raise ReceiveFault(f"receive on {port} {what}; nothing was saved ({len(punch.wire)} bytes had arrived): "
                            "start lagsym receive again, then punch the program again", bytes(punch.wire),
                            what) from None

@@ -52,11 +52,10 @@ control cannot read what is sent either.
 from __future__ import annotations
 
 import math
-import signal
 import time
 from collections.abc import Callable
 
-from ..errors import Terminated, TransferError
+from ..errors import TransferError, stopped_by
 from .blocks import DC1, DC2, DC3, DC4
 from .results import LineFault, TransferProgress, TransferResult
 from .settings import CARRIER_LOSS_S, LineSettings
@@ -213,8 +212,7 @@ class Sender:
 
     def interrupted(self, e: KeyboardInterrupt) -> LineFault:
         """The fault for Ctrl-C, SIGTERM or SIGHUP."""
-        what = (f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated)
-                else "stopped by the user")
+        what = stopped_by(e)
         return self.fault(what, "when the control is ready")
 
     def poll(self, now: float) -> None:

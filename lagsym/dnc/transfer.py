@@ -9,10 +9,9 @@ pyserial is not loaded.
 
 from __future__ import annotations
 
-import signal
 from collections.abc import Callable
 
-from ..errors import InputError, Terminated, TransferError
+from ..errors import InputError, TransferError, stopped_by
 from ..values import choice
 from .blocks import Program, check_drip, check_iso, frame, tv_padded
 from .priority import realtime
@@ -130,8 +129,8 @@ def _send(port, program, settings, mode, *, start_block, segments, progress, log
         try:
             line = Port(port, settings, write_timeout=timeout)
         except KeyboardInterrupt as e:
-            what = f"stopped by {signal.Signals(e.signum).name}" if isinstance(e, Terminated) else "stopped by the user"
-            raise TransferError(f"{what} while opening {port}; nothing was sent: send the program again") from None
+            raise TransferError(f"{stopped_by(e)} while opening {port}; nothing was sent: "
+                                "send the program again") from None
     try:
         sender = Sender(line, segments, settings, mode, port, progress=progress, log=log,
                         resumable_from=first_resumable_block(program) if start_block <= 1 else 2, stray=stray)
