@@ -247,7 +247,7 @@ def test_the_roughing_page_quotes_the_roughing_macro(tmp_path, run_cli):
     assert (f"the Fanuc program is {sizes['fanuc']} bytes and the LinuxCNC one {sizes['linuxcnc']}, where the "
             f"Fanuc point-list program is {sizes['points']} bytes") in text
     assert f"`A` runs from {a[0]} to {a[1]} mm" in text and f"at most {a[2]} per mm" in text
-    surface, settings, tool, spec, stock, rm, _ = plan(stepdown=2.0, step=0.5)
+    surface, settings, tool, spec, stock, rm, _ = plan(stepdown=2.0, step=0.5, ramp_angle_deg=90.0)
     per = len(rm.points_mm) // len(rm.levels_mm)
     last = rm.points_mm[-per:]
     q = last[(last[:, 0] >= BOX[0]) & (last[:, 0] <= BOX[1])]

@@ -20,7 +20,7 @@ from lagsym.io import read_points
 from lagsym.lagrange import lagrange_surface
 from lagsym.machine import MachineSettings, Tool
 from lagsym.macro.program import RENDERERS
-from lagsym.macro.roughing import rough_macro
+from lagsym.macro.roughing import rough_macro, rough_macro_program
 from lagsym.simulate import simulate
 from lagsym.toolpath.rough import RoughSpec, rough_toolpath, stock_around
 
@@ -69,10 +69,10 @@ def drop(x, y, shape="flat", radius=5.0, corner=None, n=41):
 
 
 def plan(shape="flat", diameter=10.0, corner=None, dialect="fanuc", precision=8, stepdown=10.0, step=1.0,
-         stepover=5.0, margin=0.0, direction="x"):
+         stepover=5.0, margin=0.0, direction="x", ramp_angle_deg=None):
     surface = lagrange_surface(read_points(EX4))
     settings = MachineSettings(dialect=dialect, mm_per_unit=20.0, safe_z_mm=120.0)
-    tool = Tool(shape, diameter, corner)
+    tool = Tool(shape, diameter, corner, ramp_angle_deg=ramp_angle_deg)
     spec = RoughSpec(stepdown, stepover, step, 0.3, direction)
     stock = stock_around(BOX, TOP, margin)
     rm = rough_macro(surface, tool, stock, spec, settings, precision=precision)
@@ -283,7 +283,7 @@ def test_rough_macro_is_refused_where_the_control_cannot_hold_its_variables(run_
     used = sorted({int(n) for n in re.findall(r"#(\d+)", text)})
     small = ((100, 149), (500, 531))
     outside = [n for n in used if not any(lo <= n <= hi for lo, hi in small)]
-    assert outside and used[0] == 100 and used[-1] == 627 and len(used) == 176, (used[:3], used[-3:], len(used))
+    assert outside and used[0] == 100 and used[-1] == 627 and len(used) == 178, (used[:3], used[-3:], len(used))
     with pytest.raises(ControlAlarm, match="alarm 115"):
         simulate(text, "fanuc", 8, variable_ranges=small)
     status, out, err = run_cli(*args, tmp_path / "small.nc", "--variables", "small")
@@ -310,3 +310,26 @@ def test_a_job_file_variables_profile_is_checked_for_its_roughing_macro(run_cli,
     job.write_text(job_text(**{'dialect = "linuxcnc"': 'dialect = "fanuc"\nvariables = "small"'}))
     status, _, err = run_cli("job", job, "-o", tmp_path / "job.nc")
     assert status == 2 and "variables = 'small' applies to a roughing macro only" in err, err
+
+
+@pytest.mark.parametrize("dialect, precision", [("fanuc", 8), ("linuxcnc", 15), ("heidenhain", 8)])
+def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialect, precision):
+    """From Python: a non-centre-cutting mill (3 degrees) is planned, not refused; the header states the
+    angle, and the simulated control never descends over the block steeper than it (one 0.001 mm unit of
+    rounding allowed per move), where the same macro planned to plunge does."""
+    steepest = {}
+    for angle in (None, 90.0):
+        surface = lagrange_surface(read_points(EX4))
+        settings = MachineSettings(dialect=dialect, mm_per_unit=20.0, safe_z_mm=120.0)
+        tool = Tool("flat", 10.0, centre_cutting=angle is not None, ramp_angle_deg=angle)
+        rm = rough_macro(surface, tool, stock_around(BOX, TOP), RoughSpec(10.0, 5.0, 1.0, 0.3), settings,
+                         precision=precision)
+        text = rough_macro_program(rm, settings)
+        assert f"RAMP INTO MATERIAL AT MOST {tool.max_ramp_deg:g} DEG" in text
+        pts = simulate(text, dialect, precision).feed_points()
+        a, b = pts[:-1], pts[1:]
+        run = np.hypot(*(b[:, :2] - a[:, :2]).T)
+        over = (b[:, 0] >= BOX[0]) & (b[:, 0] <= BOX[1]) & (run > 0)
+        drop = (a[:, 2] - b[:, 2])[over] - 1e-3
+        steepest[angle] = float(np.degrees(np.arctan2(drop, run[over])).max())
+    assert 2.0 < steepest[None] <= 3.0 and steepest[90.0] > 60.0, steepest

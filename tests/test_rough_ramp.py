@@ -157,8 +157,6 @@ def test_a_plunge_angle_of_90_descends_as_the_surface_falls(rs274, extra):
     (["--plunge-angle", "0"], "--plunge-angle"),
     (["--plunge-angle", "91"], "--plunge-angle"),
     (["--not-centre-cutting", "--plunge-angle", "90"], "cannot make"),
-    (["--macro", "--not-centre-cutting"], "does not cut at its centre"),
-    (["--macro", "--plunge-angle", "10"], "ramp angle of 10 degrees"),
     (["--plunge-angle", "0.5", "--max-points", "110000"], "with its ramps at 0.5 degrees is"),
 ])
 @pytest.mark.slow
@@ -208,3 +206,34 @@ def test_the_job_file_gives_the_tool_its_ramp(run_cli, tmp_path, extra, status, 
     got, _, err = run_cli("job", job, "-o", out)
     assert got == status, err
     assert words in (out.read_text() if status == 0 else err)
+
+
+def _left_above_surface(h):
+    """Material the height map ``h`` holds above the exact surface plus the 0.3 mm stock, over the box's cells."""
+    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
+    fx, fy = np.meshgrid(gx, gy, indexing="ij")
+    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    left = h[inbox] - (exact_heights(EX4, fx[inbox], fy[inbox]) + 0.3)
+    return float(left.mean()), float(left.max())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("extra, limit", [([], 15.0), (["--not-centre-cutting"], 3.0),
+                                          (["--plunge-angle", "90"], 90.0)])
+def test_the_roughing_macro_ramps_at_the_tool_angle(rs274, extra, limit):
+    """The roughing macro, run by rs274 (the control computes every tip): no feed move enters the block's
+    material going down steeper than the angle its header states, a plunging one (90) does, and the material
+    each leaves above the surface plus the stock is the figure docs/roughing.md quotes."""
+    text = _program(["--macro"] + extra)
+    assert f"RAMP INTO MATERIAL AT MOST {limit:g} DEG" in text
+    mv = moves(rs274, text)
+    count, deepest, steepest, h = descents_into_stock(mv, min(limit, 15.0))
+    page = " ".join(_page().split())
+    mean, most = _left_above_surface(h)
+    if limit < 90:
+        assert count == 0 and limit - 1.0 < steepest <= limit + 0.01, (count, deepest, steepest)
+        assert f"{mean:.2f} mm on average and {most:.2f} at most" in page, (mean, most)
+    else:
+        assert count > 0 and steepest > 60, (count, steepest)
+        assert f"plunging macro descends into material in {count} moves, up to {deepest:.2f} mm" in page
+        assert f"leaves {mean:.2f} mm on average above the surface plus the stock ({most:.2f} at most" in page

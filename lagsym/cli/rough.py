@@ -28,8 +28,9 @@ the header states.
 With --macro the program is a parametric macro instead: the control loops
 over the levels, rows and points and computes each tip height from the
 surface equation, never below the drop-cutter height plus the stock (see
-docs/roughing.md for the proof of its clearance); it follows the surface
-down as steeply as it falls, so it needs a tool that may plunge.
+docs/roughing.md for the proof of its clearance); inside a row it descends
+no steeper than the same ramp angle, leaving wedges on flanks that fall
+along a row to the rows that run the other way.
 
 FILE may be a piecewise surface ('lagsym piecewise'): the cutter is dropped
 on every piece within its reach, as for toolpath.  --macro is refused for

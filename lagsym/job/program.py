@@ -91,9 +91,7 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
         kind = op.spec.kind + (" MACRO" if isinstance(op.path, RoughMacro) else "") + (
             " REST" if op.spec.options.get("rest") else "")
         out.append(f.comment(iso_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN")))
-        if isinstance(op.path, RoughMacro):
-            out.append(f.comment(iso_comment(f"{i} PLUNGES INTO MATERIAL: A CENTRE-CUTTING TOOL")))
-        elif op.spec.kind == "rough":
+        if op.spec.kind == "rough":  # a point list or a macro alike
             out.append(f.comment(iso_comment(f"{i} RAMP INTO MATERIAL AT MOST {t.tool.max_ramp_deg:g} DEG")))
     out.append(f.comment(iso_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN")))
     out.append(f"{units_word(s)} {f.safe_start}")

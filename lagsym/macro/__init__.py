@@ -15,7 +15,8 @@ does not depend on the step.  The modules, in the order data flows through them:
 - :mod:`.fanuc`, :mod:`.linuxcnc`, :mod:`.heidenhain`: one renderer a dialect;
 - :mod:`.program`: :func:`macro_program`, the one entry point;
 - :mod:`.stats`: the size comparison with a point list;
-- :mod:`.roughing`, :mod:`.clearance`: the roughing macro (:func:`rough_macro`) and the proof of its clearance.
+- :mod:`.roughing`, :mod:`.clearance`: the roughing macro (:func:`rough_macro`) and the proof of its clearance;
+- :mod:`.roughpath`: the path the roughing macro's control computes, its descents held to the ramp angle.
 
 :mod:`lagsym.simulate` dry-runs the result.
 """

@@ -14,16 +14,19 @@
                 z = F(pc, rc) + stock, zp, zr = the slopes there;  ti = its tile
                 z = z + R * SQRT[zp**2 + zr**2] + A[ti, tj];  if z > B[ti, tj]: z = B[ti, tj]
                 if z < lv: z = lv
-                G1 to (p, r, z)
+                if i > 0 and z < zq - |p - pq| T: z = zq - |p - pq| T      T: the ramp angle's tangent
+                G1 to (p, r, z);  zq = z;  pq = p
             d = 1 - d
         w = 1 - w
 
 so the tool runs the point-list roughing's zig-zag (:mod:`lagsym.toolpath.rough`):
 every row starts and ends beside the block by the tool radius plus the
 clearance, so every level is entered from the air, and the links between
-rows and levels run there.  The tables ``A`` and ``B`` (set at the start,
-read with ``#[..]``; one tile and no table for a dialect without them) and
-the proof are in :mod:`.clearance`:
+rows and levels run there; inside a row no descent is steeper than the
+tool's ramp angle (:mod:`.roughpath`; none held for a plunge, 90 degrees).
+The tables ``A`` and ``B`` (set at the start, read with ``#[..]``; one tile
+and no table for a dialect without them) and the proof are in
+:mod:`.clearance`:
 no position and no move goes below the exact drop-cutter height plus the
 stock.  The program's size depends on the surface's degree, not on the block.
 """
@@ -51,10 +54,10 @@ from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .loops import MacroLoops
 from .model import Assign, Choose, Clamp, Item, Loop, Move, SetItem, Var, add, const, decimal_context, mul, run, sqrt, sub, var
 from .raster import Axis, MacroRaster
+from .roughpath import b_mm, model, path, ramp_note, ramp_tangent, xy
 from .roughvars import check_rough_variables
 
-__all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING",
-           "check_plunging"]
+__all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]
 
 MACRO_MILLING = ("zigzag",)
 JOB_MACROS = names(point_lists=True, macros=True)
@@ -165,16 +168,27 @@ def _tile(index: Var, position: Var, edges) -> tuple:
 
 
 def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, *, top: Fraction, sd: Fraction,
-                low: Fraction, levels: int, direction: str) -> tuple[tuple, tuple, tuple]:
+                low: Fraction, levels: int, direction: str,
+                tan_a: Fraction | None = None) -> tuple[tuple, tuple, tuple]:
     """The loops, and the row and point statements of ``F + stock + R |grad F|`` (for the arithmetic check).
 
     ``tables`` is ``(A, B)`` as constants (one tile) or ``(base, tiles)``: the
-    tables' first variable number and tiles a side.
+    tables' first variable number and tiles a side.  ``tan_a`` holds every
+    descent inside a row to that slope (:mod:`.roughpath`); None lets the tip
+    fall as the surface does.
     """
     n, j, jj, i, kk, t = var("n"), var("j"), var("jj"), var("i"), var("kk"), var("t")
     w, d, lv, r, rc, p, pc, z, q = var("w"), var("d"), var("lv"), var("r"), var("rc"), var("p"), var("pc"), \
         var("z"), var("q")
     zp, zr, ti, tj, ia, ib = var("zp"), var("zr"), var("ti"), var("tj"), var("ia"), var("ib")
+    zq, pq = var("zq"), var("pq")  # the row's last tip and position, for the ramp
+    ramp, keep, start = (), (), ()
+    if tan_a is not None:  # q = zq - |p - pq| tan, low at a row's first point (beside the block, not held)
+        ramp = (Assign(q, mul(sub(p, pq), sub(const(1), mul(const(2), d)))),
+                Assign(q, sub(zq, mul(q, const(tan_a)))),
+                Choose(q, i, "LT", const(Fraction(1, 2)), const(low)),
+                Choose(z, z, "LT", q, q))
+        keep, start = (Assign(zq, z), Assign(pq, p)), (Assign(zq, const(low)), Assign(pq, const(lay.e0)))
     row_code = tuple(row_statements(rf, rc, slopes=True))
     point_code = tuple(point_statements(rf, pc, z, slopes=True)) + (
         Assign(q, sqrt(add(mul(zp, zp), mul(zr, zr)))),
@@ -201,7 +215,9 @@ def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, *, top: Fra
         *point_code,
         *cap,
         Choose(z, z, "LT", lv, lv),
+        *ramp,
         Move(p, r, z) if direction == "x" else Move(r, p, z),
+        *keep,
     )
     row_body = (
         Assign(t, sub(const(lay.nr), mul(const(2), j))),
@@ -222,24 +238,13 @@ def _statements(rf: RowForm, lay: _Layout, radius: Fraction, tables, *, top: Fra
         Loop(j, lay.nr, row_body),
         Assign(w, sub(const(1), w)),
     )
-    body = (Assign(w, const(0)), Assign(d, const(0)), Loop(n, levels - 1, level_body))
+    body = (Assign(w, const(0)), Assign(d, const(0)), *start, Loop(n, levels - 1, level_body))
     return body, row_code, point_code
 
 
 def _near(v_mm: float, per_mm: Fraction) -> Fraction:
     """A length given in mm, in program units, on the loops' grid (a decimal as written, not its binary float)."""
     return round(Fraction(repr(float(v_mm))) * per_mm / _GRID) * _GRID
-
-
-def _b_mm(ev, place, radius_mm: float, stock_mm: float, x_mm, y_mm) -> np.ndarray:
-    """``F + stock + R |grad F|`` (mm) at box positions ``x_mm, y_mm`` (machine mm), in floats."""
-    u, v = place.to_surface(np.asarray(x_mm, float), np.asarray(y_mm, float))
-    g = np.hypot(ev.fast_points(u, v, dx=1), ev.fast_points(u, v, dy=1))
-    return place.height_mm(ev.fast_points(u, v)) + stock_mm + radius_mm * g
-
-
-def _xy(direction: str, p, r):
-    return (p, r) if direction == "x" else (r, p)
 
 
 def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: MachineSettings, *, per_mm: Fraction,
@@ -256,8 +261,8 @@ def _arithmetic_mm(rf, lay: _Layout, radius: Fraction, ev, place, settings: Mach
         for pv in ps:
             env["pc"] = ctx.create_decimal(repr(float(pv)))
             got.append(float(run(point_code, env, ctx)["z"]))
-        x, y = _xy(rf.direction, ps / float(per_mm), np.full(len(ps), rv / float(per_mm)))
-        want = _b_mm(ev, place, float(radius / per_mm), settings.stock_to_leave_mm, x, y)
+        x, y = xy(rf.direction, ps / float(per_mm), np.full(len(ps), rv / float(per_mm)))
+        want = b_mm(ev, place, float(radius / per_mm), settings.stock_to_leave_mm, x, y)
         worst = max(worst, float(np.abs(np.array(got) / float(per_mm) - want).max()))
         size = max(size, float(np.abs(want).max()))
     ulp = float(Decimal(1).scaleb(Decimal(repr(size * float(per_mm))).adjusted() + 1 - precision)) / float(per_mm)
@@ -297,7 +302,6 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     if spec.milling not in MACRO_MILLING:
         raise ToolpathError(f"milling {spec.milling!r}: a roughing macro cuts zig-zag only (a one-way raster "
                             "retracts over the block between rows); leave out the macro for climb or conventional")
-    check_plunging(tool)
     form = form or ("lagrange" if precision <= 8 else "horner")
     choice(form, FORMS, "form")
     settings = dataclasses.replace(settings, stock_to_leave_mm=spec.stock_to_leave_mm)
@@ -319,7 +323,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
                              direction=spec.direction)
     a = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.a_mm]
     b = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.b_mm]
-    rows, pts, tip = _model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a=a, b=b,
+    rows, pts, tip = model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a=a, b=b,
                             per_mm=per_mm, direction=spec.direction)
     top, sd = _near(stock.top_mm, per_mm), _near(spec.stepdown_mm, per_mm)
     low = _down(Fraction(repr(float(tip.min()))) * per_mm)
@@ -336,35 +340,18 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
         tables = (base, tiles)
         setup = tuple(SetItem(base + k * tiles * tiles + ir * tiles + ip, const(t[ip][ir]))
                       for k, t in enumerate((a, b)) for ir in range(tiles) for ip in range(tiles))
+    tan_a = ramp_tangent(tool)
     body, row_code, point_code = _statements(rf, lay, radius, tables, top=top, sd=sd, low=low, levels=count,
-                                             direction=spec.direction)
-    path = _path(rows, pts, tip, levels, spec.direction)
-    _check_safe_z(float(path[:, 2].max()), settings)
-    start = tuple(Fraction(repr(float(v))) * per_mm for v in path[0])
+                                             direction=spec.direction, tan_a=tan_a)
+    tips = path(rows, pts, tip, levels, spec.direction, tan_a)
+    _check_safe_z(float(tips[:, 2].max()), settings)
+    start = tuple(Fraction(repr(float(v))) * per_mm for v in tips[0])
     raster = MacroRaster(spec.direction, rows=Axis("Y" if spec.direction == "x" else "X", lay.c0, lay.c1, lay.dr,
                                                    lay.nr),
                          points=Axis("X" if spec.direction == "x" else "Y", lay.a0, lay.a1, lay.dp, lay.np_))
     loops = MacroLoops(body=setup + body, raster=raster, form=rf, start=start, row_code=row_code,
                        point_code=point_code, title="LAGSYM ROUGHING MACRO")
-    return RoughMacro(loops, clear, levels, path, precision, tool, stock, spec)
-
-
-def check_plunging(tool: Tool) -> Tool:
-    """The tool, refused where it may not plunge: a roughing macro follows the surface down as steeply as it falls.
-
-    The control computes each tip from the position alone, not from what the
-    passes before left, so it cannot ramp a descent into material without
-    leaving wedges no later level takes; the point-list roughing
-    (:func:`~lagsym.toolpath.rough.rough_toolpath`) ramps.  A tool with no
-    ramp angle stated is taken to be a centre-cutting mill that may plunge,
-    and the program's header says so.
-    """
-    if tool.centre_cutting and tool.ramp_angle_deg in (None, 90.0):
-        return tool
-    what = ("a cutter that does not cut at its centre" if not tool.centre_cutting
-            else f"a ramp angle of {tool.ramp_angle_deg:g} degrees")
-    raise ToolpathError(f"{what}: a roughing macro descends into material as steeply as the surface falls "
-                        "(it plunges); leave out the macro for roughing that ramps at the tool's angle")
+    return RoughMacro(loops, clear, levels, tips, precision, tool, stock, spec)
 
 
 def _check_safe_z(highest_mm: float, settings: MachineSettings) -> None:
@@ -379,38 +366,6 @@ def _check_safe_z(highest_mm: float, settings: MachineSettings) -> None:
                             f"{settings.feed_height_mm:g} mm above the highest tip of the roughing macro "
                             f"{highest_mm:.3f} mm (its clearance lifts the tool above the surface on steep flanks): "
                             f"raise --safe-z to at least {need:.3f} mm")
-
-
-def _model(ev, place, lay: _Layout, radius_mm: float, stock_mm: float, *, a, b, per_mm: Fraction, direction: str):
-    """The rows' and points' positions (mm) and the tip before the level (mm) at each, rows by points."""
-    f = float(per_mm)
-    kk = np.arange(lay.np_ + 1)
-    p = np.minimum(float(lay.a0) + (kk - 1) * float(lay.dp), float(lay.a1))
-    p[0], p[-1] = float(lay.e0), float(lay.e1)
-    r = np.minimum(float(lay.c0) + np.arange(lay.nr + 1) * float(lay.dr), float(lay.c1))
-    pc, rc = np.clip(p, float(lay.a0), float(lay.a1)), np.clip(r, float(lay.b0), float(lay.b1))
-    ti = np.searchsorted(np.array([float(e) for e in lay.p_edges]), pc)
-    tj = np.searchsorted(np.array([float(e) for e in lay.r_edges]), rc)
-    at = np.array([[float(v) for v in row] for row in a]) / f
-    bt = np.array([[float(v) for v in row] for row in b]) / f
-    pp, rr = np.meshgrid(pc / f, rc / f)
-    x, y = _xy(direction, pp, rr)
-    high = _b_mm(ev, place, radius_mm, stock_mm, x, y) + at[ti[None, :], tj[:, None]]
-    return r / f, p / f, np.minimum(high, bt[ti[None, :], tj[:, None]])
-
-
-def _path(rows, pts, b, levels, direction: str) -> np.ndarray:
-    """The tips in the order the loops visit them (mm)."""
-    out, d = [], 0
-    for n, lv in enumerate(levels):
-        order = range(len(rows)) if n % 2 == 0 else range(len(rows) - 1, -1, -1)
-        for j in order:
-            z = np.maximum(b[j], lv)
-            p, zz = (pts, z) if d == 0 else (pts[::-1], z[::-1])
-            x, y = _xy(direction, p, np.full(len(p), rows[j]))
-            out.append(np.column_stack([x, y, zz]))
-            d = 1 - d
-    return np.vstack(out)
 
 
 def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
@@ -441,10 +396,12 @@ def rough_macro_blocks(rm: RoughMacro, settings: MachineSettings, variable_base:
 
 def rough_macro_program(rm: RoughMacro, settings: MachineSettings, variable_base: int | None = None,
                         variables: str = "full") -> str:
-    """The whole program for ``rm``: header, tool, approach, the loops, the end (Fanuc, LinuxCNC or Heidenhain)."""
+    """The whole program for ``rm``: header (the ramp angle among its notes), tool, approach, the loops, the end
+    (Fanuc, LinuxCNC or Heidenhain)."""
     from .program import RENDERERS
 
     c = control(settings.dialect, "macro dialect", names(macros=True))
     check_rough_variables(rm, c.name, variables, variable_base)
+    settings = dataclasses.replace(settings, notes=(*settings.notes, ramp_note(rm.tool)))
     return RENDERERS[c.macro.name](rm.loops, settings, precision=rm.precision, variable_base=variable_base,
                               variables=variables)

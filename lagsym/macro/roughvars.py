@@ -2,8 +2,8 @@
 
 A roughing macro (:mod:`.roughing`) numbers its loops' variables from a
 base, as a finishing macro does, and keeps its clearance tables at the
-language's ``table_base``: on a Fanuc ``#100``-``#147`` and ``#500``-``#627``
-for Example 4, 176 variables, which a small Fanuc (``#100``-``#149``,
+language's ``table_base``: on a Fanuc ``#100``-``#149`` and ``#500``-``#627``
+for Example 4, 178 variables, which a small Fanuc (``#100``-``#149``,
 ``#500``-``#531``) cannot hold.  :func:`check_rough_variables` refuses such a
 program with the figures, as :func:`lagsym.macro.macro_program` does a
 finishing macro.
@@ -39,7 +39,7 @@ def rough_macro_variables(rm, dialect: str, variable_base: int | None = None) ->
     >>> rm = rough_macro(s, Tool("flat", 2.0), Stock(0, 4, 0, 4, 4.0), RoughSpec(1.5, 1.5, 1.0, 0.5),
     ...                  MachineSettings(dialect="fanuc"), precision=8)
     >>> rough_macro_variables(rm, "fanuc")
-    ((100, 132), (500, 627))
+    ((100, 134), (500, 627))
     """
     from . import fanuc, heidenhain
 
