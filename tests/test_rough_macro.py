@@ -312,24 +312,32 @@ def test_a_job_file_variables_profile_is_checked_for_its_roughing_macro(run_cli,
     assert status == 2 and "variables = 'small' applies to a roughing macro only" in err, err
 
 
-@pytest.mark.parametrize("dialect, precision", [("fanuc", 8), ("linuxcnc", 15), ("heidenhain", 8)])
-def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialect, precision):
+BUMP = [(x, y, 3 if (x, y) == (2, 2) else 0) for x in (0, 2, 4) for y in (0, 2, 4)]  # flanks up to 71 degrees
+
+
+@pytest.mark.parametrize("dialect, precision, points, scale, box, top", [
+    ("fanuc", 8, EX4, 20.0, BOX, TOP), ("linuxcnc", 15, EX4, 20.0, BOX, TOP), ("heidenhain", 8, EX4, 20.0, BOX, TOP),
+    ("fanuc", 8, BUMP, 10.0, (0.0, 40.0, 0.0, 40.0), 32.0)])
+def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialect, precision, points, scale, box,
+                                                                          top):
     """From Python: a non-centre-cutting mill (3 degrees) is planned, not refused; the header states the
     angle, and the simulated control never descends over the block steeper than it (one 0.001 mm unit of
-    rounding allowed per move), where the same macro planned to plunge does."""
+    rounding allowed per move), where the same macro planned to plunge does: on Example 4 and a bump."""
+    from lagsym.grid import grid_from_points
+
     steepest = {}
     for angle in (None, 90.0):
-        surface = lagrange_surface(read_points(EX4))
-        settings = MachineSettings(dialect=dialect, mm_per_unit=20.0, safe_z_mm=120.0)
+        surface = lagrange_surface(read_points(points) if points is EX4 else grid_from_points(points))
+        settings = MachineSettings(dialect=dialect, mm_per_unit=scale, safe_z_mm=120.0)
         tool = Tool("flat", 10.0, centre_cutting=angle is not None, ramp_angle_deg=angle)
-        rm = rough_macro(surface, tool, stock_around(BOX, TOP), RoughSpec(10.0, 5.0, 1.0, 0.3), settings,
+        rm = rough_macro(surface, tool, stock_around(box, top), RoughSpec(10.0, 5.0, 1.0, 0.3), settings,
                          precision=precision)
         text = rough_macro_program(rm, settings)
         assert f"RAMP INTO MATERIAL AT MOST {tool.max_ramp_deg:g} DEG" in text
         pts = simulate(text, dialect, precision).feed_points()
         a, b = pts[:-1], pts[1:]
         run = np.hypot(*(b[:, :2] - a[:, :2]).T)
-        over = (b[:, 0] >= BOX[0]) & (b[:, 0] <= BOX[1]) & (run > 0)
+        over = (b[:, 0] >= box[0]) & (b[:, 0] <= box[1]) & (run > 0)
         drop = (a[:, 2] - b[:, 2])[over] - 1e-3
         steepest[angle] = float(np.degrees(np.arctan2(drop, run[over])).max())
     assert 2.0 < steepest[None] <= 3.0 and steepest[90.0] > 60.0, steepest
