@@ -66,6 +66,13 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+def _points_of(value, cls: type, make: str):
+    """``value`` if it is a ``cls`` (a grid or a curve's points), else an InputError saying how to make one."""
+    if not isinstance(value, cls):
+        raise InputError(f"{value!r:.60} is not a {cls.__name__}: make one with {make} (or read_points(file))")
+    return value
+
+
 def _variable(value, what: str):
     """A variable as the value keeps it: a plain symbol by its name (no SymPy needed), any other symbol itself."""
     if isinstance(value, str):
@@ -382,6 +389,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
     >>> lagrange_curve(pts, x=t).expr.subs(t, 2)
     3
     """
+    points = _points_of(points, CurvePoints, "curve_from_points([(x, y), ...])")
     check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
@@ -418,6 +426,7 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     >>> lagrange_surface(grid_from_points(pts), x=u, y=v).expr
     u**2 + 3*v
     """
+    grid = _points_of(grid, ControlGrid, "grid_from_points([(x, y, z), ...])")
     sx, sy = _variable(x, "x"), _variable(y, "y")
     if sx == sy:
         raise InputError(f"x and y are both the symbol {sx}: a surface needs two different variables")

@@ -135,6 +135,8 @@ def _calls():
         lambda a, b: lagsym.lagrange_surface(lagsym.grid_from_points(GRID), y=a),
         lambda a, b: lagsym.grid_from_table([0, 1], [0, 1], [[0, 1], [1, 2]], units=a),
         lambda a, b: lagsym.evaluate_points(s, a, b),
+        lambda a, b: lagsym.lagrange_surface(a),
+        lambda a, b: lagsym.lagrange_curve(a),
         lambda a, b: lagsym.evaluate_grid(s, a, b),
         lambda a, b: lagsym.raster_pattern((0, a, 0, 1), "x", 0.1, 0.1),
         lambda a, b: lagsym.raster_pattern((0, 1, 0, 1), "x", a, 0.1),
@@ -159,6 +161,21 @@ def test_public_functions_answer_hostile_values_with_a_lagsym_error(which, a, b)
         CALLS[which](a, b)
     except LagsymError as e:
         assert "\n" not in str(e)
+
+
+def test_a_height_beyond_float64_is_refused_naming_the_point_without_a_numpy_warning():
+    import warnings
+
+    s = surface()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # NumPy's "overflow encountered" would be an error here
+        for call in (lambda: lagsym.evaluate_points(s, [0.5, 1e300], 0.5),
+                     lambda: lagsym.evaluate_grid(s, [0.5, -1e300], [0.5])):
+            with pytest.raises(lagsym.InputError, match=r"^the height at x = -?1e\+300, y = 0.5 \(1 of 2 points\) "
+                                                        r"is beyond float64's range"):
+                call()
+        z = lagsym.evaluate_points(s, [0.5, float("nan")], 0.5)  # NaN in, NaN out: not an overflow
+        assert np.isfinite(z[0]) and np.isnan(z[1])
 
 
 def test_the_limits_the_docs_quote_are_the_ones_in_force():

@@ -28,6 +28,7 @@ The modules, one concern each:
   paid for their loading; ``Engine("numpy")`` turns them off);
 * :mod:`.surface`: :class:`SurfaceEvaluator`, values on grids and at points,
   partial derivatives and the curvature bound (what drop-cutter needs);
+* :mod:`.heights`: :func:`evaluate_points` and :func:`evaluate_grid`, the public calls (overflow named, not warned);
 * :mod:`.curve`: :class:`CurveEvaluator`, the 1-D case;
 * :mod:`.bounds`: the rounding-error bound;
 * :mod:`.threads`: large grids and point sets shared among the threads of
@@ -48,14 +49,13 @@ from .bounds import EPS, EPS_BASIS
 from .chebyshev import chebyshev_basis, chebyshev_matrix, chebyshev_matrix_float64, chebyshev_transform
 from .curve import CurveEvaluator, curve_evaluator, evaluate_curve
 from .engine import Engine, current_engine, use_engine
+from .heights import evaluate_grid, evaluate_points
 from .power import PARTIALS, lambdify_surface, power_partials
 from .surface import (
     CHUNK_POINTS,
     COMPILED_POINTS,
     FAST_CHUNK_POINTS,
     SurfaceEvaluator,
-    evaluate_grid,
-    evaluate_points,
     load_compiled,
     surface_evaluator,
 )

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["coordinates", "broadcast_pair", "of_type", "a_surface"]
+__all__ = ["coordinates", "broadcast_pair", "of_type", "a_surface", "finite_heights"]
 
 
 def coordinates(value, what: str) -> np.ndarray:
@@ -39,3 +39,14 @@ def a_surface(value):
     from ..lagrange import LagrangeSurface
 
     return of_type(value, LagrangeSurface, "surface")
+
+
+def finite_heights(z: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``z``, or an InputError naming the first point with finite coordinates whose height overflowed float64."""
+    bad = ~np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
+    if bad.any():
+        k = np.flatnonzero(bad)[0]
+        raise InputError(f"the height at x = {x.flat[k]:.6g}, y = {y.flat[k]:.6g} ({int(bad.sum())} of {z.size} "
+                         "points) is beyond float64's range, far outside the control points' box: evaluate the exact "
+                         "expression there")
+    return z

@@ -23,7 +23,6 @@ from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
 from ..exactsize import ExactClock, stepped_product
-from .arguments import a_surface, broadcast_pair, coordinates
 from .bounds import chebyshev_error_bound
 from .cache import ObjectCache
 from .engine import COMPILED_POINTS, Engine, current_engine
@@ -40,7 +39,7 @@ from .chebyshev import (
 )
 
 __all__ = ["CHUNK_POINTS", "COMPILED_POINTS", "FAST_CHUNK_POINTS", "SurfaceEvaluator", "surface_evaluator",
-           "evaluate_points", "evaluate_grid", "grid_product", "load_compiled"]
+           "grid_product", "load_compiled"]
 
 CHUNK_POINTS = 1 << 13  # NumPy evaluates scattered points in blocks of this many: their scratch stays in cache
 FAST_CHUNK_POINTS = 1 << 14  # the float64 path's blocks: its basis matrices stay in cache
@@ -438,13 +437,3 @@ def _make_evaluator(surface) -> SurfaceEvaluator:
 
 
 _SURFACES: ObjectCache[SurfaceEvaluator] = ObjectCache(_make_evaluator)
-
-
-def evaluate_points(surface, x, y) -> np.ndarray:
-    """Evaluate a surface at scattered points; ``x`` and ``y`` broadcast together."""
-    return surface_evaluator(a_surface(surface)).points(*broadcast_pair(x, y))
-
-
-def evaluate_grid(surface, xs, ys) -> np.ndarray:
-    """Evaluate a surface on the grid ``xs`` x ``ys``; result ``Z[i, j] = F(xs[i], ys[j])``."""
-    return surface_evaluator(a_surface(surface)).grid(coordinates(xs, "xs"), coordinates(ys, "ys"))
