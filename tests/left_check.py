@@ -32,18 +32,24 @@ def _pairs(a, b, radius, qx, qy):
     r2 = radius * radius
     for s in range(0, len(a), 64):
         ma, mb = a[s:s + 64], b[s:s + 64]
+        # Only the points within the radius of the group's plan box can be within it of a move of the group.
+        lo, hi = np.minimum(ma[:, :2], mb[:, :2]).min(axis=0) - radius, np.maximum(ma[:, :2], mb[:, :2]).max(axis=0) + radius
+        near = np.flatnonzero((qx >= lo[0]) & (qx <= hi[0]) & (qy >= lo[1]) & (qy <= hi[1]))
+        if not near.size:
+            continue
         d = mb[:, :2] - ma[:, :2]
         dd = np.maximum((d * d).sum(axis=1), 1e-300)
-        rx, ry = qx[None, :] - ma[:, 0:1], qy[None, :] - ma[:, 1:2]
+        rx, ry = qx[None, near] - ma[:, 0:1], qy[None, near] - ma[:, 1:2]
         t0 = np.clip((rx * d[:, 0:1] + ry * d[:, 1:2]) / dd[:, None], 0.0, 1.0)
         ex, ey = rx - t0 * d[:, 0:1], ry - t0 * d[:, 1:2]
         e2 = ex * ex + ey * ey
-        mi, qi = np.nonzero(e2 <= r2)
+        mi, ni = np.nonzero(e2 <= r2)
         if not mi.size:
             continue
-        rise = radius - np.sqrt(r2 - e2[mi, qi])
+        qi = near[ni]
+        rise = radius - np.sqrt(r2 - e2[mi, ni])
         low = np.minimum(ma[mi, 2], mb[mi, 2]) + rise
-        high = ma[mi, 2] + t0[mi, qi] * (mb[mi, 2] - ma[mi, 2]) + rise
+        high = ma[mi, 2] + t0[mi, ni] * (mb[mi, 2] - ma[mi, 2]) + rise
         yield ma[mi], mb[mi], qi, low, high
 
 
