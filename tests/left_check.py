@@ -19,6 +19,8 @@ import numpy as np
 
 from swept_check import ball_heights, golden_lowest, polynomial_heights
 
+_BATCH = 200_000  # pairs of move and point per golden-section search
+
 
 def _pairs(a, b, radius, qx, qy):
     """Per group of up to 64 moves: the pairs of move and point within the radius of the move's plan line.
@@ -72,13 +74,17 @@ def swept_lowest(points_mm, radius, qx, qy, iterations=48):
     a, b = a[near], b[near]
     for _, _, qi, _, high in _pairs(a, b, radius, qx, qy):
         np.minimum.at(out, qi, high)
-    for ma, mb, qi, low, _ in _pairs(a, b, radius, qx, qy):
-        keep = low < out[qi]
-        if not keep.any():
-            continue
-        height, _ = ball_heights(ma[keep], mb[keep], radius, qx[qi[keep]], qy[qi[keep]])
-        best, _ = golden_lowest(height, int(keep.sum()), iterations)
-        np.minimum.at(out, qi[keep], best)
+    # The pairs that may come lower, searched in large batches (one search's NumPy calls serve many pairs).
+    todo = [(ma[keep], mb[keep], qi[keep]) for ma, mb, qi, low, _ in _pairs(a, b, radius, qx, qy)
+            for keep in [low < out[qi]] if keep.any()]
+    if not todo:
+        return out
+    ma, mb, qi = (np.concatenate(v) for v in zip(*todo))
+    for s in range(0, len(qi), _BATCH):
+        part = slice(s, s + _BATCH)
+        height, _ = ball_heights(ma[part], mb[part], radius, qx[qi[part]], qy[qi[part]])
+        best, _ = golden_lowest(height, len(qi[part]), iterations)
+        np.minimum.at(out, qi[part], best)
     return out
 
 
