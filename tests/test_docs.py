@@ -88,11 +88,54 @@ def test_each_example_group_holds_what_its_examples_read():
     assert any(line.startswith("lagsym macro") and "-o O1000.nc" in line for line in groups["simulate"])
 
 
+@pytest.fixture(scope="session")
+def example_outputs(tmp_path_factory):
+    """A folder the whole run shares (every test worker), where each example keeps the files it wrote."""
+    base = tmp_path_factory.getbasetemp()
+    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "example-outputs"
+    folder.mkdir(exist_ok=True)
+    return folder
+
+
+def _run_example(line: str, shared) -> None:
+    """Run an example in the working folder, once in the whole run: an example that writes files and has run
+    already (in another command's group, on the same inputs) gives its files again instead of running twice."""
+    import fcntl
+    import hashlib
+    import shutil
+    from pathlib import Path
+
+    def run():
+        out, err = io.StringIO(), io.StringIO()
+        status = main(shlex.split(line)[1:], out, err)
+        assert status == 0, f"{line!r} exited {status}: {err.getvalue()}"
+
+    reads, writes = _files(line)
+    if not writes or any("/" in name for name in writes):
+        return run()
+    key = hashlib.sha256(line.encode())
+    for name in sorted(reads):
+        key.update(name.encode() + b"\0" + (Path(name).read_bytes() if Path(name).is_file() else b""))
+    keep = shared / key.hexdigest()[:24]
+    keep.mkdir(exist_ok=True)
+    with open(keep / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # one worker runs it; the others wait for its files
+        if (keep / ".done").exists():
+            for name in writes:
+                shutil.copyfile(keep / name, name)
+            return None
+        run()
+        for name in writes:
+            shutil.copyfile(name, keep / name)
+        (keep / ".done").touch()
+    return None
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("command", sorted({name for name, _ in _examples()}))
-def test_cli_examples_run(command, tmp_path, monkeypatch):
+def test_cli_examples_run(command, tmp_path, monkeypatch, example_outputs):
     """Run every example of a command, in order, in a folder of its own, after the examples of other commands
-    that write the files they read.
+    that write the files they read (each of those once in the whole run: :func:`_run_example`).
 
     Without an OpenGL the examples that draw are left out and the test skips at the end, naming them
     and the packages to install (the others have run by then)."""
@@ -104,9 +147,7 @@ def test_cli_examples_run(command, tmp_path, monkeypatch):
         if _draws(line) and not can_draw:
             left_out.append(line)
             continue
-        out, err = io.StringIO(), io.StringIO()
-        status = main(shlex.split(line)[1:], out, err)
-        assert status == 0, f"{line!r} exited {status}: {err.getvalue()}"
+        _run_example(line, example_outputs)
     if left_out:
         need_opengl(f"{len(left_out)} examples that draw ({left_out[0]!r}, ...)")
 
