@@ -140,3 +140,49 @@ def made_once(tmp_path_factory, name: str, make):
         value = make()
         kept.write_bytes(pickle.dumps(value))
         return value
+
+
+def example_files(line: str) -> tuple[set[str], set[str]]:
+    """The files in the working folder an example reads and those it writes (``-o``)."""
+    import shlex
+
+    words = shlex.split(line)[2:]
+    written = {w for k, w in enumerate(words[1:]) if words[k] in ("-o", "--output")}
+    read = {w for w in words if "." in w and "/" not in w and not w.startswith("-") and " " not in w} - written
+    return read, written
+
+
+def run_example(line: str, tmp_path_factory) -> str:
+    """Run an example (a line of a command's help, ``lagsym ...``) in the working folder.
+
+    One that writes files runs once in the whole run: where another test ran
+    it already on the same inputs, its files are written again instead
+    (:func:`made_once`).  Returns what it printed on standard error.
+    """
+    import hashlib
+    import io
+    import shlex
+
+    from lagsym.cli import main
+
+    def run():
+        out, err = io.StringIO(), io.StringIO()
+        status = main(shlex.split(line)[1:], out, err)
+        assert status == 0, f"{line!r} exited {status}: {err.getvalue()}"
+        return {name: Path(name).read_bytes() for name in writes}, err.getvalue()
+
+    reads, writes = example_files(line)
+    if not writes or any("/" in name for name in writes):
+        return run()[1]
+    key = hashlib.sha256(" ".join(shlex.split(line)).encode())
+    for name in sorted(reads):
+        key.update(name.encode() + b"\0" + (Path(name).read_bytes() if Path(name).is_file() else b""))
+    files, err = made_once(tmp_path_factory, "example-" + key.hexdigest()[:24], run)
+    for name, data in files.items():
+        Path(name).write_bytes(data)
+    return err
+
+
+README_FINISHING = ("lagsym toolpath examples/paper-example-4.json --scale 20 --tool-diameter 6 --stepover 0.4 --step 0.2 "
+                    "--feed 600 --safe-z 80 --dialect fanuc -o O1000.nc")
+"""The README's finishing program, as the toolpath command's help gives it (:func:`run_example` runs it once)."""

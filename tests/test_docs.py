@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import io
 import os
-import shlex
 import subprocess
 import sys
 
 import pytest
 
-from lagsym.cli import COMMANDS, command_module, main
+from lagsym.cli import COMMANDS, command_module
 
-from conftest import EXAMPLES, ROOT, need_opengl
+from conftest import EXAMPLES, ROOT, example_files as _files, need_opengl, run_example
 from systempackages import can_render
 
 sys.path.insert(0, str(ROOT / "docs"))
@@ -53,14 +51,6 @@ def _draws(line: str) -> bool:
     return line.startswith("lagsym plot ") or " --plot " in line
 
 
-def _files(line: str) -> tuple[set[str], set[str]]:
-    """The files in the working folder an example reads and those it writes (``-o``)."""
-    words = shlex.split(line)[2:]
-    written = {w for k, w in enumerate(words[1:]) if words[k] in ("-o", "--output")}
-    read = {w for w in words if "." in w and "/" not in w and not w.startswith("-") and " " not in w} - written
-    return read, written
-
-
 def _example_groups() -> dict[str, list[str]]:
     """Each command's examples, after the earlier examples (of any command) that write the files they read."""
     examples = [line for _, line in _examples()]
@@ -88,54 +78,11 @@ def test_each_example_group_holds_what_its_examples_read():
     assert any(line.startswith("lagsym macro") and "-o O1000.nc" in line for line in groups["simulate"])
 
 
-@pytest.fixture(scope="session")
-def example_outputs(tmp_path_factory):
-    """A folder the whole run shares (every test worker), where each example keeps the files it wrote."""
-    base = tmp_path_factory.getbasetemp()
-    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "example-outputs"
-    folder.mkdir(exist_ok=True)
-    return folder
-
-
-def _run_example(line: str, shared) -> None:
-    """Run an example in the working folder, once in the whole run: an example that writes files and has run
-    already (in another command's group, on the same inputs) gives its files again instead of running twice."""
-    import fcntl
-    import hashlib
-    import shutil
-    from pathlib import Path
-
-    def run():
-        out, err = io.StringIO(), io.StringIO()
-        status = main(shlex.split(line)[1:], out, err)
-        assert status == 0, f"{line!r} exited {status}: {err.getvalue()}"
-
-    reads, writes = _files(line)
-    if not writes or any("/" in name for name in writes):
-        return run()
-    key = hashlib.sha256(line.encode())
-    for name in sorted(reads):
-        key.update(name.encode() + b"\0" + (Path(name).read_bytes() if Path(name).is_file() else b""))
-    keep = shared / key.hexdigest()[:24]
-    keep.mkdir(exist_ok=True)
-    with open(keep / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # one worker runs it; the others wait for its files
-        if (keep / ".done").exists():
-            for name in writes:
-                shutil.copyfile(keep / name, name)
-            return None
-        run()
-        for name in writes:
-            shutil.copyfile(name, keep / name)
-        (keep / ".done").touch()
-    return None
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("command", sorted({name for name, _ in _examples()}))
-def test_cli_examples_run(command, tmp_path, monkeypatch, example_outputs):
+def test_cli_examples_run(command, tmp_path, monkeypatch, tmp_path_factory):
     """Run every example of a command, in order, in a folder of its own, after the examples of other commands
-    that write the files they read (each of those once in the whole run: :func:`_run_example`).
+    that write the files they read (each of those once in the whole run: :func:`run_example`).
 
     Without an OpenGL the examples that draw are left out and the test skips at the end, naming them
     and the packages to install (the others have run by then)."""
@@ -147,7 +94,7 @@ def test_cli_examples_run(command, tmp_path, monkeypatch, example_outputs):
         if _draws(line) and not can_draw:
             left_out.append(line)
             continue
-        _run_example(line, example_outputs)
+        run_example(line, tmp_path_factory)
     if left_out:
         need_opengl(f"{len(left_out)} examples that draw ({left_out[0]!r}, ...)")
 

@@ -17,7 +17,7 @@ from lagsym.post.program import PointProgram, point_program, write_program
 from lagsym.toolpath import plan_toolpath
 from lagsym.verify import gouge_limit, program_resolution_mm, simulate_cut
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, README_FINISHING, run_example
 from cutters import exact_heights, swept_ball, swept_tool
 
 EX2 = EXAMPLES / "paper-example-2.json"
@@ -235,15 +235,15 @@ def test_material_left_is_reported_apart_from_the_gouge(run_cli, tmp_path):
 
 
 @pytest.mark.slow
-def test_readme_finishing_example(run_cli, tmp_path):
+def test_readme_finishing_example(run_cli, tmp_path, tmp_path_factory, monkeypatch):
     """The README's finishing example finishes the part's edges; the figures docs/toolpaths.md quotes."""
     import re
 
     ex4 = EXAMPLES / "paper-example-4.json"
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    monkeypatch.chdir(tmp_path)
+    err = run_example(README_FINISHING, tmp_path_factory)
     prog = tmp_path / "O1000.nc"
-    status, _, err = run_cli("toolpath", ex4, "--scale", "20", "--tool-diameter", "6", "--stepover", "0.4",
-                             "--step", "0.2", "--feed", "600", "--safe-z", "80", "--dialect", "fanuc", "-o", prog)
-    assert status == 0, err
     status, out, _ = run_cli("verify", ex4, prog, "--scale", "20", "--tool-diameter", "6")
     num = r"([0-9.]+)"
     predicted = re.search(rf"worst predicted cusp {num} mm normal to the surface at X{num} Y{num}", err).groups()

@@ -18,7 +18,7 @@ from lagsym.machine import MachineSettings, Placement, RasterSpec, Tool
 from lagsym.toolpath import plan_toolpath
 from lagsym.verify import program_resolution_mm, simulate_cut
 
-from conftest import EXAMPLES, ROOT
+from conftest import EXAMPLES, README_FINISHING, ROOT, run_example
 from swept_check import polynomial_heights, swept_ball_window, window_check
 
 EX2 = EXAMPLES / "paper-example-2.json"
@@ -127,13 +127,13 @@ def test_a_rapid_through_the_part_is_not_understated(ex2_plan):
 
 
 @pytest.mark.slow
-def test_readme_finishing_material_left_is_not_understated(run_cli, tmp_path):
+def test_readme_finishing_material_left_is_not_understated(tmp_path, tmp_path_factory, monkeypatch):
     """The README's finishing program: the cusp on the 76 degree flank at the edge y = 20 is not understated."""
     surf = lagrange_surface(read_points(EX4))
+    (tmp_path / "examples").symlink_to(EX4.parent)
+    monkeypatch.chdir(tmp_path)
+    run_example(README_FINISHING, tmp_path_factory)
     prog = tmp_path / "O1000.nc"
-    status, _, err = run_cli("toolpath", EX4, "--scale", "20", "--tool-diameter", "6", "--stepover", "0.4",
-                             "--step", "0.2", "--feed", "600", "--safe-z", "80", "--dialect", "fanuc", "-o", prog)
-    assert status == 0, err
     moves = parse_moves(prog.read_text())
     report = simulate_cut(surf, moves, Tool("ball", 6.0), Placement(20.0))
     a, b = feed_moves(moves)
