@@ -324,7 +324,7 @@ def rough_macro(surface, tool: Tool, stock: Stock, spec: RoughSpec, settings: Ma
     a = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.a_mm]
     b = [[_up(Fraction(repr(float(v))) * per_mm) for v in row] for row in clear.b_mm]
     rows, pts, tip = model(ev, place, lay, float(radius / per_mm), settings.stock_to_leave_mm, a=a, b=b,
-                            per_mm=per_mm, direction=spec.direction)
+                           per_mm=per_mm, direction=spec.direction)
     top, sd = _near(stock.top_mm, per_mm), _near(spec.stepdown_mm, per_mm)
     low = _down(Fraction(repr(float(tip.min()))) * per_mm)
     count = max(math.ceil((top - low) / sd), 1)
