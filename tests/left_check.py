@@ -35,7 +35,8 @@ def _pairs(a, b, radius, qx, qy):
     for s in range(0, len(a), 64):
         ma, mb = a[s:s + 64], b[s:s + 64]
         # Only the points within the radius of the group's plan box can be within it of a move of the group.
-        lo, hi = np.minimum(ma[:, :2], mb[:, :2]).min(axis=0) - radius, np.maximum(ma[:, :2], mb[:, :2]).max(axis=0) + radius
+        lo = np.minimum(ma[:, :2], mb[:, :2]).min(axis=0) - radius
+        hi = np.maximum(ma[:, :2], mb[:, :2]).max(axis=0) + radius
         near = np.flatnonzero((qx >= lo[0]) & (qx <= hi[0]) & (qy >= lo[1]) & (qy <= hi[1]))
         if not near.size:
             continue
