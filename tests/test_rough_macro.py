@@ -313,16 +313,17 @@ def test_a_job_file_variables_profile_is_checked_for_its_roughing_macro(run_cli,
 
 
 BUMP = [(x, y, 3 if (x, y) == (2, 2) else 0) for x in (0, 2, 4) for y in (0, 2, 4)]  # flanks up to 71 degrees
+PIT = [(x, y, 0 if (x, y) == (2, 2) else 3 if 2 in (x, y) else 4) for x in (0, 2, 4) for y in (0, 2, 4)]  # a pocket
 
 
 @pytest.mark.parametrize("dialect, precision, points, scale, box, top", [
     ("fanuc", 8, EX4, 20.0, BOX, TOP), ("linuxcnc", 15, EX4, 20.0, BOX, TOP), ("heidenhain", 8, EX4, 20.0, BOX, TOP),
-    ("fanuc", 8, BUMP, 10.0, (0.0, 40.0, 0.0, 40.0), 32.0)])
+    ("fanuc", 8, BUMP, 10.0, (0.0, 40.0, 0.0, 40.0), 32.0), ("linuxcnc", 15, PIT, 10.0, (0.0, 40.0, 0.0, 40.0), 42.0)])
 def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialect, precision, points, scale, box,
                                                                           top):
     """From Python: a non-centre-cutting mill (3 degrees) is planned, not refused; the header states the
     angle, and the simulated control never descends over the block steeper than it (one 0.001 mm unit of
-    rounding allowed per move), where the same macro planned to plunge does: on Example 4 and a bump."""
+    rounding allowed per move), where the same macro planned to plunge does: on Example 4, a bump and a pit."""
     from lagsym.grid import grid_from_points
 
     steepest = {}
