@@ -33,7 +33,7 @@ import flint
 from .errors import InputError
 from .exactsize import MAX_EXACT_MB, ExactClock, check_exact_size, stepped_product
 from .exactsize import to_fraction as _frac
-from .values import MAX_NAME, as_exact, check_name  # noqa: F401 - MAX_NAME: where the name check was
+from .values import MAX_NAME, as_exact, check_name, of_type  # noqa: F401 - MAX_NAME: where the name check was
 
 from .grid import ControlGrid, CurvePoints
 
@@ -64,13 +64,6 @@ def __getattr__(name: str):
 
         return sympy.Symbol(name.lower())
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def _points_of(value, cls: type, make: str):
-    """``value`` if it is a ``cls`` (a grid or a curve's points), else an InputError saying how to make one."""
-    if not isinstance(value, cls):
-        raise InputError(f"{value!r:.60} is not a {cls.__name__}: make one with {make} (or read_points(file))")
-    return value
 
 
 def _variable(value, what: str):
@@ -389,7 +382,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
     >>> lagrange_curve(pts, x=t).expr.subs(t, 2)
     3
     """
-    points = _points_of(points, CurvePoints, "curve_from_points([(x, y), ...])")
+    points = of_type(points, CurvePoints, "points", "curve_from_points([(x, y), ...]) or read_points(file)")
     check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
     b = _basis_matrix(points.x)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
@@ -426,7 +419,7 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     >>> lagrange_surface(grid_from_points(pts), x=u, y=v).expr
     u**2 + 3*v
     """
-    grid = _points_of(grid, ControlGrid, "grid_from_points([(x, y, z), ...])")
+    grid = of_type(grid, ControlGrid, "grid", "grid_from_points([(x, y, z), ...]) or read_points(file)")
     sx, sy = _variable(x, "x"), _variable(y, "y")
     if sx == sy:
         raise InputError(f"x and y are both the symbol {sx}: a surface needs two different variables")

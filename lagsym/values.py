@@ -25,7 +25,7 @@ from fractions import Fraction
 from .errors import InputError
 
 __all__ = ["FrozenMap", "frozen", "as_exact", "exact_number", "finite", "positive", "in_range", "whole", "choice",
-           "NotANumber", "MAX_EXPONENT", "MAX_NAME", "SYMPY_LETTERS", "check_name"]
+           "NotANumber", "MAX_EXPONENT", "MAX_NAME", "SYMPY_LETTERS", "check_name", "of_type"]
 
 MAX_EXPONENT = 300  # beyond this a coordinate has no use and no float to go with it
 _RATIONAL = re.compile(r"^\s*([+-]?\d+)\s*/\s*(\d+)\s*$")
@@ -220,6 +220,14 @@ def positive(value, what: str, *, allow_zero: bool = False, high: float | None =
     if not (v > 0 or (allow_zero and v == 0)):
         raise InputError(f"{what + ' ' if what else ''}{value!r} must be {'zero or ' if allow_zero else ''}a positive number")
     return v
+
+
+def of_type(value, cls: type, what: str, make: str | None = None):
+    """``value`` if it is a ``cls``, else an InputError that names it (and says how to ``make`` one, if given)."""
+    if not isinstance(value, cls):
+        hint = f": make one with {make}" if make else ""
+        raise InputError(f"{what} = {value!r:.80} is not a {cls.__name__}{hint}")
+    return value
 
 
 def choice(value, options: Iterable, what: str):

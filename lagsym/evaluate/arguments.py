@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..values import of_type
 
-__all__ = ["coordinates", "broadcast_pair", "of_type", "a_surface", "finite_heights"]
+__all__ = ["coordinates", "broadcast_pair", "a_surface", "finite_heights"]
 
 
 def coordinates(value, what: str) -> np.ndarray:
@@ -25,13 +26,6 @@ def broadcast_pair(x, y) -> tuple[np.ndarray, np.ndarray]:
     except ValueError:
         raise InputError(f"x of shape {x.shape} and y of shape {y.shape} do not broadcast together") from None
     return x, y
-
-
-def of_type(value, cls: type, what: str):
-    """``value`` if it is a ``cls``, else an InputError that names it."""
-    if not isinstance(value, cls):
-        raise InputError(f"{what} = {value!r:.80} is not a {cls.__name__}")
-    return value
 
 
 def a_surface(value):

@@ -8,7 +8,8 @@ import flint
 import numpy as np
 
 from .._arrays import readonly as _readonly
-from .arguments import coordinates, of_type
+from ..values import of_type
+from .arguments import coordinates
 from .cache import ObjectCache
 from .chebyshev import chebyshev_basis, chebyshev_transform, data_range, fmpq, fraction
 
