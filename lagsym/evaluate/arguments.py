@@ -35,8 +35,16 @@ def a_surface(value):
     return of_type(value, LagrangeSurface, "surface")
 
 
-def finite_heights(z: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``z``, or an InputError naming the first point with finite coordinates whose height overflowed float64."""
+def finite_heights(z: np.ndarray, places) -> np.ndarray:
+    """``z``, or an InputError naming the first point with finite coordinates whose height overflowed float64.
+
+    ``places()`` gives the points' ``x`` and ``y`` in ``z``'s shape; it is
+    called only when some height is not finite (a grid's coordinates are not
+    spread out on every call for a check that nearly always passes).
+    """
+    if np.isfinite(z).all():
+        return z
+    x, y = places()
     bad = ~np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
     if bad.any():
         k = np.flatnonzero(bad)[0]

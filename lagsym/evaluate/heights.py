@@ -24,7 +24,7 @@ def evaluate_points(surface, x, y) -> np.ndarray:
     x, y = broadcast_pair(x, y)
     with np.errstate(over="ignore", invalid="ignore"):
         z = surface_evaluator(a_surface(surface)).points(x, y)
-    return finite_heights(z, *np.broadcast_arrays(x, y))
+    return finite_heights(z, lambda: np.broadcast_arrays(x, y))
 
 
 def evaluate_grid(surface, xs, ys) -> np.ndarray:
@@ -33,4 +33,4 @@ def evaluate_grid(surface, xs, ys) -> np.ndarray:
     xs, ys = coordinates(xs, "xs"), coordinates(ys, "ys")
     with np.errstate(over="ignore", invalid="ignore"):
         z = surface_evaluator(a_surface(surface)).grid(xs, ys)
-    return finite_heights(z, *np.meshgrid(xs, ys, indexing="ij"))
+    return finite_heights(z, lambda: np.meshgrid(xs, ys, indexing="ij"))
