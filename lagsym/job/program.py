@@ -22,7 +22,7 @@ from ..macro.roughing import RoughMacro, rough_macro_blocks
 from ..post.model import iso_comment, units_word
 from ..post.moves import format_moves
 from ..gcode.numbers import fixed
-from ..toolpath.rough import PLUNGE, RAPID
+from ..toolpath.rough import PLUNGE, RAPID, ramp_note
 from .operations import PlannedJob, _settings
 from .spec import COOLANTS
 
@@ -92,7 +92,7 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
             " REST" if op.spec.options.get("rest") else "")
         out.append(f.comment(iso_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN")))
         if op.spec.kind == "rough":  # a point list or a macro alike
-            out.append(f.comment(iso_comment(f"{i} RAMP INTO MATERIAL AT MOST {t.tool.max_ramp_deg:g} DEG")))
+            out.append(f.comment(iso_comment(f"{i} {ramp_note(t.tool)}")))
     out.append(f.comment(iso_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN")))
     out.append(f"{units_word(s)} {f.safe_start}")
     out.append(spec.work_offset)

@@ -47,14 +47,14 @@ from ..errors import ToolpathError
 from ..evaluate import surface_evaluator
 from ..machine import MachineSettings, Tool, program_units_per_mm
 from ..surfaces.piecewise import PiecewiseSurface
-from ..toolpath.rough import RoughSpec, Stock, check_points, check_rough_request
+from ..toolpath.rough import RoughSpec, Stock, check_points, check_rough_request, ramp_note
 from ..values import choice
 from .clearance import Clearance, clearance_tables
 from .form import FORMS, RowForm, point_statements, row_form, row_statements
 from .loops import MacroLoops
 from .model import Assign, Choose, Clamp, Item, Loop, Move, SetItem, Var, add, const, decimal_context, mul, run, sqrt, sub, var
 from .raster import Axis, MacroRaster
-from .roughpath import b_mm, model, path, ramp_note, ramp_tangent, xy
+from .roughpath import b_mm, model, path, ramp_tangent, xy
 from .roughvars import check_rough_variables
 
 __all__ = ["RoughMacro", "rough_macro", "rough_macro_blocks", "rough_macro_program", "MACRO_MILLING"]

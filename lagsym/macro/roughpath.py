@@ -26,8 +26,9 @@ from fractions import Fraction
 import numpy as np
 
 from ..machine import Tool
+from ..toolpath.rough import ramp_slope
 
-__all__ = ["ramp_tangent", "ramp_note", "b_mm", "xy", "model", "path"]
+__all__ = ["ramp_tangent", "b_mm", "xy", "model", "path"]
 
 _TAN_GRID = 1_000_000  # the tangent the loops multiply by: rounded down to 1e-6, so a ramp is never steeper
 
@@ -38,15 +39,8 @@ def ramp_tangent(tool: Tool) -> Fraction | None:
     >>> ramp_tangent(Tool("flat", 10.0)), ramp_tangent(Tool("flat", 10.0, ramp_angle_deg=90.0))
     (Fraction(267949, 1000000), None)
     """
-    deg = tool.max_ramp_deg
-    if deg >= 90.0:
-        return None
-    return Fraction(math.floor(math.tan(math.radians(deg)) * _TAN_GRID), _TAN_GRID)
-
-
-def ramp_note(tool: Tool) -> str:
-    """The header's statement of the steepest descent into material (the point-list roughing's words)."""
-    return f"RAMP INTO MATERIAL AT MOST {tool.max_ramp_deg:g} DEG"
+    slope = ramp_slope(tool)
+    return None if math.isinf(slope) else Fraction(math.floor(slope * _TAN_GRID), _TAN_GRID)
 
 
 def b_mm(ev, place, radius_mm: float, stock_mm: float, x_mm, y_mm) -> np.ndarray:

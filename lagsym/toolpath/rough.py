@@ -52,7 +52,8 @@ from .plansize import check_points
 from .roughmoves import FEED, PATTERNS, PLUNGE, RAPID, along_samples, assemble_offset, assemble_raster, offset_line
 
 __all__ = ["PATTERNS", "Stock", "RoughSpec", "RoughPath", "rough_toolpath", "MILLING", "FEED", "RAPID", "PLUNGE", "stock_around",
-           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points", "raster_samples", "rough_levels", "ramp_slope"]
+           "MAX_ROUGH_SAMPLES", "check_rough_request", "check_points", "raster_samples", "rough_levels", "ramp_slope",
+           "ramp_note"]
 
 MAX_ROUGH_SAMPLES = 100_000  # drop-cutter samples of one level, each checked exactly (the slow part): minutes at most
 
@@ -276,6 +277,11 @@ def ramp_slope(tool: Tool) -> float:
     """The steepest descent into material the tool makes, as a rise per mm (``inf`` for a plunge at 90 degrees)."""
     deg = tool.max_ramp_deg
     return math.inf if deg >= 90.0 else math.tan(math.radians(deg))
+
+
+def ramp_note(tool: Tool) -> str:
+    """The header's statement of the steepest descent into material, for a point list and a macro alike."""
+    return f"RAMP INTO MATERIAL AT MOST {tool.max_ramp_deg:g} DEG"
 
 
 def check_rough_request(tool: Tool, stock: Stock, spec: RoughSpec, ev: SurfaceEvaluator, place, *,
