@@ -326,10 +326,10 @@ def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialec
     rounding allowed per move), where the same macro planned to plunge does: on Example 4, a bump and a pit."""
     from lagsym.grid import grid_from_points
 
+    surface = lagrange_surface(read_points(points) if points is EX4 else grid_from_points(points))
+    settings = MachineSettings(dialect=dialect, mm_per_unit=scale, safe_z_mm=120.0)
     steepest = {}
     for angle in (None, 90.0):
-        surface = lagrange_surface(read_points(points) if points is EX4 else grid_from_points(points))
-        settings = MachineSettings(dialect=dialect, mm_per_unit=scale, safe_z_mm=120.0)
         tool = Tool("flat", 10.0, centre_cutting=angle is not None, ramp_angle_deg=angle)
         rm = rough_macro(surface, tool, stock_around(box, top), RoughSpec(10.0, 5.0, 1.0, 0.3), settings,
                          precision=precision)
@@ -339,6 +339,6 @@ def test_a_tool_that_may_not_plunge_gets_a_ramping_macro_in_every_dialect(dialec
         a, b = pts[:-1], pts[1:]
         run = np.hypot(*(b[:, :2] - a[:, :2]).T)
         over = (b[:, 0] >= box[0]) & (b[:, 0] <= box[1]) & (run > 0)
-        drop = (a[:, 2] - b[:, 2])[over] - 1e-3
-        steepest[angle] = float(np.degrees(np.arctan2(drop, run[over])).max())
+        fall = (a[:, 2] - b[:, 2])[over] - 1e-3
+        steepest[angle] = float(np.degrees(np.arctan2(fall, run[over])).max())
     assert 2.0 < steepest[None] <= 3.0 and steepest[90.0] > 60.0, steepest

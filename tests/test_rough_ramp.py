@@ -38,15 +38,20 @@ def _program(extra):
         return out.read_text()
 
 
+def _cells():
+    """The height maps' cell centres (the box and 10 mm of air around it): axes, grids, and the cells in the box."""
+    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
+    fx, fy = np.meshgrid(gx, gy, indexing="ij")
+    return gx, gy, fx, fy, (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+
+
 def descents_into_stock(mv, limit_deg):
     """Feed moves that descend steeper than ``limit_deg`` and end with material above the tip under the tool.
 
     Returns (count, deepest entry mm, steepest angle of any descent that ends below material in degrees, the
     height map after the program).
     """
-    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
-    fx, fy = np.meshgrid(gx, gy, indexing="ij")
-    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    gx, gy, fx, fy, inbox = _cells()
     top = float(exact_heights(EX4, *np.meshgrid(np.linspace(20, 100, 401), np.linspace(20, 100, 401))).max()) + 2
     h = np.where(inbox, top, -np.inf)  # the block is the box: air around it
     k = int(math.ceil(R / CELL))
@@ -75,9 +80,7 @@ def descents_into_stock(mv, limit_deg):
 def left_above_reach(mv, h):
     """The most material the map ``h`` holds above what the flat end reaches from the centres the moves pass
     (the lowest lattice drop-cutter height over those centres covering a cell) plus the stock, inside the box."""
-    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
-    fx, fy = np.meshgrid(gx, gy, indexing="ij")
-    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
+    gx, gy, fx, fy, inbox = _cells()
     f = np.where(inbox, exact_heights(EX4, np.clip(fx, 20, 100), np.clip(fy, 20, 100)), -np.inf)
     k = int(round(R / CELL))
     off = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1) if (i * i + j * j) * CELL * CELL <= R * R]
@@ -209,11 +212,9 @@ def test_the_job_file_gives_the_tool_its_ramp(run_cli, tmp_path, extra, status, 
 
 
 def _left_above_surface(h):
-    """Material the height map ``h`` holds above the exact surface plus the 0.3 mm stock, over the box's cells."""
-    gx = gy = np.arange(10.0, 110.0 + CELL / 2, CELL)
-    fx, fy = np.meshgrid(gx, gy, indexing="ij")
-    inbox = (fx >= 20) & (fx <= 100) & (fy >= 20) & (fy <= 100)
-    left = h[inbox] - (exact_heights(EX4, fx[inbox], fy[inbox]) + 0.3)
+    """Material the height map ``h`` holds above the exact surface plus the stock, over the box's cells."""
+    _, _, fx, fy, inbox = _cells()
+    left = h[inbox] - (exact_heights(EX4, fx[inbox], fy[inbox]) + STOCK)
     return float(left.mean()), float(left.max())
 
 
