@@ -103,8 +103,15 @@ def test_a_fault_after_a_silent_death_resumes_within_what_the_control_holds(line
     with pytest.raises(LineFault) as info:
         send_program(pair.near, parse_program(program_text(900)), settings, "drip", progress=progress)
     fault = info.value
-    held = whole_blocks(sim.stop()["received"])
-    assert 1 <= fault.last_block <= held and fault.start_block <= held + 1
+    record = sim.stop()
+    held = whole_blocks(record["received"])
+    assert fault.last_block <= held and fault.start_block <= held + 1
+    # An XOFF after the XON that ended a pause proves what was written before that pause (a few hundred
+    # characters: past block 1).  The control sends a second XOFF only after an XON; if it died inside its first
+    # (on a loaded machine the sender can be late to hear it while the control takes the rest), nothing is
+    # proved and "no block surely reached the control" is the true answer.
+    if record["xoffs"] >= 2:
+        assert fault.last_block >= 1, (record["xoffs"], str(fault))
     if "held XOFF (DC3) for more than 5 s" in str(fault):
         return  # it died inside an XOFF (when depends on the machine's load): a stall, told truly
     assert fault.last_left_block > held  # the port took far more than the control holds
