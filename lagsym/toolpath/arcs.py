@@ -36,7 +36,7 @@ and end radii must agree within :data:`RADIUS_AGREE` of what LinuxCNC
 accepts (0.002 mm in a millimetre program, 0.0002 inch in an inch one);
 radii are at most :data:`MAX_RADIUS_MM`, so centres stay within any
 control's axis words, and no arc turns more steeply than
-:data:`MIN_COS` from the horizontal.
+:data:`.arcfit.MIN_COS` from the horizontal.
 
 Grbl does not move on the circle: it cuts an arc into chords no further
 than its arc tolerance (``$12``, 0.002 mm by default) inside it, and ends on
@@ -54,13 +54,12 @@ import numpy as np
 
 from .._arrays import freeze_fields
 from ..gcode.numbers import program_ints
+from .arcfit import MAX_RADIUS_MM, Bounds, Runs, fit
 
 __all__ = ["Arcs", "fit_arcs", "RADIUS_LIMIT", "MAX_RADIUS_MM"]
 
 RADIUS_LIMIT = {"mm": 0.002, "inch": 0.0002}  # LinuxCNC: start and end radius may differ by this (program units)
 RADIUS_AGREE = 0.75  # the part of that limit a written arc may use
-MAX_RADIUS_MM = 1000.0
-MIN_COS = 0.1  # both ends at least this part of the radius above (or below) the centre: tangents within 84 degrees
 
 
 @dataclass(frozen=True)
@@ -100,38 +99,6 @@ class Arcs:
         return int(np.sum(self.end - self.start - 1))
 
 
-@dataclass(frozen=True)
-class _Row:
-    """One run of points along a row, in a frame where the along coordinate grows: positions and heights in mm."""
-
-    a: np.ndarray  # along (mm, flipped so it grows), written
-    z: np.ndarray  # written heights (mm)
-    s_a: np.ndarray  # cutter-location samples: along (mm, same frame), sorted
-    s_z: np.ndarray  # and their heights (mm)
-
-
-@dataclass(frozen=True)
-class _Bounds:
-    """What every arc of one toolpath is checked against; travels together through the fit and its checks."""
-
-    kappa: float  # how fast the cutter path bends down at most (1/mm)
-    tol: float  # the chordal tolerance (mm)
-    unit_mm: float  # one unit of the program's last decimal (mm)
-    limit_mm: float  # how far the start and end radius of a written arc may differ (mm)
-    chord_mm: float  # how far inside its arcs the control's chords may lie (mm)
-
-
-@dataclass(frozen=True)
-class _Chord:
-    """The chord from an arc's start to its end: its ends ``(along, z)``, length, middle and upward unit normal."""
-
-    start: np.ndarray
-    end: np.ndarray
-    length: float
-    mid: np.ndarray
-    normal: np.ndarray
-
-
 def fit_arcs(points_mm, rows, exact_mm, fine_mm, *, direction: str, kappa: float, tol: float, unit_factor: float,
              digits: int, units: str, reach_mm: tuple[float, float], radius_mm: float, chord_mm: float = 0.0) -> Arcs:
     """The arcs that replace moves of the toolpath ``points_mm`` (see the module docstring).
@@ -164,16 +131,15 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, *, direction: str, kappa: float
     safe = (ints[:, ax] * unit_mm >= lo) & (ints[:, ax] * unit_mm <= hi)
     order = np.lexsort((fine_ints[:, ax], fine_ints[:, cx]))
     f_cross = fine_ints[order, cx]
-    bounds = _Bounds(kappa, tol, unit_mm, RADIUS_AGREE * RADIUS_LIMIT[units] / unit_factor, chord_mm)
-    out = []
+    bounds = Bounds(kappa, tol, unit_mm, RADIUS_AGREE * RADIUS_LIMIT[units] / unit_factor, chord_mm)
     n = len(ints)
     same = np.zeros(n, dtype=bool)
     same[1:] = (ints[1:, cx] == ints[:-1, cx]) & (rows[1:] == rows[:-1]) & safe[1:] & safe[:-1] \
         & (ints[1:, ax] != ints[:-1, ax])
     breaks = np.flatnonzero(~same)
-    for b0, b1 in zip(breaks, np.append(breaks[1:], n)):
-        if b1 - b0 < 3:
-            continue
+    spans = [(b0, b1) for b0, b1 in zip(breaks, np.append(breaks[1:], n)) if b1 - b0 >= 3]
+    signs, rows_ = [], []
+    for b0, b1 in spans:
         sign = 1 if ints[b1 - 1, ax] > ints[b0, ax] else -1
         k0, k1 = np.searchsorted(f_cross, ints[b0, cx]), np.searchsorted(f_cross, ints[b0, cx], side="right")
         sel = order[k0:k1]
@@ -182,172 +148,57 @@ def fit_arcs(points_mm, rows, exact_mm, fine_mm, *, direction: str, kappa: float
         a = ints[b0:b1, ax] * unit_mm * sign
         inside = (sa >= a[0]) & (sa <= a[-1])
         k = np.argsort(sa[inside], kind="stable")
-        row = _Row(a, ints[b0:b1, 2] * unit_mm, sa[inside][k], sz[inside][k])
-        for i, j, centre in _greedy(row, bounds):
-            ca = centre[0] * sign
-            s3, e3 = points_mm[b0 + i], points_mm[b0 + j]
-            v1 = np.array([s3[ax] - ca, s3[2] - centre[1]])
-            v2 = np.array([e3[ax] - s3[ax], e3[2] - s3[2]])
-            turn = v1[0] * v2[1] - v1[1] * v2[0]  # positive: from the along axis towards Z
-            # About +Y (G18) a positive turn takes Z to X; about +X (G19) it takes Y to Z.
-            out.append((b0 + i, b0 + j, ca, centre[1], bool(turn < 0) if ax == 0 else bool(turn > 0)))
-    arr = np.array(out, dtype=float).reshape(-1, 5)
-    return Arcs(start=arr[:, 0].astype(int), end=arr[:, 1].astype(int), centre_mm=arr[:, 2:4],
-                ccw=arr[:, 4].astype(bool), plane="G18" if ax == 0 else "G19")
+        signs.append(sign)
+        rows_.append((a, ints[b0:b1, 2] * unit_mm, sa[inside][k], sz[inside][k]))
+    run, i, j, centre = _greedy(Runs.of(rows_), np.array([b1 - b0 for b0, b1 in spans], dtype=np.int64), bounds)
+    offset = np.array([b0 for b0, _ in spans], dtype=np.int64)
+    first, end = offset[run] + i, offset[run] + j
+    ca = centre[:, 0] * np.array(signs, dtype=float)[run]
+    s3, e3 = points_mm[first], points_mm[end]
+    turn = (s3[:, ax] - ca) * (e3[:, 2] - s3[:, 2]) - (s3[:, 2] - centre[:, 1]) * (e3[:, ax] - s3[:, ax])
+    # turn > 0: from the along axis towards Z.  About +Y (G18) a positive turn takes Z to X; about +X (G19)
+    # it takes Y to Z.
+    ccw = turn < 0 if ax == 0 else turn > 0
+    return Arcs(start=first, end=end, centre_mm=np.stack([ca, centre[:, 1]], axis=1), ccw=ccw,
+                plane="G18" if ax == 0 else "G19")
 
 
-def _greedy(row: _Row, bounds: _Bounds):
-    """``(i, j, centre)`` of the arcs along one run, from each point as far as an arc fits."""
-    n, i = len(row.a), 0
-    while i < n - 2:
-        good, bad, step = None, None, 2
-        while True:  # the reach doubled while an arc fits, then bisected back
-            hi = min(i + step, n - 1)
-            c = _fit(row, i, hi, bounds)
-            if c is None:
-                bad = hi
-                break
-            good = (hi, c)
-            if hi == n - 1:
-                break
-            step *= 2
-        if good is None:
-            i += 1
-            continue
-        while bad is not None and bad - good[0] > 1:
-            mid = (good[0] + bad) // 2
-            c = _fit(row, i, mid, bounds)
-            if c is None:
-                bad = mid
-            else:
-                good = (mid, c)
-        yield i, good[0], good[1]
-        i = good[0]
+def _greedy(runs: Runs, counts, bounds: Bounds):
+    """``(run, i, j, centre)`` of the arcs along every run: from each point as far as an arc fits, runs side by side.
 
-
-def _samples(row: _Row, i: int, j: int):
-    """The cutter-location samples from point ``i`` to point ``j``, ends included (along, height)."""
-    k0 = np.searchsorted(row.s_a, row.a[i], side="left")
-    k1 = np.searchsorted(row.s_a, row.a[j], side="right")
-    return row.s_a[k0:k1], row.s_z[k0:k1]
-
-
-def _fit(row: _Row, i: int, j: int, bounds: _Bounds):
-    """The rounded centre ``(along, z)`` (mm) of an arc from point ``i`` to ``j`` that passes both checks, or None.
-
-    The arcs through both ends form a family ordered by their sagitta (the
-    height of the arc's middle above the chord): each sample asks for a
-    sagitta above the one of the circle through the ends and a point the
-    margin above it, and below the one through a point the tolerance above
-    it.  The middle of what is left is tried, its centre rounded, and the
-    rounded arc (or one a unit beside it) checked in full (:func:`_check`).
+    Along one run, from point ``i`` the reach is doubled while an arc fits,
+    then bisected back between the last that fitted and the first that did
+    not; the arc is kept and the next one starts at its end.  Where no arc
+    fits from ``i``, the search moves on to ``i + 1``.  Every round asks
+    :func:`.arcfit.fit` for one candidate of every run still searching.
     """
-    kappa, tol, chord_mm = bounds.kappa, bounds.tol, bounds.chord_mm
-    sa, sz = _samples(row, i, j)
-    S, E = np.array([row.a[i], row.z[i]]), np.array([row.a[j], row.z[j]])
-    chord = E - S
-    L = float(np.hypot(*chord))
-    normal = np.array([-chord[1], chord[0]]) / L  # the upward side of the chord (the along axis grows)
-    mid = (S + E) / 2
-    line = _Chord(S, E, L, mid, normal)
-    inner = (sa > S[0]) & (sa < E[0])
-    if not inner.any():
-        return None
-    smin = MAX_RADIUS_MM - np.sqrt(MAX_RADIUS_MM**2 - L * L / 4)
-    h = np.diff(sa)
-    gap = np.maximum(np.concatenate([[0.0], h]), np.concatenate([h, [0.0]]))[inner]
-    a, cl = sa[inner], sz[inner]
-    first, last = int(np.flatnonzero(inner)[0]), int(np.flatnonzero(inner)[-1])
-    m_ends = (S[1] - chord_mm - sz[first - 1], E[1] - chord_mm - sz[last + 1])
-    hi = _sagittas(a, cl + tol, line).min()
-    bend, s = 0.0, None
-    for _ in range(2):  # once for a dome, again with a hollow's own bend
-        c = kappa + bend
-        need = c * gap**2 / 8
-        for k, h_end, m in ((0, sa[first] - sa[first - 1], m_ends[0]), (-1, sa[last + 1] - sa[last], m_ends[1])):
-            q = c * h_end**2 / 2
-            need[k] = max(need[k], (np.sqrt(q) - np.sqrt(max(m, 0.0))) ** 2 if m < q else 0.0)
-        lo = _sagittas(a, cl + need + chord_mm, line).max()
-        if lo > hi:
-            return None
-        s = 0.5 * (lo + hi)
-        if abs(s) < smin:  # the range holds the chord: the flattest arc on the wider side
-            s = smin * (1 + 1e-6) * (1.0 if hi > -lo else -1.0)
-        if s > 0:
-            break
-        r = (L * L / 4 + s * s) / (2 * abs(s))
-        cz = (mid + normal * (s + r))[1]
-        v = cz - max(S[1], E[1])
-        if v < MIN_COS * r:
-            return None
-        bend = r * r / v**3
-    if abs(s) > 0.45 * L:
-        return None
-    r = (L * L / 4 + s * s) / (2 * abs(s))
-    centre = mid + normal * (s - np.sign(s) * r)
-    base = np.rint(centre / bounds.unit_mm)
-    for step in ((0, 0), (0, -1), (0, 1), (-1, 0), (1, 0), (-1, -1), (1, 1), (-1, 1), (1, -1)):
-        c = (base + step) * bounds.unit_mm
-        if _check(c, line, sa, sz, bounds):
-            return c
-    return None
-
-
-def _sagittas(a, z, line: _Chord):
-    """The signed sagitta of the circle through the chord's ends and each point ``(a, z)`` (positive: bulging up)."""
-    L, mid, normal = line.length, line.mid, line.normal
-    d = np.stack([a - mid[0], z - mid[1]], axis=1)
-    tangent = np.array([normal[1], -normal[0]])
-    u, w = d @ tangent, d @ normal
-    aw = np.maximum(np.abs(w), 1e-300)
-    e = (L * L / 4 - u * u - w * w) / (2 * aw)
-    root = np.sqrt(e * e + L * L / 4)
-    mag = np.where(e >= 0, (L * L / 4) / (e + root), root - e)
-    return np.where(w == 0, 0.0, np.sign(w) * mag)
-
-
-def _heights(centre_a, centre_z, radius, dome, a):
-    """Heights of circles (rows) at abscissae ``a``: the upper half for a dome, the lower one otherwise."""
-    root = np.sqrt(np.maximum(radius**2 - (a - centre_a) ** 2, 0.0))
-    return np.where(dome, centre_z + root, centre_z - root)
-
-
-def _passes(low, high, sa, sz, bounds: _Bounds, bend):
-    """Both checks of a circle's heights: ``low`` never below the path, ``high`` within ``tol`` above it.
-
-    ``low - sz`` at two neighbouring samples is ``m0`` and ``m1``; with the
-    path less the circle bending down no faster than ``c = bounds.kappa + bend``,
-    the path rises above the circle between them by at most the largest of
-    ``-(1-u) m0 - u m1 + c h**2 u (1-u) / 2`` (``h`` apart), which must be 0
-    or less.
-    """
-    m = low - sz
-    q = (bounds.kappa + bend) * np.diff(sa) ** 2 / 2.0
-    m0, m1 = m[:-1], m[1:]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        u = np.clip(np.where(q > 0, (m0 - m1 + q) / (2 * q), 0.0), 0.0, 1.0)
-    if np.any(m < 0.0) or np.any(-(1 - u) * m0 - u * m1 + q * u * (1 - u) > 0.0):
-        return False
-    inner = (sa > sa[0]) & (sa < sa[-1])  # the ends are written points, kept as the line moves keep them
-    return bool(np.all(high[inner] - sz[inner] <= bounds.tol))
-
-
-def _check(c, line: _Chord, sa, sz, bounds: _Bounds):
-    """Whether the rounded arc about ``c`` along the chord ``line`` passes both checks."""
-    S, E, limit_mm, chord_mm = line.start, line.end, bounds.limit_mm, bounds.chord_mm
-    rs, re = float(np.hypot(*(S - c))), float(np.hypot(*(E - c)))
-    if abs(rs - re) > limit_mm or max(rs, re) > MAX_RADIUS_MM:
-        return False
-    dome = S[1] > c[1] and E[1] > c[1]
-    if not dome and not (S[1] < c[1] and E[1] < c[1]):
-        return False
-    r_lo, r_hi = min(rs, re), max(rs, re)
-    if np.any(np.abs(sa - c[0]) >= r_lo):
-        return False
-    low = _heights(c[0], c[1], r_lo if dome else r_hi, dome, sa) - (chord_mm if dome else 0.0)
-    high = _heights(c[0], c[1], r_hi if dome else r_lo, dome, sa) + (0.0 if dome else chord_mm)
-    v = (min(S[1], E[1]) - c[1]) if dome else (c[1] - max(S[1], E[1]))
-    v -= r_hi - r_lo
-    if v < MIN_COS * r_hi:
-        return False
-    return _passes(low, high, sa, sz, bounds, 0.0 if dome else r_hi * r_hi / v**3)
+    nrun = len(counts)
+    base = np.cumsum(counts) - counts
+    i, step = np.zeros(nrun, dtype=np.int64), np.full(nrun, 2, dtype=np.int64)
+    good, bad = np.full(nrun, -1, dtype=np.int64), np.full(nrun, -1, dtype=np.int64)
+    good_c, bisect = np.zeros((nrun, 2)), np.zeros(nrun, dtype=bool)
+    found = []
+    live = np.flatnonzero(i < counts - 2)
+    while len(live):
+        j = np.where(bisect[live], (good[live] + bad[live]) // 2, np.minimum(i[live] + step[live], counts[live] - 1))
+        ok, c = fit(runs, base[live] + i[live], base[live] + j, bounds)
+        was_bisect = bisect[live]
+        good[live[ok]], good_c[live[ok]] = j[ok], c[ok]
+        bad[live[~ok]] = j[~ok]
+        at_end = ok & (j == counts[live] - 1)
+        grow = ~was_bisect & ok & ~at_end
+        none = ~was_bisect & ~ok & (good[live] < 0)
+        settle = at_end | (~grow & ~none & (bad[live] - good[live] <= 1))
+        step[live[grow]] *= 2
+        bisect[live[~grow & ~none & ~settle]] = True
+        done = live[settle]
+        found.append((done, i[done], good[done], good_c[done]))
+        i[done] = good[done]
+        i[live[none]] += 1
+        reset = live[settle | none]
+        step[reset], good[reset], bad[reset], bisect[reset] = 2, -1, -1, False
+        live = live[i[live] < counts[live] - 2]
+    run, first, end, centre = (np.concatenate(v) for v in zip(*found)) if found else \
+        (np.zeros(0, dtype=np.int64),) * 3 + (np.zeros((0, 2)),)
+    k = np.lexsort((first, run))
+    return run[k], first[k], end[k], centre[k]
