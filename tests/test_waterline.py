@@ -23,7 +23,7 @@ from lagsym.post.program import point_program, write_program
 from lagsym.toolpath import STRATEGIES, Toolpath, plan_strategy
 
 from conftest import EXAMPLES
-from cutters import steep_flank
+from cutters import brute_ball, steep_flank
 from gcheck import check_feeds, interpret
 from left_check import left_normal
 
@@ -35,6 +35,33 @@ def _lines(points, across, at, lo, hi, n):
     u = np.linspace(lo, hi, n)
     out = [(u, np.full_like(u, a)) if across == "x" else (np.full_like(u, a), u) for a in at]
     return np.concatenate([o[0] for o in out]), np.concatenate([o[1] for o in out])
+
+
+def _far_links(points):
+    """The crossing moves of the links between distant passes: level, over 4 radii of a 6 mm ball long, entered by a
+    rise of 1 mm or more and left by a descent of as much."""
+    z, i = points[:, 2], np.arange(1, len(points) - 2)
+    long = np.hypot(*(points[i + 1, :2] - points[i, :2]).T) > 12.0
+    return i[(z[i] == z[i + 1]) & long & (z[i] >= z[i - 1] + 1.0) & (z[i + 1] >= z[i + 2] + 1.0)]
+
+
+def _highest_under(a, b, radius, f, box):
+    """The highest tip of a ball dropped (brute force) along the segment ``a -> b`` (mm): every 0.1 mm, then every
+    0.005 mm within 0.1 mm of the three highest."""
+    n = int(np.hypot(*(b - a)) / 0.1) + 2
+    s = np.linspace(0.0, 1.0, n)
+    z = brute_ball(f, box, a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), radius, n=21, rounds=6)
+    fine = np.concatenate([np.linspace(s[k] - 1.0 / n, s[k] + 1.0 / n, 41) for k in np.argsort(z)[-3:]])
+    fine = np.clip(fine, 0.0, 1.0)
+    zf = brute_ball(f, box, a[0] + fine * (b[0] - a[0]), a[1] + fine * (b[1] - a[1]), radius, n=21, rounds=6)
+    return max(float(z.max()), float(zf.max()))
+
+
+def _example4_mm(x, y):
+    """Example 4's exact polynomial at scale 20, in mm (the tests' own, tests/test_arcs.py)."""
+    from test_arcs import example4
+
+    return 20.0 * example4(x / 20.0, y / 20.0)
 
 
 def _dome():
@@ -166,6 +193,12 @@ def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_tha
             reach.append(k1 * 3.0 < 0.9)  # outside hollows tighter than the ball or barely wider (by 11 %)
         left, reach = np.concatenate(left), np.concatenate(reach)
         found[strategy] = (len(tp), float(left[reach].max()), float(left.min()))
+        if strategy == "steep-shallow":  # docs/toolpaths.md: a link rises 1 mm above the cutter path under it
+            links = _far_links(tp.points_mm)
+            rise = [tp.points_mm[k, 2] - _highest_under(tp.points_mm[k, :2], tp.points_mm[k + 1, :2], 3.0, _example4_mm,
+                                                        (20.0, 100.0, 20.0, 100.0))
+                    for k in np.random.default_rng(5).choice(links, 12, replace=False)]
+            assert len(links) > 100 and min(rise) >= 1.0, (len(links), rise)
     (n_ss, left_ss, low_ss), (n_r, left_r, low_r) = found["steep-shallow"], found["raster"]
     print("measured (cutter locations, most left normal, least left):", found)
     # The issue's target is 0.015 mm; next to the hollow of radius 3.09 mm near X91 (the ball barely fits) both

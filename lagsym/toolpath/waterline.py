@@ -96,6 +96,9 @@ LINK_CLEARANCE_MM = 1.0
 NEAR_RADII = 4.0
 """A next pass within this many tool radii is joined by a straight move where one stays above the cutter path."""
 
+FAR_LINK_STEPS = 4
+"""How many times further apart than a move's the samples of a link that rises over the part lie."""
+
 _DIRECTIONS = ("climb", "conventional")
 
 
@@ -428,16 +431,23 @@ def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing:
     """
     if not len(p):
         return []
-    margin = kappa * (spacing * mpu) ** 2 / 8
     near = np.hypot(q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]) * mpu <= NEAR_RADII * radius_mm
-    # One set of samples for both: how far the straight move lies below the cutter path, and the highest cutter
-    # location under the link.
-    k, _, pz, z, bend = drop.samples(p, q, spacing)
-    below, highest = np.full(len(p), -np.inf), np.full(len(p), -np.inf)
-    np.maximum.at(below, k, z - pz + bend)
-    np.maximum.at(highest, k, z + bend)
-    clear = near & (below + margin <= 0)
-    top = np.maximum(np.maximum(p[:, 2], q[:, 2]), highest + margin)
+    below, top = np.full(len(p), np.inf), np.maximum(p[:, 2], q[:, 2])
+    # The samples under a link give both how far the straight move lies below the cutter path and the highest
+    # cutter location under it.  A link that crosses rises a millimetre above the latter, so where the next pass
+    # is not near they lie FAR_LINK_STEPS times further apart (their larger margin counted).
+    for pick, step in ((near, spacing), (~near, FAR_LINK_STEPS * spacing)):
+        idx = np.flatnonzero(pick)
+        if not len(idx):
+            continue
+        margin = kappa * (step * mpu) ** 2 / 8
+        k, _, pz, z, bend = drop.samples(p[idx], q[idx], step)
+        low, high = np.full(len(idx), -np.inf), np.full(len(idx), -np.inf)
+        np.maximum.at(low, k, z - pz + bend)
+        np.maximum.at(high, k, z + bend)
+        below[idx] = low + margin
+        top[idx] = np.maximum(top[idx], high + margin)
+    clear = near & (below <= 0)
     h = top + LINK_CLEARANCE_MM
     return [np.empty((0, 3)) if c else np.array([[a[0], a[1], z], [b[0], b[1], z]])
             for c, a, b, z in zip(clear, p, q, h)]
