@@ -95,9 +95,7 @@ LINK_CLEARANCE_MM = 1.0
 
 NEAR_RADII = 4.0
 """A next pass within this many tool radii is joined by a straight move where one stays above the cutter path."""
-
-FAR_LINK_STEPS = 4
-"""How many times further apart than a move's the samples of a link that rises over the part lie."""
+_FAR_LINK_STEPS = 4  # how many times further apart than a move's the samples of a link over the part lie
 
 _DIRECTIONS = ("climb", "conventional")
 
@@ -433,10 +431,9 @@ def _links(drop: _Drop, p: np.ndarray, q: np.ndarray, radius_mm: float, spacing:
         return []
     near = np.hypot(q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]) * mpu <= NEAR_RADII * radius_mm
     below, top = np.full(len(p), np.inf), np.maximum(p[:, 2], q[:, 2])
-    # The samples under a link give both how far the straight move lies below the cutter path and the highest
-    # cutter location under it.  A link that crosses rises a millimetre above the latter, so where the next pass
-    # is not near they lie FAR_LINK_STEPS times further apart (their larger margin counted).
-    for pick, step in ((near, spacing), (~near, FAR_LINK_STEPS * spacing)):
+    # The samples under a link give how far the straight move lies below the cutter path and the highest cutter
+    # location under it; a link to a pass not near rises 1 mm above that, so needs no finer search than 0.25 mm.
+    for pick, step in ((near, spacing), (~near, _FAR_LINK_STEPS * spacing)):
         idx = np.flatnonzero(pick)
         if not len(idx):
             continue
