@@ -198,6 +198,42 @@ def test_rest_rapids_go_through_no_material(rest_run, maps):
     assert np.array_equal(h, maps["rest"])
 
 
+@pytest.mark.slow
+def test_the_finish_states_from_the_safe_side_what_it_takes_in_one_pass(rest_run, maps):
+    """The rest job's finish (max_engagement = 0.7) states the most it takes normal to the surface, in its line and
+    its header; the tests' own height map after the rest stage (pressed from rs274's moves) stands no further
+    above the polynomial, normal to it, anywhere in the box.  docs/roughing.md quotes both figures."""
+    text, printed, _ = rest_run
+    m = re.search(r"^finish T2: .*, takes at most ([\d.]+) mm normal to the surface \(max_engagement 0\.7 mm\)$",
+                  printed, re.M)
+    assert m, printed
+    assert f"(3 TAKES AT MOST {m.group(1)} MM NORMAL TO THE SURFACE)" in text, text[:800]
+    stated, measured = float(m.group(1)), float(((maps["rest"] - maps["f"]) / maps["w"]).max())
+    assert measured <= stated <= 0.7, (measured, stated)
+    page = " ".join((ROOT / "docs" / "roughing.md").read_text().split())
+    assert f"takes at most {stated:.2f} mm normal to the surface" in page
+    assert f"the tests' own height map finds {measured:.2f} mm" in page, measured
+
+
+@pytest.mark.slow
+def test_a_finish_deeper_than_its_max_engagement_is_refused_with_the_figure(run_cli, tmp_path, maps):
+    """The plain example job (no rest stage) with max_engagement = 0.5 on its finish: refused in one line with the
+    figure, no less than how far the tests' own map after the same rough stands above the polynomial, normal to
+    it; no program is written.  docs/roughing.md quotes the line."""
+    text = (ROOT / "examples" / "example-4-job.toml").read_text()
+    text = text.replace('points = "paper-example-4.json"', f'points = "{EX4.as_posix()}"')
+    job, out = tmp_path / "plain.toml", tmp_path / "plain.ngc"
+    job.write_text(text.replace("step = 0.2\n", "step = 0.2\nmax_engagement = 0.5\n", 1))
+    status, stdout, err = run_cli("job", job, "-o", out)
+    assert status == 2 and err.count("\n") == 1 and not stdout and not out.exists(), err
+    m = re.search(r"operations\[1\] \(finish\): (ball6 would take up to ([\d.]+) mm normal to the surface at "
+                  r"X[\d.]+ Y[\d.]+), more than max_engagement = 0\.5 mm: rough what stands there first", err)
+    assert m, err
+    measured = float(((maps["rough"] - maps["f"]) / maps["w"]).max())
+    assert measured <= float(m.group(2)) <= measured + 0.25, (measured, err)
+    assert m.group(1) in " ".join((ROOT / "docs" / "roughing.md").read_text().split())
+
+
 BAD = [
     ({"kind = \"rough\"\ntool = \"rougher\"": "kind = \"rough\"\nrest = true\ntool = \"rougher\""},
      "operations[0].rest = true: no earlier operation leaves a stock to rest-rough"),
@@ -208,6 +244,9 @@ BAD = [
     ({"rest = true": "rest = true\npattern = \"offset\"\nmilling = \"climb\"", 'direction = "y"\n': ""},
      "operations[1].rest = true: rest roughing runs point-list raster rows, not pattern = offset"),
     ({"rest = true": "rest = 1"}, "operations[1].rest = 1 must be true or false"),
+    ({"stock_to_leave = 0.3": "stock_to_leave = 0.3\nmax_engagement = 1"},
+     "operations[0].max_engagement does not apply to a rough operation"),
+    ({"max_engagement = 0.7": "max_engagement = 0"}, "operations[2].max_engagement = 0 must be a number above 0"),
 ]
 
 

@@ -144,5 +144,8 @@ def report(planned, prog, err) -> None:
         cusp = cusp_note(op.path) if getattr(op.path, "cusp_mm", None) is not None else ""
         if getattr(op.path, "runs", None) is not None:  # a rest finish
             cusp = f", in {op.path.runs} runs over {100 * op.path.share:.1f} % of its raster"
+        if op.engagement is not None:
+            cusp += (f", takes at most {op.engagement.stated} mm normal to the surface (max_engagement "
+                     f"{op.spec.options['max_engagement']:g} mm)")
         say(err, f"{op.label}: {len(op.points_mm)} moves, about {m:.1f} min{cusp}")
     err.write(f"cycle time about {prog.total_minutes:.1f} min (rapids at {planned.spec.rapid_mm_min:g} mm/min)\n")

@@ -30,7 +30,7 @@ from ..toolpath.plan import MAX_PLAN_POINTS
 from ..toolpath.rest import rest_toolpath
 from ..toolpath.restfinish import REST_ABOVE_MM, rest_finish
 from ..toolpath.rough import FEED, MAX_ROUGH_SAMPLES, PLUNGE, RAPID, RoughSpec, Stock, rough_toolpath, stock_around
-from .rest import stock_left
+from .rest import Engagement, engagement, stock_left
 from .spec import JobSpec, OperationSpec, ToolSpec
 
 __all__ = ["Operation", "plan_job", "job_stock", "job_surface", "PlannedJob"]
@@ -50,6 +50,7 @@ class Operation:
     points_mm: np.ndarray
     kinds: np.ndarray
     path: object
+    engagement: Engagement | None = None  # what a finish with max_engagement takes at most
 
     def __post_init__(self):
         freeze_fields(self, ("points_mm", "kinds"))
@@ -175,17 +176,26 @@ def _plan(spec: JobSpec, op: OperationSpec, tool: ToolSpec, surface, ev, stock: 
     except LagsymError as e:
         raise ToolpathError(str(e)) from None
     s = _settings(spec, op, o.get("stock_to_leave", 0.0))
+    left = stock_left(done, stock) if o.get("rest") or "max_engagement" in o else None
+    took = None
+    if "max_engagement" in o:  # before planning: refused with the figure, or stated in the report and header
+        took = engagement(left, ev, s.placement, s.stock_to_leave_mm)
+        if took.most_mm > o["max_engagement"]:
+            raise ToolpathError(
+                f"{tool.name} would take up to {took.stated} mm normal to the surface at X{took.x_mm:.3f} "
+                f"Y{took.y_mm:.3f}, more than max_engagement = {o['max_engagement']:g} mm: rough what stands there "
+                f"first (an operation with rest = true and a smaller tool before this one) or raise max_engagement")
     tp = plan_toolpath(surface, tool.tool, raster, s.placement, s.program, evaluator=ev, max_points=limits[0],
                        stock_to_leave_mm=s.stock_to_leave_mm, progress=progress)
     _check_reach(tool, stock, tp.points_mm[:, 2].min())
     if o.get("rest"):  # only where the operations before left material above what this ball reaches
-        rf = rest_finish(tp, stock_left(done, stock), stock.top_mm + 2.0, above_mm=o.get("rest_above", REST_ABOVE_MM))
-        return Operation(op, tool, rf.points_mm, rf.kinds, rf)
+        rf = rest_finish(tp, left, stock.top_mm + 2.0, above_mm=o.get("rest_above", REST_ABOVE_MM))
+        return Operation(op, tool, rf.points_mm, rf.kinds, rf, took)
     p = tp.points_mm
     above = stock.top_mm + 2.0
     pts = np.vstack([[p[0, 0], p[0, 1], above], p, [p[-1, 0], p[-1, 1], above]])
     kinds = np.concatenate([[RAPID, PLUNGE], np.full(len(p) - 1, FEED), [RAPID]])
-    return Operation(op, tool, pts, kinds, tp)
+    return Operation(op, tool, pts, kinds, tp, took)
 
 
 def _check_reach(tool: ToolSpec, stock: Stock, lowest_mm: float) -> None:

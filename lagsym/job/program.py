@@ -93,6 +93,8 @@ def _header(job: PlannedJob, s: MachineSettings, minutes) -> list[str]:
         out.append(f.comment(iso_comment(f"{i} {kind} T{t.number} {t.tool.label} {m:.1f} MIN")))
         if op.spec.kind == "rough":  # a point list or a macro alike
             out.append(f.comment(iso_comment(f"{i} {ramp_note(t.tool)}")))
+        if op.engagement is not None:
+            out.append(f.comment(iso_comment(f"{i} TAKES AT MOST {op.engagement.stated} MM NORMAL TO THE SURFACE")))
     out.append(f.comment(iso_comment(f"CYCLE TIME ABOUT {sum(minutes):.1f} MIN AT RAPID {spec.rapid_mm_min:g} MM/MIN")))
     out.append(f"{units_word(s)} {f.safe_start}")
     out.append(spec.work_offset)

@@ -58,7 +58,7 @@ _TOOL = {"number": int, "shape": str, "diameter": float, "corner_radius": float,
 _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed": float, "coolant": str,
        "stepdown": float, "stepover": float, "step": float, "scallop": float, "tolerance": float,
        "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
-       "pattern": str, "rest": bool, "rest_above": float}
+       "pattern": str, "rest": bool, "rest_above": float, "max_engagement": float}
 _REQUIRED_OP = ("kind", "tool")
 
 
@@ -183,7 +183,7 @@ _RANGES = {"scale": (1e-6, 1e6), "rapid": (1.0, 1e5), "feed": (1.0, 1e5), "plung
            "reach": (0.0, 1e4), "plunge_angle": (0.0, 90.0),
            "margin": (0.0, 1e5), "top_above": (0.0, 1e5), "stepdown": (1e-3, 1000.0), "stepover": (1e-4, 1000.0),
            "step": (1e-4, 1000.0), "stock_to_leave": (0.0, 100.0), "scallop": (1e-6, 1000.0),
-           "tolerance": (1e-6, 1000.0), "rest_above": (0.0, 100.0)}
+           "tolerance": (1e-6, 1000.0), "rest_above": (0.0, 100.0), "max_engagement": (0.0, 100.0)}
 _ABOVE = {"scallop", "tolerance"}  # above the low end, as --scallop and --tolerance
 _LENGTH_MM = 1e5  # safe_z, origin and block coordinates: within 100 m
 
@@ -358,7 +358,8 @@ def _operation(i: int, table: dict, tools: dict, source: str) -> OperationSpec:
     _choice(table["tool"], tuple(tools), where + "tool", source)
     allowed = {"stepdown", "stepover", "step", "stock_to_leave", "direction", "milling", "macro",
                "precision", "pattern", "rest"} if kind == "rough" else \
-        {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction", "rest", "rest_above"}
+        {"stepover", "step", "scallop", "tolerance", "stock_to_leave", "direction", "rest", "rest_above",
+         "max_engagement"}
     opts = {}
     for key, value in table.items():
         if key in ("kind", "tool", "spindle", "feed", "plunge_feed", "coolant"):
