@@ -363,3 +363,22 @@ def test_the_scores_from_one_factorization_are_each_candidates_own(criterion, la
     assert got.keys() == want.keys()  # the same candidates scored, the same refused (on four lines: x degree 3 at most)
     assert all(abs(got[c] - want[c]) <= 1e-9 * want[c] for c in want), max(abs(got[c] / want[c] - 1) for c in want)
     assert layout == "scattered" or max(p for p, _ in want) == 3
+
+
+@pytest.mark.parametrize("span, weight, degree", [(1, 1, (0, 0)), (3, 1, (1, 3)), (10**5, 1, (8, 8)),
+                                                  (10**9, 2**30, (6, 2)), (2**40, 7, (3, 3))])
+def test_the_modular_moments_are_the_python_integer_sums(span, weight, degree):
+    """lagsym.fit.moments (residues modulo primes below 2**16 in float64 products, then the CRT) against the sums
+    in Python's own integers, with zeros, negatives, weights and values up to 2**40; beyond 64 bits it declines."""
+    from lagsym.fit.moments import moments
+
+    rng = np.random.default_rng(span % 1000 + degree[0])
+    n = 700
+    U, V, Z = ([int(v) for v in rng.integers(-span, span + 1, n)] for _ in range(3))
+    U[:50] = [0] * 50
+    W = [int(v) for v in rng.integers(1, weight + 1, n)]
+    p, q = degree
+    M = [[sum(w * u ** s * v ** t for u, v, w in zip(U, V, W)) for t in range(2 * q + 1)] for s in range(2 * p + 1)]
+    R = [[sum(w * z * u ** a * v ** b for u, v, w, z in zip(U, V, W, Z)) for b in range(q + 1)] for a in range(p + 1)]
+    assert moments(U, V, W, Z, degree) == (M, R)
+    assert moments(U, V, W, [2 ** 63] + Z[1:], degree) is None

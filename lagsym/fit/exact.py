@@ -3,8 +3,9 @@
 Every coordinate is scaled to an integer (``x * Dx``, ``Dx`` the common
 denominator of the x values: for decimals a power of ten) and shifted by an
 integer near the middle of its range, so the moments ``sum_k w_k u_k**s
-v_k**t`` and the right-hand side are integer matrix products
-(python-flint's ``fmpz_mat``); the normal equations are solved exactly
+v_k**t`` and the right-hand side are integer sums (modulo small primes in
+float64 matrix products, :mod:`.moments`, or python-flint's ``fmpz_mat``
+products where a value does not fit 64 bits); the normal equations are solved exactly
 (``fmpz_mat.solve``) and the solution carried back to powers of ``x`` and
 ``y`` by the exact binomial change of variables.
 """
@@ -19,6 +20,7 @@ from fractions import Fraction
 import flint
 
 from ..errors import GridError
+from .moments import moments
 
 __all__ = ["fit_coefficients"]
 
@@ -116,17 +118,12 @@ def _solve(s: _Scaled, degree: tuple[int, int], source: str) -> tuple[tuple[Frac
     p, q = degree
     # Integer shifts near the middle keep the powers, and so the exact numbers, small.
     cx, cy = (min(s.X) + max(s.X)) // 2, (min(s.Y) + max(s.Y)) // 2
-    pu = _powers([v - cx for v in s.X], 2 * p)
-    pv = _powers([v - cy for v in s.Y], 2 * q)
     n = len(s.X)
-    wu = flint.fmpz_mat(2 * p + 1, n, [w * r[e] for e in range(2 * p + 1) for w, r in zip(s.W, pu)])
-    wzu = flint.fmpz_mat(p + 1, n, [w * z * r[e] for e in range(p + 1) for w, z, r in zip(s.W, s.Z, pu)])
-    moments = wu * flint.fmpz_mat(n, 2 * q + 1, [c for r in pv for c in r])  # sum w u**s v**t
-    rhs = wzu * flint.fmpz_mat(n, q + 1, [c for r in pv for c in r[:q + 1]])
+    mom, rhs = _moments([v - cx for v in s.X], [v - cy for v in s.Y], s.W, s.Z, (p, q))
     k = (p + 1) * (q + 1)
     idx = [(a, b) for a in range(p + 1) for b in range(q + 1)]
-    gram = flint.fmpz_mat(k, k, [moments[a + c, b + d] for a, b in idx for c, d in idx])
-    r = flint.fmpz_mat(k, 1, [rhs[a, b] for a, b in idx])
+    gram = flint.fmpz_mat(k, k, [mom[a + c][b + d] for a, b in idx for c, d in idx])
+    r = flint.fmpz_mat(k, 1, [rhs[a][b] for a, b in idx])
     try:
         sol = gram.solve(r)
     except ZeroDivisionError:
@@ -140,6 +137,26 @@ def _solve(s: _Scaled, degree: tuple[int, int], source: str) -> tuple[tuple[Frac
     ty = flint.fmpq_mat(q + 1, q + 1, [v for row in _shift_matrix(s.dy, cy, q) for v in row])
     c = tx.transpose() * cu * ty / s.dz
     return tuple(tuple(Fraction(int(c[a, b].p), int(c[a, b].q)) for b in range(q + 1)) for a in range(p + 1))
+
+
+def _moments(U, V, W, Z, degree):
+    """``sum w u**s v**t`` (``s <= 2p``, ``t <= 2q``) and ``sum w z u**a v**b`` (``a <= p``, ``b <= q``), exactly.
+
+    Modulo small primes in float64 matrix products (:mod:`.moments`) where
+    every value fits 64 bits; else as python-flint integer matrix products.
+    """
+    found = moments(U, V, W, Z, degree)
+    if found is not None:
+        return found
+    p, q = degree
+    pu, pv = _powers(U, 2 * p), _powers(V, 2 * q)
+    n = len(U)
+    wu = flint.fmpz_mat(2 * p + 1, n, [w * r[e] for e in range(2 * p + 1) for w, r in zip(W, pu)])
+    wzu = flint.fmpz_mat(p + 1, n, [w * z * r[e] for e in range(p + 1) for w, z, r in zip(W, Z, pu)])
+    mom = wu * flint.fmpz_mat(n, 2 * q + 1, [c for r in pv for c in r])
+    rhs = wzu * flint.fmpz_mat(n, q + 1, [c for r in pv for c in r[:q + 1]])
+    return ([[int(mom[i, j]) for j in range(2 * q + 1)] for i in range(2 * p + 1)],
+            [[int(rhs[i, j]) for j in range(q + 1)] for i in range(p + 1)])
 
 
 def _residuals(s: _Scaled, coefficients) -> tuple[tuple[int, ...], int]:
