@@ -49,6 +49,11 @@ def _common_denominator(values: Sequence[Fraction]) -> int:
     return d
 
 
+def _times(values: Sequence[Fraction], d: int) -> list[int]:
+    """``v * d`` for each value, ``d`` a multiple of every denominator: the integer without a Fraction product."""
+    return [v.numerator * (d // v.denominator) for v in values]
+
+
 def _powers(values: Sequence[int], top: int) -> list[list[int]]:
     rows = []
     for v in values:
@@ -87,9 +92,8 @@ class _Scaled:
             W, dw = [1] * len(points), 1
         else:
             dw = _common_denominator(weights)
-            W = [int(w * dw) for w in weights]
-        return cls([int(v * dx) for v in xs], [int(v * dy) for v in ys], [int(v * dz) for v in zs], W,
-                   dx, dy, dz, dw)
+            W = _times(weights, dw)
+        return cls(_times(xs, dx), _times(ys, dy), _times(zs, dz), W, dx, dy, dz, dw)
 
 
 def fit_coefficients(points: Sequence[Sequence[Fraction]], degree: tuple[int, int],
