@@ -26,6 +26,7 @@ from conftest import EXAMPLES
 from cutters import brute_ball, steep_flank
 from gcheck import check_feeds, interpret
 from left_check import left_normal
+from test_rough import EX4, exact_heights
 
 TOL = 0.005
 
@@ -55,13 +56,6 @@ def _highest_under(a, b, radius, f, box):
     fine = np.clip(fine, 0.0, 1.0)
     zf = brute_ball(f, box, a[0] + fine * (b[0] - a[0]), a[1] + fine * (b[1] - a[1]), radius, n=21, rounds=6)
     return max(float(z.max()), float(zf.max()))
-
-
-def _example4_mm(x, y):
-    """Example 4's exact polynomial at scale 20, in mm (the tests' own, tests/test_arcs.py)."""
-    from test_arcs import example4
-
-    return 20.0 * example4(x / 20.0, y / 20.0)
 
 
 def _dome():
@@ -195,7 +189,8 @@ def test_example_4_steep_shallow_meets_the_bound_with_fewer_cutter_locations_tha
         found[strategy] = (len(tp), float(left[reach].max()), float(left.min()))
         if strategy == "steep-shallow":  # docs/toolpaths.md: a link rises 1 mm above the cutter path under it
             links = _far_links(tp.points_mm)
-            rise = [tp.points_mm[k, 2] - _highest_under(tp.points_mm[k, :2], tp.points_mm[k + 1, :2], 3.0, _example4_mm,
+            exact_mm = lambda x, y: exact_heights(EX4, x, y)  # noqa: E731 - the tests' own basis products, at scale 20
+            rise = [tp.points_mm[k, 2] - _highest_under(tp.points_mm[k, :2], tp.points_mm[k + 1, :2], 3.0, exact_mm,
                                                         (20.0, 100.0, 20.0, 100.0))
                     for k in np.random.default_rng(5).choice(links, 12, replace=False)]
             assert len(links) > 100 and min(rise) >= 1.0, (len(links), rise)
