@@ -12,47 +12,29 @@ of ``--runs`` runs, the compiled drop-cutter loaded once outside the timing.
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
-import sys
-import time
-from pathlib import Path
 
 import results as recorded
+from runs import alternate, arguments, example4
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from lagsym.machine import MachineSettings, RasterSpec, Tool
+from lagsym.toolpath import plan_toolpath
 
-from lagsym.allocator import keep_freed_memory  # noqa: E402
-from lagsym.evaluate import surface_evaluator  # noqa: E402
-from lagsym.io import read_points  # noqa: E402
-from lagsym.lagrange import lagrange_surface  # noqa: E402
-from lagsym.machine import MachineSettings, RasterSpec, Tool  # noqa: E402
-from lagsym.toolpath import drop_cutter, plan_toolpath  # noqa: E402
-
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "paper-example-4.json"
 SCALE, DIAMETER, STEPOVER, STEP = 20.0, 6.0, 0.4, 0.2
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=3, help="runs of each (default 3)")
-    recorded.add_option(ap)
-    args = ap.parse_args(argv)
-    keep_freed_memory()
-    surface = lagrange_surface(read_points(EXAMPLE))
-    ev = surface_evaluator(surface)
+    args = arguments(__doc__, argv)
+    surface, ev = example4(SCALE, DIAMETER)
     settings = MachineSettings(mm_per_unit=SCALE, dialect="fanuc")
     tool = Tool("ball", DIAMETER)
-    drop_cutter(surface, 3.0, 3.0, DIAMETER / 2 / SCALE, evaluator=ev)  # the compiled kernel loaded, untimed
-    walls = {False: [], True: []}
-    plans = {}
-    for _ in range(args.runs):
-        for arcs in (False, True):
-            t = time.perf_counter()
-            plans[arcs] = plan_toolpath(surface, tool, RasterSpec("x", STEPOVER, STEP, arcs=arcs), settings.placement,
-                                        settings.program, evaluator=ev)
-            walls[arcs].append(time.perf_counter() - t)
+
+    def plan(arcs):
+        return lambda: plan_toolpath(surface, tool, RasterSpec("x", STEPOVER, STEP, arcs=arcs), settings.placement,
+                                     settings.program, evaluator=ev)
+
+    walls, plans = alternate(args.runs, {False: plan(False), True: plan(True)})
     plain, with_arcs = statistics.median(walls[False]), statistics.median(walls[True])
     arcs = plans[True].arcs
     print(f"Example 4 at scale {SCALE:g}, ball D{DIAMETER:g} mm, side step {STEPOVER:g} mm, step {STEP:g} mm: "

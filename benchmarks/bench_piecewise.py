@@ -19,7 +19,6 @@ Run:  python3 benchmarks/bench_piecewise.py [--runs 3]
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import resource
@@ -30,10 +29,10 @@ from fractions import Fraction
 from pathlib import Path
 
 import results as recorded
+from runs import arguments
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from lagsym.allocator import keep_freed_memory  # noqa: E402
 from lagsym.grid import grid_from_table  # noqa: E402
 from lagsym.lagrange import lagrange_surface  # noqa: E402
 from lagsym.machine import RasterSpec, Tool  # noqa: E402
@@ -69,11 +68,7 @@ def _cpu() -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=3, help="runs of each (default 3)")
-    recorded.add_option(ap)
-    args = ap.parse_args(argv)
-    keep_freed_memory()
+    args = arguments(__doc__, argv)
     grid_pieces, grid_single = grids()
     make = {"pieces": lambda: piecewise_surface(grid_pieces), "single": lambda: lagrange_surface(grid_single)}
     tool, raster = Tool("ball", DIAMETER), RasterSpec("x", STEPOVER, STEP)

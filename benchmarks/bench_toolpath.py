@@ -32,20 +32,16 @@ from pathlib import Path
 import numpy as np
 
 import results as recorded
+from runs import arguments, example4
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_dropcutter import ocl_drop, stl_surface  # noqa: E402
 
-from lagsym.allocator import keep_freed_memory  # noqa: E402
-from lagsym.evaluate import surface_evaluator  # noqa: E402
-from lagsym.io import read_points  # noqa: E402
-from lagsym.lagrange import lagrange_surface  # noqa: E402
 from lagsym.machine import MachineSettings, RasterSpec, Tool  # noqa: E402
 from lagsym.toolpath import drop_cutter, plan_toolpath  # noqa: E402
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "paper-example-4.json"
 SCALE, DIAMETER, STEP = 20.0, 6.0, 0.2
 
 
@@ -69,22 +65,16 @@ def _times(run, runs: int):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="side step 2 mm, OpenCAMLib on a sample of the positions")
-    ap.add_argument("--runs", type=int, default=3, help="runs of each (default 3)")
     ap.add_argument("--mesh", type=int, default=360, help="STL cells per side (default 360: within about 5 um)")
-    recorded.add_option(ap)
     ap.add_argument("--ocl-points", type=int, default=4000, help="with --quick, positions OpenCAMLib drops on")
-    args = ap.parse_args(argv)
+    args = arguments(__doc__, argv, ap)
     import opencamlib as ocl
 
-    keep_freed_memory()
-
-    surface = lagrange_surface(read_points(EXAMPLE))
-    ev = surface_evaluator(surface)
+    surface, ev = example4(SCALE, DIAMETER)
     stepover = 2.0 if args.quick else 0.5
     raster = RasterSpec("x", stepover, STEP)
     settings = MachineSettings(mm_per_unit=SCALE)
     tool = Tool("ball", DIAMETER)
-    drop_cutter(surface, 3.0, 3.0, DIAMETER / 2 / SCALE, evaluator=ev)  # the compiled kernel loaded, untimed
     best, median, cbest, cmedian, tp = _times(lambda: plan_toolpath(surface, tool, raster, settings.placement, settings.program, evaluator=ev, stock_to_leave_mm=settings.stock_to_leave_mm),
                                               args.runs)
     n = len(tp)

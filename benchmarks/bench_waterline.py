@@ -17,46 +17,25 @@ the figure recorded is the raster's plan time over steep-and-shallow's (below
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
-import sys
-import time
-from pathlib import Path
 
 import results as recorded
+from runs import alternate, arguments, example4
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from lagsym.machine import Placement, RasterSpec, Tool
+from lagsym.toolpath import plan_strategy
 
-from lagsym.allocator import keep_freed_memory  # noqa: E402
-from lagsym.evaluate import surface_evaluator  # noqa: E402
-from lagsym.io import read_points  # noqa: E402
-from lagsym.lagrange import lagrange_surface  # noqa: E402
-from lagsym.machine import Placement, RasterSpec, Tool  # noqa: E402
-from lagsym.toolpath import drop_cutter, plan_strategy  # noqa: E402
-
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "paper-example-4.json"
 SCALE, DIAMETER, CUSP, TOL = 20.0, 6.0, 0.01, 0.005
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=3, help="runs of each (default 3)")
-    recorded.add_option(ap)
-    args = ap.parse_args(argv)
-    keep_freed_memory()
-    surface = lagrange_surface(read_points(EXAMPLE))
-    ev = surface_evaluator(surface)
-    drop_cutter(surface, 3.0, 3.0, DIAMETER / 2 / SCALE, evaluator=ev)  # the compiled kernel loaded, untimed
+    args = arguments(__doc__, argv)
+    surface, ev = example4(SCALE, DIAMETER)
     spec = RasterSpec("x", None, None, CUSP, TOL)
-    times = {"raster": [], "steep-shallow": []}
-    plans = {}
-    for _ in range(args.runs):
-        for strategy in times:
-            t = time.perf_counter()
-            plans[strategy] = plan_strategy(surface, Tool("ball", DIAMETER), spec, Placement(SCALE), evaluator=ev,
-                                            strategy=strategy)
-            times[strategy].append(time.perf_counter() - t)
+    times, plans = alternate(args.runs, {strategy: lambda strategy=strategy: plan_strategy(
+        surface, Tool("ball", DIAMETER), spec, Placement(SCALE), evaluator=ev, strategy=strategy)
+        for strategy in ("raster", "steep-shallow")})
     r, s = plans["raster"], plans["steep-shallow"]
     for name, tp in plans.items():
         w = times[name]
