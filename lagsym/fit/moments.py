@@ -59,10 +59,13 @@ def moments(U, V, W, Z, degree: tuple[int, int]):
     (3, 5, -6)
     """
     p, q = degree
-    if not len(U) or max(max(map(abs, U)), max(map(abs, V)), max(map(abs, W)), max(map(abs, Z))) >= _FITS:
+    if not len(U):
+        return None
+    largest = [max(map(abs, a)) for a in (U, V, W, Z)]
+    if max(largest) >= _FITS:
         return None
     u, v, w, z = (np.array(a, dtype=np.int64) for a in (U, V, W, Z))
-    umax, vmax = max(int(np.abs(u).max()), 1), max(int(np.abs(v).max()), 1)  # u**0 is 1 even where u is 0
+    umax, vmax = max(largest[0], 1), max(largest[1], 1)  # u**0 is 1 even where u is 0
     bound = max(sum(map(abs, W)) * umax ** (2 * p) * vmax ** (2 * q),
                 sum(abs(a * b) for a, b in zip(W, Z)) * umax ** p * vmax ** q)
     # Primes below 2**16 are above 2**15: enough of them that their product exceeds 2 * bound.
