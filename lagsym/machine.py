@@ -20,7 +20,8 @@ from .errors import InputError, ToolpathError
 from .values import as_exact, choice, finite, positive
 
 __all__ = ["Placement", "Cutter", "Tool", "MachineSettings", "ProgramFormat", "CuttingData", "ToolSlot", "RasterSpec", "DIALECTS", "TOOL_SHAPES", "LINE_ENDINGS",
-           "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "mm_per_surface_unit",
+           "PROGRAM_LINE_ENDINGS", "UNITS", "DIRECTIONS", "COOLANTS", "MM_PER", "LENGTH_UNITS", "FEED_UNITS", "split_unit",
+           "mm_per_surface_unit",
            "program_units_per_mm", "mm_per_program_unit", "BOUNDARIES", "DEFAULT_TOLERANCE_MM", "MAX_LEFT_MM", "cutter_profile"]
 
 DIALECTS = names()
@@ -38,6 +39,25 @@ MAX_LEFT_MM = 0.1
 """Material left above the surface from which a finishing program fails verification, by default."""
 MM_PER_INCH = Fraction(254, 10)
 MM_PER = {"mm": Fraction(1), "inch": MM_PER_INCH}
+LENGTH_UNITS = {"mm": Fraction(1), "in": MM_PER_INCH}
+"""The units a length may name after its number (``5mm``, ``0.2 in``), and their millimetres."""
+FEED_UNITS = {"mm/min": Fraction(1), "in/min": MM_PER_INCH}
+"""The units a feed may name after its number (``600mm/min``, ``24 in/min``), and their millimetres."""
+
+
+def split_unit(text: str, units) -> tuple[str, Fraction | None]:
+    """``text`` as its number and the millimetres of the unit it ends in, of ``units`` (None if it names none).
+
+    Examples
+    --------
+    >>> split_unit(" 0.2 in", LENGTH_UNITS), split_unit("600", FEED_UNITS)
+    (('0.2', Fraction(127, 5)), ('600', None))
+    """
+    s = text.strip()
+    for name in sorted(units, key=len, reverse=True):
+        if s.endswith(name):
+            return s[:-len(name)].strip(), units[name]
+    return s, None
 
 
 def mm_per_surface_unit(surface_units: str | None, scale: float = 1.0) -> float:

@@ -11,6 +11,7 @@ from ..errors import InputError
 from ..io import write_text
 from ._lines import say
 from ..controls import CONTROLS, work_offset
+from ..machine import FEED_UNITS, LENGTH_UNITS, split_unit
 from ..values import as_exact, finite, in_range, whole
 
 
@@ -217,8 +218,6 @@ def number(low: float, high: float, unit: str = "", *, above: bool = False):
 # in inches and inches a minute) unless the number carries its own: ``5mm``, ``0.2in``, ``600mm/min``,
 # ``24in/min``.  The range is checked once the number is in millimetres.
 MM_PER_INCH = 25.4
-LENGTH_UNITS = {"mm": 1.0, "in": MM_PER_INCH}
-FEED_UNITS = {"mm/min": 1.0, "in/min": MM_PER_INCH}
 
 
 @dataclass(frozen=True)
@@ -249,12 +248,8 @@ def measure(low: float, high: float, unit: str, *, above: bool = False):
     units = FEED_UNITS if unit == "mm/min" else LENGTH_UNITS
 
     def parse(text: str) -> Given:
-        s = text.strip()
-        factor = None
-        for name in sorted(units, key=len, reverse=True):
-            if s.endswith(name):
-                s, factor = s[:-len(name)].strip(), units[name]
-                break
+        s, named = split_unit(text, units)
+        factor = None if named is None else float(named)
         try:
             value = finite(s, "")
         except InputError:

@@ -9,7 +9,10 @@ from ._common import add_file_points_limit, add_conditioning_argument, guarded_s
 DESCRIPTION = """Plan every operation of the job file JOB.toml (points file, units, stock
 block, work offset, tools, operations) and write them as one point-list
 program, in order, with a tool change, spindle speed, feeds and coolant for
-each.  Every key of the job file is checked.  The cycle-time estimate of
+each.  Every key of the job file is checked.  Lengths and feeds are in the
+job's units: in an inch job (units = "inch") safe_z = 2 is 2 inches and
+feed = 24 is 24 inches a minute; text with a unit ("50 mm", "600 mm/min")
+is read in that unit.  The cycle-time estimate of
 each operation and of the whole job is printed and written in the program's
 header.  See docs/roughing.md for the job file.  The points file may be a
 piecewise surface ('lagsym piecewise'); a roughing macro (macro = true) is

@@ -199,7 +199,7 @@ def run(args, out, err) -> int:
         if pieces is not None:
             raise InputError(f"--macro: {piecewise_macro_refusal(pieces, 'a roughing macro')}")
     samples = MAX_ROUGH_SAMPLES if args.max_samples is None else args.max_samples
-    spec, surface = guard_job(parse_job(job_data(args), "lagsym rough"), args, err)
+    spec, surface = guard_job(parse_job(job_data(args), "lagsym rough", lengths_in_mm=True), args, err)
     with progress_bar(err) as progress:
         planned = plan_job(spec, args.max_points, samples, progress=progress, max_exact_mb=exact_limit(args),
                            surface=surface)

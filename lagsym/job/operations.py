@@ -126,7 +126,9 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     ev = evaluator_of(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:
-        raise InputError(f"{spec.source}: safe_z = {spec.safe_z_mm:g} mm is not above the stock top {stock.top_mm:g} mm")
+        both = (lambda mm: f"{mm / 25.4:.4f} in ({mm:g} mm)") if spec.units == "inch" else (lambda mm: f"{mm:g} mm")
+        raise InputError(f"{spec.source}: safe_z = {both(spec.safe_z_mm)} is not above the stock top "
+                         f"{both(stock.top_mm)}")
     ops = []
     planned = Tally(progress, "operations", len(spec.operations))
     planned.start()

@@ -9,7 +9,7 @@ key and (for a choice) the valid values.  Example::
     safe_z = 80
 
     [stock]
-    top_above = 2                        # mm above the surface's highest point (or: top = 73.6)
+    top_above = 2                        # above the surface's highest point (or: top = 73.6), in the units
 
     [tools.rougher]
     number = 1
@@ -37,6 +37,7 @@ from ..controls import VARIABLE_PROFILES, control, names
 from ..machine import DIRECTIONS, TOOL_SHAPES, UNITS, Tool
 from ..toolpath.rough import MILLING, PATTERNS
 from ..values import FrozenMap, in_range
+from .units import Given, in_mm
 
 __all__ = ["JobSpec", "OperationSpec", "ToolSpec", "ProbeStage", "read_job", "parse_job", "KINDS", "COOLANTS"]
 
@@ -201,12 +202,19 @@ def _positive(value, key: str, source: str, allow_zero: bool = False) -> float:
 
 def _length(value, key: str, source: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"{source}: {key} = {value!r} must be a number of mm")
+        raise InputError(f"{source}: {key} = {value!r} must be a number (a length)")
     return in_range(value, f"{source}: {key}", -_LENGTH_MM, _LENGTH_MM, unit="mm")
 
 
-def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobSpec:
-    """A :class:`JobSpec` from the parsed TOML ``data``; ``base`` is where a relative points path starts."""
+def parse_job(data: dict, source: str = "<job>", base: Path = Path("."), *, lengths_in_mm: bool = False) -> JobSpec:
+    """A :class:`JobSpec` from the parsed TOML ``data``; ``base`` is where a relative points path starts.
+
+    Lengths and feeds are in the job's ``units`` (inches and inches a minute in an inch job) unless given as text
+    with their unit (``"50 mm"``); with ``lengths_in_mm`` they are millimetres whatever ``units`` says (a caller
+    that has converted them).
+    """
+    if not lengths_in_mm:
+        data = in_mm(data, source)
     _keys(data, _TOP, "", source)
     for key in ("tools", "operations", "stock"):
         if key not in data:
@@ -216,7 +224,7 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path(".")) -> JobS
                          f"machine), {'not both' if 'points' in data else 'one of them'}")
     origin = data.get("origin", [0.0, 0.0, 0.0])
     if len(origin) != 3 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in origin):
-        raise InputError(f"{source}: origin = {origin!r} must be three numbers [X, Y, Z] in mm")
+        raise InputError(f"{source}: origin = {origin!r} must be three numbers [X, Y, Z]")
     tools = {name: _tool(name, t, source) for name, t in data["tools"].items()}
     numbers = [t.number for t in tools.values()]
     if len(set(numbers)) != len(numbers):
@@ -275,7 +283,7 @@ def _probe(table: dict, dialect: str, source: str) -> ProbeStage:
         raise InputError(f"{source}: a probe stage is written for {', '.join(PROBE_DIALECTS)}, not {dialect!r}")
     box = table["box"]
     if len(box) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in box):
-        raise InputError(f"{source}: probe.box = {box!r} must be four numbers [x0, x1, y0, y1] in mm")
+        raise InputError(f"{source}: probe.box = {box!r} must be four numbers [x0, x1, y0, y1]")
     for key in ("top", "bottom"):
         _length(table[key], f"probe.{key}", source)
     for k, v in enumerate(box):
@@ -285,13 +293,20 @@ def _probe(table: dict, dialect: str, source: str) -> ProbeStage:
     if fit_degree is not None and not 0 <= fit_degree <= 12:
         raise InputError(f"{source}: probe.fit_degree = {fit_degree} must be 0 to 12")
     try:
-        plan = node_plan(tuple(box), table.get("degree", 4), spacing=spacing, margin=table.get("margin", 2))
-        settings = ProbeSettings(str(table["tip_radius"]), str(table["top"]), str(table["bottom"]),
-                                 clearance_mm=str(table.get("clearance", 2)),
-                                 overtravel_mm=str(table.get("overtravel", 2)), feed_mm_min=str(table.get("feed", 100)))
+        plan = node_plan(tuple(v.exact if isinstance(v, Given) else v for v in box), table.get("degree", 4),
+                         spacing=spacing, margin=table.get("margin", 2))
+        settings = ProbeSettings(_exact(table["tip_radius"]), _exact(table["top"]), _exact(table["bottom"]),
+                                 clearance_mm=_exact(table.get("clearance", 2)),
+                                 overtravel_mm=_exact(table.get("overtravel", 2)),
+                                 feed_mm_min=_exact(table.get("feed", 100)))
     except InputError as e:
         raise InputError(f"{source}: probe: {e}") from None
     return ProbeStage(plan, settings, fit_degree)
+
+
+def _exact(value):
+    """A probe setting as exact as the file gave it: a converted value's exact millimetres, else its text."""
+    return value.exact if isinstance(value, Given) else str(value)
 
 
 def _check_title(title: str, c, program_number: int, source: str) -> None:
@@ -310,13 +325,13 @@ def _check_title(title: str, c, program_number: int, source: str) -> None:
 def _stock(table: dict, source: str) -> dict:
     _keys(table, _STOCK, "stock.", source)
     if ("top" in table) == ("top_above" in table):
-        raise InputError(f"{source}: stock needs exactly one of top (mm) or top_above (mm above the surface)")
+        raise InputError(f"{source}: stock needs exactly one of top (a height) or top_above (above the surface)")
     if "block" in table and "margin" in table:
         raise InputError(f"{source}: stock takes block = [x0, x1, y0, y1] or margin, not both")
     if "block" in table:
         b = table["block"]
         if len(b) != 4 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in b):
-            raise InputError(f"{source}: stock.block = {b!r} must be four numbers [x0, x1, y0, y1] in mm")
+            raise InputError(f"{source}: stock.block = {b!r} must be four numbers [x0, x1, y0, y1]")
         for k, v in enumerate(b):
             _length(v, f"stock.block[{k}]", source)
     if "top" in table:
@@ -325,7 +340,7 @@ def _stock(table: dict, source: str) -> dict:
         _positive(table["margin"], "stock.margin", source, allow_zero=True)
     if "top_above" in table:
         _positive(table["top_above"], "stock.top_above", source, allow_zero=True)
-    return dict(table)
+    return {k: [float(x) for x in v] if k == "block" else float(v) for k, v in table.items()}
 
 
 def _tool(name: str, table: dict, source: str) -> ToolSpec:
@@ -337,11 +352,11 @@ def _tool(name: str, table: dict, source: str) -> ToolSpec:
     if not 1 <= table["number"] <= 99:
         raise InputError(f"{source}: {where}number = {table['number']} must be 1 to 99")
     shape = _choice(table["shape"], TOOL_SHAPES, where + "shape", source)
+    corner = _positive(table["corner_radius"], where + "corner_radius", source) if "corner_radius" in table else None
+    angle = _positive(table["plunge_angle"], where + "plunge_angle", source) if "plunge_angle" in table else None
+    diameter = _positive(table["diameter"], where + "diameter", source)
     try:
-        corner = _positive(table["corner_radius"], where + "corner_radius", source) if "corner_radius" in table else None
-        angle = _positive(table["plunge_angle"], where + "plunge_angle", source) if "plunge_angle" in table else None
-        tool = Tool(shape, _positive(table["diameter"], where + "diameter", source), corner,
-                    centre_cutting=table.get("centre_cutting", True), ramp_angle_deg=angle)
+        tool = Tool(shape, diameter, corner, centre_cutting=table.get("centre_cutting", True), ramp_angle_deg=angle)
     except LagsymError as e:
         raise InputError(f"{source}: {where}: {e}") from None
     opt = {k: _positive(table[k], where + k, source) for k in ("flute_length", "reach") if k in table}
