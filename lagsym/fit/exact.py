@@ -20,6 +20,7 @@ from fractions import Fraction
 import flint
 
 from ..errors import GridError
+from ..io.decimals import DecimalPoints, column_floats
 from .moments import moments
 
 __all__ = ["fit_coefficients"]
@@ -29,17 +30,22 @@ def _middle_and_half(lo: Fraction, hi: Fraction) -> tuple[Fraction, Fraction]:
     return Fraction(lo + hi, 2), Fraction(hi - lo, 2) or Fraction(1)
 
 
-def _normalized(values: Sequence[Fraction], middle: Fraction, half: Fraction):
-    """``(v - middle) / half`` for each value, each rounded once to the nearest float.
+def _normalized(points, j: int, middle: Fraction, half: Fraction):
+    """``(v - middle) / half`` for coordinate ``j`` of each point, each rounded once to the nearest float.
 
     In integers: ``(n/d - mn/md) / (hn/hd) = (n md hd - mn hd d) / (d md hn)``, and Python divides two
-    integers correctly rounded, so each is ``float((v - middle) / half)`` without building a Fraction a point.
+    integers correctly rounded, so each is ``float((v - middle) / half)`` without building a Fraction a point
+    (nor, for points read in whole columns, a Fraction at all: ``n / d`` need not be in lowest terms).
     """
     import numpy as np
 
     a, b, c = middle.denominator * half.denominator, middle.numerator * half.denominator, \
         middle.denominator * half.numerator
-    return np.array([(v.numerator * a - b * v.denominator) / (v.denominator * c) for v in values])
+    if isinstance(points, DecimalPoints):
+        ns, d = points.integers(j)
+        bd, dc = b * d, d * c
+        return np.array([(n * a - bd) / dc for n in ns])
+    return np.array([(v.numerator * a - b * v.denominator) / (v.denominator * c) for v in (p[j] for p in points)])
 
 
 def _common_denominator(values: Sequence[Fraction]) -> int:
@@ -86,13 +92,16 @@ class _Scaled:
 
     @classmethod
     def of(cls, points, weights) -> _Scaled:
-        xs, ys, zs = ([pt[i] for pt in points] for i in range(3))
-        dx, dy, dz = (_common_denominator(v) for v in (xs, ys, zs))
         if weights is None:
             W, dw = [1] * len(points), 1
         else:
             dw = _common_denominator(weights)
             W = _times(weights, dw)
+        if isinstance(points, DecimalPoints):  # the integers as read, over their least denominators
+            (X, dx), (Y, dy), (Z, dz) = (points.integers(i) for i in range(3))
+            return cls(X, Y, Z, W, dx, dy, dz, dw)
+        xs, ys, zs = ([pt[i] for pt in points] for i in range(3))
+        dx, dy, dz = (_common_denominator(v) for v in (xs, ys, zs))
         return cls(_times(xs, dx), _times(ys, dy), _times(zs, dz), W, dx, dy, dz, dw)
 
 
@@ -208,8 +217,8 @@ def float_residuals(points, coefficients, box):
     tx, ty = mat(_shift_matrix(hx, -xm, c.nrows() - 1)), mat(_shift_matrix(hy, -ym, c.ncols() - 1))
     ct = tx.transpose() * c * ty
     cf = np.array([[int(ct[a, b].p) / int(ct[a, b].q) for b in range(ct.ncols())] for a in range(ct.nrows())])
-    t, u = _normalized([p[0] for p in points], xm, hx), _normalized([p[1] for p in points], ym, hy)
-    z = np.array([float(p[2]) for p in points])
+    t, u = _normalized(points, 0, xm, hx), _normalized(points, 1, ym, hy)
+    z = column_floats(points, 2)
     steps = 2 * (ct.nrows() + ct.ncols()) + 8
     bound = 2 * steps * np.finfo(float).eps / 2 * (float(np.abs(cf).sum()) + float(np.abs(z).max()))
     return z - np.polynomial.polynomial.polyval2d(t, u, cf), bound

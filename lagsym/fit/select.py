@@ -11,6 +11,7 @@ import math
 import re
 
 from ..errors import InputError
+from ..io.decimals import column_floats
 
 __all__ = ["CRITERIA", "MAX_DEGREE", "AMPLIFICATION_SAMPLES", "parse_degree", "scores", "leave_one_out",
            "amplification", "samples_for"]
@@ -19,6 +20,7 @@ CRITERIA = ("gcv", "loo")
 MAX_DEGREE = 12  # one polynomial beyond this is a piecewise surface's job
 AMPLIFICATION_SAMPLES = 65  # per axis at most: the fit's Lebesgue function sampled on up to 65 x 65 points
 AMPLIFICATION_WORK = 4_000_000  # sample points times data points: fewer samples for many points, at least 17 x 17
+_BLOCK = 1 << 14  # data points a block of the amplification's matrix products takes
 
 
 def parse_degree(degree) -> tuple[int, int] | None:
@@ -60,9 +62,9 @@ def scores(points, weights, criterion: str, max_degree: tuple[int, int]) -> list
     """
     import numpy as np
 
-    xs = np.array([float(p[0]) for p in points])
-    ys = np.array([float(p[1]) for p in points])
-    zs = np.array([float(p[2]) for p in points])
+    xs = column_floats(points, 0)
+    ys = column_floats(points, 1)
+    zs = column_floats(points, 2)
     w = np.ones(len(xs)) if weights is None else np.array([float(v) for v in weights])
     sw = np.sqrt(w)
     vx = _chebyshev(xs, xs.min(), xs.max(), max_degree[0])
@@ -111,22 +113,29 @@ def amplification(points, weights, degree: tuple[int, int], samples: int) -> flo
     """
     import numpy as np
 
-    xs = np.array([float(p[0]) for p in points])
-    ys = np.array([float(p[1]) for p in points])
+    xs = column_floats(points, 0)
+    ys = column_floats(points, 1)
     w = np.array([float(v) for v in weights]) if weights is not None else np.ones(len(xs))
     (p, q), n = degree, len(xs)
     lo_x, hi_x, lo_y, hi_y = xs.min(), xs.max(), ys.min(), ys.max()
-    a = (_chebyshev(xs, lo_x, hi_x, p)[:, :, None] * _chebyshev(ys, lo_y, hi_y, q)[:, None, :]).reshape(n, -1)
+
+    def basis(start: int):  # the Chebyshev basis at a block of the points, and times their weights
+        sx, sy = xs[start:start + _BLOCK], ys[start:start + _BLOCK]
+        a = (_chebyshev(sx, lo_x, hi_x, p)[:, :, None] * _chebyshev(sy, lo_y, hi_y, q)[:, None, :]).reshape(len(sx), -1)
+        return a, a * w[start:start + _BLOCK, None]
+
+    # In blocks of points: one pass for G, one for the sums, each a matrix product of a size BLAS runs well,
+    # and no matrix as long as the data.
+    gram = sum((a.T @ aw for a, aw in map(basis, range(0, n, _BLOCK))), np.zeros(((p + 1) * (q + 1),) * 2))
     k = samples
     gx = _chebyshev(np.linspace(lo_x, hi_x, k), lo_x, hi_x, p)
     gy = _chebyshev(np.linspace(lo_y, hi_y, k), lo_y, hi_y, q)
     b = (gx[:, None, :, None] * gy[None, :, None, :]).reshape(k * k, -1)
-    coef = np.linalg.solve(a.T @ (a * w[:, None]), b.T).T  # b G^-1, one row an evaluation point
-    aw = (a * w[:, None]).T
-    best, rows = 0.0, max(1, 4_000_000 // n)
-    for start in range(0, len(coef), rows):
-        best = max(best, float(np.abs(coef[start:start + rows] @ aw).sum(axis=1).max()))
-    return best
+    coef = np.linalg.solve(gram, b.T).T  # b G^-1, one row an evaluation point
+    sums = np.zeros(len(coef))
+    for start in range(0, n, _BLOCK):
+        sums += np.abs(coef @ basis(start)[1].T).sum(axis=1)
+    return float(sums.max())
 
 
 def leave_one_out(points, weights, residuals, degree: tuple[int, int]) -> float:
@@ -134,8 +143,8 @@ def leave_one_out(points, weights, residuals, degree: tuple[int, int]) -> float:
     import numpy as np
 
     n, k = len(points), (degree[0] + 1) * (degree[1] + 1)
-    xs = np.array([float(p[0]) for p in points])
-    ys = np.array([float(p[1]) for p in points])
+    xs = column_floats(points, 0)
+    ys = column_floats(points, 1)
     sw = np.sqrt(np.array([float(v) for v in (weights or (1,) * n)]))
     vx = _chebyshev(xs, xs.min(), xs.max(), degree[0])
     vy = _chebyshev(ys, ys.min(), ys.max(), degree[1])

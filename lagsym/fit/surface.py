@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from functools import cached_property
@@ -13,10 +14,11 @@ import numpy as np
 from .._arrays import readonly
 from ..errors import GridError, InputError
 from ..grid import ControlGrid, grid_from_table
+from ..io.decimals import DecimalPoints
 from ..lagrange import LagrangeSurface, horner2
 from ..values import as_exact, choice
 from .exact import _residuals, _Scaled, _solve, float_residuals
-from .hull import convex_hull, inside_hull, polygon_area
+from .hull import convex_hull_integers, inside_hull, polygon_area
 from .select import AMPLIFICATION_SAMPLES, CRITERIA, amplification, leave_one_out, parse_degree, samples_for
 from .select import scores as score_all
 
@@ -38,8 +40,9 @@ class SurfaceFit:
         ``coefficients[a][b]`` multiplies ``x**a * y**b``, ``a <= P``, ``b <= Q``.
     degree : tuple of int
         ``(P, Q)``.
-    points : tuple of (Fraction, Fraction, Fraction)
-        The data, in the order given.
+    points : sequence of (Fraction, Fraction, Fraction)
+        The data, in the order given: a tuple, or the
+        :class:`~lagsym.io.decimals.DecimalPoints` a table of plain decimals was read into.
     weights : tuple of Fraction or None
         The weights, when given.
     criterion : str or None
@@ -64,7 +67,7 @@ class SurfaceFit:
     surface: LagrangeSurface
     coefficients: tuple[tuple[Fraction, ...], ...]
     degree: tuple[int, int]
-    points: tuple[tuple[Fraction, Fraction, Fraction], ...]
+    points: Sequence[tuple[Fraction, Fraction, Fraction]]
     weights: tuple[Fraction, ...] | None
     criterion: str | None = None
     score: float | None = None
@@ -244,9 +247,13 @@ def representation_nodes(lo: Fraction, hi: Fraction, degree: int) -> tuple[Fract
     return tuple(out)
 
 
-def _check_points(points, source: str) -> tuple[tuple[Fraction, Fraction, Fraction], ...]:
+def _check_points(points, source: str):
+    """The points as exact ``(x, y, z)``: a tuple of tuples of Fractions, or points read in whole columns as they
+    are (:class:`~lagsym.io.decimals.DecimalPoints`, exact already)."""
     if isinstance(points, ControlGrid):
         return tuple(points.points())
+    if isinstance(points, DecimalPoints) and len(points.columns) == 3 and len(points):
+        return points
     out = []
     for idx, pt in enumerate(points):
         if len(pt) != 3:
@@ -255,6 +262,13 @@ def _check_points(points, source: str) -> tuple[tuple[Fraction, Fraction, Fracti
     if not out:
         raise InputError(f"{source}: no points to fit")
     return tuple(out)
+
+
+def _distinct(points, j: int) -> int:
+    """How many distinct values coordinate ``j`` takes."""
+    if isinstance(points, DecimalPoints):
+        return int(np.unique(points.columns[j]).size)
+    return len({p[j] for p in points})
 
 
 def _score(fit: SurfaceFit, criterion: str) -> float:
@@ -329,7 +343,7 @@ def fit_surface(points, degree=None, *, criterion: str | None = None, weights=No
                          f"leave out one or the other")
     criterion = choice(criterion or "gcv", CRITERIA, "criterion")
     w = _weights(weights, len(pts), source)
-    nx, ny = len({p[0] for p in pts}), len({p[1] for p in pts})
+    nx, ny = _distinct(pts, 0), _distinct(pts, 1)
     if nx < 2 or ny < 2:
         raise GridError(f"{source}: the points have {nx} distinct x and {ny} distinct y values; "
                         f"a surface needs at least 2 of each")
@@ -388,4 +402,4 @@ def _fmpq(v: Fraction) -> flint.fmpq:
 
 
 def _hull(s: _Scaled) -> tuple[tuple[Fraction, Fraction], ...]:
-    return tuple((Fraction(a, s.dx), Fraction(b, s.dy)) for a, b in convex_hull(list(zip(s.X, s.Y))))
+    return tuple((Fraction(a, s.dx), Fraction(b, s.dy)) for a, b in convex_hull_integers(s.X, s.Y))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from fractions import Fraction
 from pathlib import Path
@@ -17,6 +18,7 @@ from typing import Any
 from ..errors import InputError
 from ..grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
 from ..values import MAX_EXPONENT, NotANumber, choice, exact_number
+from .decimals import DecimalPoints, first_repeat
 from .files import check_point_count, read_text
 from .table import UNIT_NAMES, parse_columns, read_table
 
@@ -323,8 +325,8 @@ class ScatteredPoints:
 
     Attributes
     ----------
-    points : tuple of (Fraction, Fraction, Fraction)
-        The points in the file's order (a grid file's x-major).
+    points : sequence of (Fraction, Fraction, Fraction)
+        The points in the file's order (a grid file's x-major); a table of plain decimals gives a DecimalPoints.
     source : str
         The file name.
     units : str or None
@@ -335,7 +337,7 @@ class ScatteredPoints:
         True for the layouts that need no saying.
     """
 
-    points: tuple[tuple[Fraction, Fraction, Fraction], ...]
+    points: Sequence[tuple[Fraction, Fraction, Fraction]]
     source: str
     units: str | None
     layout: str
@@ -363,15 +365,12 @@ def read_scattered_points(path: str | os.PathLike, columns=None) -> ScatteredPoi
     if isinstance(points, ControlGrid):
         units = units or points.units
         points = points.points()
-    seen: dict[tuple[int, int, int, int], int] = {}
-    for idx, pt in enumerate(points):
-        # the lowest-terms integers: a Fraction's own hash takes a modular inverse, most of this loop's time
-        key = (pt[0].numerator, pt[0].denominator, pt[1].numerator, pt[1].denominator)
-        if key in seen:
-            raise InputError(f"{name}: points {seen[key] + 1} and {idx + 1} are both at (x, y) = "
-                             f"({float(pt[0]):g}, {float(pt[1]):g}); average them or drop one")
-        seen[key] = idx
-    return ScatteredPoints(tuple(tuple(pt) for pt in points), name, units, layout, plain)
+    points = points if isinstance(points, DecimalPoints) else tuple(tuple(pt) for pt in points)
+    if (repeat := first_repeat(points)) is not None:
+        i, j = repeat
+        raise InputError(f"{name}: points {i + 1} and {j + 1} are both at (x, y) = "
+                         f"({float(points[j][0]):g}, {float(points[j][1]):g}); average them or drop one")
+    return ScatteredPoints(points, name, units, layout, plain)
 
 
 def parse_points(text: str, source: str = "<points>", kind: str = "json") -> ControlGrid:

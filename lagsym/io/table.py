@@ -26,6 +26,7 @@ from fractions import Fraction
 
 from ..errors import InputError
 from ..values import NotANumber, exact_number
+from .decimals import DecimalPoints, parse_plain
 
 __all__ = ["Layout", "read_table", "parse_columns", "UNIT_NAMES"]
 
@@ -249,6 +250,9 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
     >>> pts, layout.describe()
     ([(Fraction(0, 1), Fraction(0, 1), Fraction(5, 4))], "semicolon-separated; decimal comma; header 'Nr;X (mm);Y (mm);Z (mm)'; x from column 2, y from column 3, z from column 4; ignoring column(s) Nr; units mm")
     """
+    plain = _plain_table(name, text, arity, columns)
+    if plain is not None:
+        return plain
     try:
         sep, rows = _separator(text)
     except InputError as e:
@@ -293,3 +297,45 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
                     for j in range(len(keep)) if j not in chosen)
     return points, Layout(separator=sep, decimal=decimal, header=tuple(header),
                           columns=tuple(keep[j] for j in chosen), ignored=ignored, units=units)
+
+
+def _plain_table(name: str, text: str, arity: int | None, columns) -> tuple[DecimalPoints, Layout] | None:
+    """The table read in whole columns (:mod:`.decimals`) where, after an optional header line, every line is the
+    same number of plain decimals split by one separator; else None, and the table is read cell by cell.
+
+    Such a table has one layout for the steps above: its one separator, the first line a header if it is not all
+    numbers, decimal points, no empty column.  The header and the columns are found by the same code.
+    """
+    if not text.isascii() or '"' in text:
+        return None
+    if "\r" in text:
+        if text.count("\r") != text.count("\r\n"):
+            return None
+        text = text.replace("\r\n", "\n")
+    newline = text.find("\n")
+    first = text if newline < 0 else text[:newline]
+    rest = "" if newline < 0 else text[newline + 1:]
+    found = [s for s in SEPARATORS if s in (rest or first)]
+    if len(found) != 1 or len(first.splitlines()) != 1 or first.lstrip().startswith("#") or len(first) > MAX_CELL:
+        return None
+    sep = found[0]
+    cells = _join_units(first.split()) if sep == " " else [c.strip() for c in first.split(sep)]
+    header, body, lineno = (cells, rest, 2) if _is_header(cells) else ([], text, 1)
+    width = body.find("\n")
+    width = len(body[:width if width >= 0 else len(body)].split(sep))
+    if width < 2:
+        return None
+    parsed = parse_plain(body, sep, width)
+    if parsed is None:
+        return None
+    names, units = None, None
+    if header:
+        _check_header(name, sep, header, 1, [(lineno, ["0"] * width)])  # no data cell is empty
+        names, units = _header_names(name, header)
+        names = names[:width] + [""] * max(0, width - len(names))
+    chosen = _choose(name, names, width, columns, arity)
+    values, exponents = parsed
+    points = DecimalPoints([values[j] for j in chosen], [exponents[j] for j in chosen])
+    ignored = tuple((header[j] if j < len(header) else f"{j + 1}") for j in range(width) if j not in chosen)
+    return points, Layout(separator=sep, decimal=".", header=tuple(header), columns=tuple(chosen), ignored=ignored,
+                          units=units)
