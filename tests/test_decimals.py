@@ -177,3 +177,28 @@ def test_a_fit_from_a_table_is_the_fit_from_the_same_points_as_fractions(tmp_pat
     with pytest.raises(InputError, match=r"points 3 and 2501 are both at \(x, y\)"):
         path.write_text(path.read_text() + f"{float(pts[2][0]):.1f},{float(pts[2][1]):.1f},1.5\n")
         read_scattered_points(path)
+
+
+def test_a_grid_read_in_whole_columns_is_the_grid_of_its_points(tmp_path, monkeypatch):
+    from lagsym.grid import grid_from_points
+    from lagsym.io import read_points
+    from lagsym.io.decimals import grid_of_columns
+
+    rng = random.Random(2)
+    rows = [(f"{x * 0.25:.2f}", f"{-y * 1.5:.1f}", f"{rng.uniform(-9, 9):.4f}") for x in range(7) for y in range(5)]
+    rng.shuffle(rows)
+    path = tmp_path / "grid.csv"
+    path.write_text("x,y,z\n" + "".join(",".join(r) + "\n" for r in rows))
+    grid = read_points(path)
+    want = grid_from_points([tuple(Fraction(v) for v in r) for r in rows], source=str(path))
+    assert (grid.x, grid.y, grid.z, grid.shape) == (want.x, want.y, want.z, (7, 5))
+    # A place missing and a place twice: the grid of points says which, as it does for any points.
+    for broken in (rows[:-1] + [rows[0][:2] + ("1",)], rows[:-1]):
+        path.write_text("x,y,z\n" + "".join(",".join(r) + "\n" for r in broken))
+        points, _ = read_table(str(path), path.read_text(), 3)
+        assert grid_of_columns(points, str(path), None) is None
+        with pytest.raises(InputError) as fast:
+            read_points(path)
+        with pytest.raises(InputError) as slow:
+            grid_from_points([tuple(Fraction(v) for v in r) for r in broken], source=str(path))
+        assert str(fast.value) == str(slow.value)

@@ -23,7 +23,7 @@ import functools
 from collections.abc import Sequence
 from fractions import Fraction
 
-__all__ = ["DecimalPoints", "parse_plain", "first_repeat", "column_floats", "MAX_DIGITS"]
+__all__ = ["DecimalPoints", "parse_plain", "first_repeat", "grid_of_columns", "column_floats", "MAX_DIGITS"]
 
 MAX_DIGITS = 18  # digits of a cell read here: 10**18 fits a signed 64-bit integer
 _CHUNK = 1 << 22  # bytes of text read at a time: the index arrays stay a few times this, not the file's size
@@ -147,6 +147,39 @@ def first_repeat(points) -> tuple[int, int] | None:
             return seen[key], idx
         seen[key] = idx
     return None
+
+
+def grid_of_columns(points: DecimalPoints, source: str, units: str | None):
+    """The control grid of points read in whole columns, arranged from their integers; None where they do not make
+    one (repeated or missing places): :func:`lagsym.grid.grid_from_points` then says which, as for any points.
+
+    Examples
+    --------
+    >>> g = grid_of_columns(DecimalPoints([[3, 1, 3, 1], [2, 2, 3, 3], [15, 7, 18, 10]], [0, 0, 0]), "p.csv", None)
+    >>> g.x, g.z
+    ((Fraction(1, 1), Fraction(3, 1)), ((Fraction(7, 1), Fraction(10, 1)), (Fraction(15, 1), Fraction(18, 1))))
+    """
+    import numpy as np
+
+    from ..grid import ControlGrid
+
+    x, y, z = points.columns
+    ux, ix = np.unique(x, return_inverse=True)
+    uy, iy = np.unique(y, return_inverse=True)
+    nx, ny = len(ux), len(uy)
+    if nx < 2 or ny < 2 or nx * ny != len(z):
+        return None
+    at = ix * ny + iy
+    filled = np.zeros(nx * ny, dtype=bool)
+    filled[at] = True
+    if not filled.all():  # as many points as places, so a place missed is a place repeated
+        return None
+    heights = np.empty(nx * ny, dtype=np.int64)
+    heights[at] = z
+    (tx, ty, tz), flat = (10 ** e for e in points.exponents), heights.tolist()
+    return ControlGrid(x=tuple(Fraction(v, tx) for v in ux.tolist()), y=tuple(Fraction(v, ty) for v in uy.tolist()),
+                       z=tuple(tuple(Fraction(v, tz) for v in flat[i * ny:(i + 1) * ny]) for i in range(nx)),
+                       source=source, units=units)
 
 
 def column_floats(points, j: int):

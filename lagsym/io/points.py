@@ -18,7 +18,7 @@ from typing import Any
 from ..errors import InputError
 from ..grid import ControlGrid, CurvePoints, SnapReport, curve_from_points, grid_from_points, grid_from_table, snap_points
 from ..values import MAX_EXPONENT, NotANumber, choice, exact_number
-from .decimals import DecimalPoints, first_repeat
+from .decimals import DecimalPoints, first_repeat, grid_of_columns
 from .files import check_point_count, read_text
 from .table import UNIT_NAMES, parse_columns, read_table
 
@@ -316,7 +316,8 @@ def read_point_file(path: str | os.PathLike, what: str = "surface", columns=None
     if snap is not None:
         points, report = snap_points(points, snap, axes=arity - 1, source=name)
     build = grid_from_points if arity == 3 else curve_from_points
-    return PointsFile(build(points, source=name, units=units), layout, plain, report)
+    made = grid_of_columns(points, name, units) if arity == 3 and isinstance(points, DecimalPoints) else None
+    return PointsFile(made or build(points, source=name, units=units), layout, plain, report)
 
 
 @dataclass(frozen=True)
