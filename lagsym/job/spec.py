@@ -9,7 +9,7 @@ key and (for a choice) the valid values.  Example::
     safe_z = 80
 
     [stock]
-    top_above = 2                        # above the surface's highest point (or: top = 73.6), in the units
+    top_above = 2                        # above the surface's highest point, in the job's units (or: top = 73.6)
 
     [tools.rougher]
     number = 1
