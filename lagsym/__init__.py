@@ -18,9 +18,25 @@ the rich display of surfaces and curves, their equation and a small figure;
 from __future__ import annotations
 
 import importlib as _importlib
+import os as _os
+import signal as _signal
 import sys as _sys
 import types as _types
-from typing import TYPE_CHECKING
+
+
+def _interrupted_at_start(signum, frame):
+    """Ctrl-C while the ``lagsym`` command loads, before it can say more: one line, nothing written, exit 130."""
+    _sys.stderr.write("lagsym: interrupted; nothing was written\n")
+    _os._exit(130)
+
+
+# Run as the command (``python -m lagsym``, which imports this first with argv[0] "-m", or the installed
+# script), a Ctrl-C before the command line's own handlers are in place ends in one line, not a traceback
+# from the imports; lagsym.cli.main puts Python's handler back.
+if _sys.argv[:1] == ["-m"] or _os.path.basename(_sys.argv[0] if _sys.argv else "") in ("lagsym", "lagsym.exe"):
+    _signal.signal(_signal.SIGINT, _interrupted_at_start)
+
+from typing import TYPE_CHECKING  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -30,7 +30,8 @@ from fractions import Fraction
 
 import numpy as np
 
-from .errors import FormulaError
+from .errors import FormulaError, InputError
+from .values import as_exact
 
 __all__ = ["FUNCTIONS", "Formula", "parse_formula"]
 
@@ -302,7 +303,11 @@ class Formula:
             would take more than ``max_bits`` bits (checked before it is
             computed).
         """
-        return _exact(self.tree, Fraction(x), Fraction(y), self.text, max_bits)
+        try:
+            at = as_exact(x, "x"), as_exact(y, "y")
+        except InputError as e:
+            raise FormulaError(f"{self.text}: {e}") from None
+        return _exact(self.tree, *at, self.text, max_bits)
 
 
 def parse_formula(text: str) -> Formula:

@@ -22,6 +22,7 @@ need none of it, and the import alone takes most of a second.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -88,23 +89,31 @@ def _fmpq(v: Fraction) -> flint.fmpq:
     return flint.fmpq(v.numerator, v.denominator)
 
 
-def _basis_polys(nodes: tuple[Fraction, ...]) -> list[flint.fmpq_poly]:
+def _basis_polys(nodes: tuple[Fraction, ...], source=None) -> list[flint.fmpq_poly]:
+    # One division and one normalisation a node, each about as long as the others: the clock foresees the whole
+    # basis from the first ones and refuses it past the time limit, as it does the products that follow.
+    clock = ExactClock(f"Lagrange basis on {len(nodes)} nodes", source)
+    started = time.perf_counter()
     w = flint.fmpq_poly([1])
     for xj in nodes:
         w *= flint.fmpq_poly([-_fmpq(xj), 1])
     out = []
-    for xi in nodes:
+    for k, xi in enumerate(nodes):
         q = w // flint.fmpq_poly([-_fmpq(xi), 1])
         out.append(q / q(_fmpq(xi)))
+        clock.foresee(k + 1, len(nodes), time.perf_counter() - started, 0)
     return out
 
 
-def _basis_matrix(nodes: tuple[Fraction, ...]) -> flint.fmpq_mat:
+def _basis_matrix(nodes: tuple[Fraction, ...], source=None) -> flint.fmpq_mat:
     n = len(nodes)
     rows = []
-    for p in _basis_polys(nodes):
+    polys = _basis_polys(nodes, source)
+    clock, started = ExactClock(f"Lagrange basis on {n} nodes", source), time.perf_counter()
+    for k, p in enumerate(polys):  # a row's coefficients made into numbers: most of the basis's time
         c = p.coeffs()
         rows.extend(c + [flint.fmpq(0)] * (n - len(c)))
+        clock.foresee(k + 1, n, time.perf_counter() - started, 0)
     return flint.fmpq_mat(n, n, rows)
 
 
@@ -384,7 +393,7 @@ def lagrange_curve(points: CurvePoints, x: sympy.Symbol | str = "x", *,
     """
     points = of_type(points, CurvePoints, "points", "curve_from_points([(x, y), ...]) or read_points(file)")
     check_exact_size(f"curve through {len(points.x)} points", points.source, points.x, None, points.y, max_mb)
-    b = _basis_matrix(points.x)
+    b = _basis_matrix(points.x, points.source)
     yv = flint.fmpq_mat(len(points.y), 1, [_fmpq(v) for v in points.y])
     c = stepped_product(b.transpose(), yv, clock=ExactClock(f"curve through {len(points.x)} points", points.source))
     return LagrangeCurve(points=points, coefficients=tuple(_frac(c[a, 0]) for a in range(c.nrows())),
@@ -426,8 +435,8 @@ def lagrange_surface(grid: ControlGrid, x: sympy.Symbol | str = "x", y: sympy.Sy
     n, m = grid.shape
     check_exact_size(f"surface through {n} x {m} nodes", grid.source, grid.x, grid.y,
                 [v for row in grid.z for v in row], max_mb)
-    bx = _basis_matrix(grid.x)
-    by = _basis_matrix(grid.y)
+    bx = _basis_matrix(grid.x, grid.source)
+    by = _basis_matrix(grid.y, grid.source)
     z = flint.fmpq_mat(n, m, [_fmpq(v) for row in grid.z for v in row])
     clock = ExactClock(f"surface through {n} x {m} nodes", grid.source)
     c = stepped_product(stepped_product(bx.transpose(), z, clock=clock, products_after=1), by, clock=clock)

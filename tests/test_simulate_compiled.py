@@ -43,6 +43,7 @@ def interpreted(text: str, dialect: str, precision: int):
             elif isinstance(b, Words):
                 values = {letter: f(m) for letter, f in b.words}
                 m.motion = "G1"
+                m.feed = values.get("F", m.feed)  # before the move, as the control takes it
                 m.move(b.line, values)
         except BlockAlarm as e:
             return ("alarm", e.alarm, b.line)
@@ -136,15 +137,15 @@ def test_alarms_name_the_block_that_raised_them(text, alarm, line):
 
 def test_a_negative_zero_keeps_its_sign_where_the_control_keeps_it():
     """Stored values are rounded by ``plus`` (-0 becomes 0); an axis word's value is not."""
-    for text in ("#1=[0.*-1.]\nG1 X#1 Y[0.*-1.] Z0.\nM30\n", "#1=-2.5\n#2=[#1*0.]\nG1 X#2 Y[#1*0.] Z0.\nM30\n"):
+    for text in ("#1=[0.*-1.]\nG1 X#1 Y[0.*-1.] Z0. F100.\nM30\n", "#1=-2.5\n#2=[#1*0.]\nG1 X#2 Y[#1*0.] Z0. F100.\nM30\n"):
         sim = simulate(text, "fanuc", 8)
         assert math.copysign(1, sim.moves[0].x) == 1 and math.copysign(1, sim.moves[0].y) == -1
 
 
 @pytest.mark.parametrize("text", [
-    "#1=1.\nIF [#1 GT 0.] THEN #100=2.\nIF [#1 LT 0.] THEN #101=3.\nG1 X#100 Y#101 Z0.\n",  # only #100 is set
-    "#1=1.\n#100=5.\nIF [#1 GT 0.] THEN #100=[#100+1.]\n#100=[#100*2.]\nG1 X#100 Y0. Z0.\n",
-    "#1=3.\n#[#1]=4.\n#2=[#3+#1]\nG1 X#2 Y#3 Z0.\n",  # a computed number: no locals
+    "#1=1.\nIF [#1 GT 0.] THEN #100=2.\nIF [#1 LT 0.] THEN #101=3.\nG1 X#100 Y#101 Z0. F100.\n",  # only #100 is set
+    "#1=1.\n#100=5.\nIF [#1 GT 0.] THEN #100=[#100+1.]\n#100=[#100*2.]\nG1 X#100 Y0. Z0. F100.\n",
+    "#1=3.\n#[#1]=4.\n#2=[#3+#1]\nG1 X#2 Y#3 Z0. F100.\n",  # a computed number: no locals
 ])
 def test_conditional_and_computed_assignments(text):
     assert compiled(text, "fanuc", 8) == interpreted(text, "fanuc", 8)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import importlib
 import os
 import signal
@@ -20,7 +21,7 @@ import traceback
 from typing import IO, Sequence
 
 from ..allocator import keep_freed_memory
-from ..errors import ExitStatus, LagsymError, Terminated
+from ..errors import ExitStatus, LagsymError, OutputError, Terminated
 from ._lines import one_line
 
 __all__ = ["main", "build_parser", "COMMANDS", "command_module"]
@@ -136,16 +137,23 @@ def build_parser(out: IO[str] = sys.stdout, err: IO[str] = sys.stderr, load=None
 
 def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stderr: IO[str] | None = None) -> int:
     """Run the ``lagsym`` command line and return its exit status."""
-    out = stdout if stdout is not None else sys.stdout
+    out = stdout if stdout is not None else _StandardOutput(sys.stdout)
     err = stderr if stderr is not None else sys.stderr
     argv = list(sys.argv[1:] if argv is None else argv)
     try:  # Ctrl-C while the command's modules load: one line, as later
+        if getattr(signal.getsignal(signal.SIGINT), "__module__", None) == "lagsym":  # the start-up's own
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         chosen = _chosen(argv)
         parser = build_parser(out, err, load=() if chosen is None else (chosen,))
         try:
             args = parser.parse_args(argv)
         except _ParserExit as e:
             return int(e.status)
+    except Exception as e:  # a Ctrl-C some import wraps in its own error (a class's set-up in numpy)
+        if not isinstance(e.__cause__ or e.__context__, KeyboardInterrupt):
+            raise
+        err.write("lagsym: interrupted; nothing was written\n")
+        return ExitStatus.INTERRUPTED
     except KeyboardInterrupt:
         err.write("lagsym: interrupted; nothing was written\n")
         return ExitStatus.INTERRUPTED
@@ -159,7 +167,9 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
         in_program_units(args)
         check_paths(args)
         with _signals_as_interrupts(), _notices(err), _engine(getattr(args, "engine", None)), _limits(args):
-            return int(args._run(args, out, err))
+            status = int(args._run(args, out, err))
+        out.flush()  # what is still buffered: a full disk says so here, not at the interpreter's exit
+        return status
     except LagsymError as e:
         if getattr(args, "traceback", False):
             traceback.print_exc(file=err)
@@ -180,6 +190,45 @@ def main(argv: Sequence[str] | None = None, stdout: IO[str] | None = None, stder
             err.write(f"lagsym: internal error: {type(e).__name__}: {one_line(str(e))} "
                       f"(run again with --traceback and report it)\n")
         return INTERNAL_ERROR
+
+
+class _StandardOutput:
+    """The process's standard output for a command: a write it cannot make (a full disk, a descriptor closed before
+    the command started) is an :class:`~lagsym.errors.OutputError` that says so, as a file's would be."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _fail(self, e: OSError | None) -> OutputError:
+        if e is None:
+            return OutputError("standard output is closed: nothing could be written; give -o FILE or open it")
+        reason = "no space left on the device" if e.errno == errno.ENOSPC else (e.strerror or str(e)).lower()
+        return OutputError(f"standard output: cannot write ({reason}); give -o FILE to write a file instead")
+
+    def write(self, text: str) -> int:
+        if self._stream is None:
+            raise self._fail(None)
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise self._fail(e) from None
+
+    def flush(self) -> None:
+        if self._stream is None:
+            return
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise self._fail(e) from None
+
+    def __getattr__(self, name):  # isatty, fileno, encoding, buffer: the stream's own
+        if self._stream is None:
+            raise self._fail(None)
+        return getattr(self._stream, name)
 
 
 @contextlib.contextmanager

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from .._arrays import readonly as _readonly
+from ..errors import ConditioningError
 from ..exactsize import ExactClock, stepped_product
 from .bounds import chebyshev_error_bound
 from .cache import ObjectCache
@@ -421,8 +422,15 @@ def _make_evaluator(surface) -> SurfaceEvaluator:
     clock = ExactClock(f"change of basis of the surface through {n} x {m} nodes (for its numeric evaluation)",
                        g.source)
     cheb = stepped_product(stepped_product(ax, power, clock=clock, products_after=1), ay.transpose(), clock=clock)
-    # int / int is correctly rounded, as float(Fraction) is, without reducing a Fraction first
-    coeffs = np.array([[int(cheb[a, b].p) / int(cheb[a, b].q) for b in range(m)] for a in range(n)])
+    try:
+        # int / int is correctly rounded, as float(Fraction) is, without reducing a Fraction first
+        coeffs = np.array([[int(cheb[a, b].p) / int(cheb[a, b].q) for b in range(m)] for a in range(n)])
+    except OverflowError:
+        digits = max(len(str(abs(int(cheb[a, b].p)) // int(cheb[a, b].q))) for a in range(n) for b in range(m))
+        raise ConditioningError(
+            f"{g.source}: the surface through {n} x {m} nodes has a coefficient of {digits} digits in the Chebyshev "
+            f"basis of its box, beyond any float (at most 309 digits): it cannot be evaluated numerically; give "
+            f"fewer nodes, fit lower degrees ('lagsym fit') or make a piecewise surface ('lagsym piecewise')") from None
     return SurfaceEvaluator(
         x_offset=xo, x_scale=xh, y_offset=yo, y_scale=yh,
         coefficients=_readonly(coeffs),

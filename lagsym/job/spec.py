@@ -39,7 +39,8 @@ from ..toolpath.rough import MILLING, PATTERNS
 from ..values import FrozenMap, in_range
 from .units import Given, in_mm
 
-__all__ = ["JobSpec", "OperationSpec", "ToolSpec", "ProbeStage", "read_job", "parse_job", "KINDS", "COOLANTS"]
+__all__ = ["JobSpec", "OperationSpec", "ToolSpec", "ProbeStage", "read_job", "parse_job", "KINDS", "COOLANTS",
+           "MAX_OPERATIONS"]
 
 KINDS = ("rough", "semi-finish", "finish", "cross-finish")
 """Operation kinds, in the order a machinist runs them."""
@@ -61,6 +62,8 @@ _OP = {"kind": str, "tool": str, "spindle": float, "feed": float, "plunge_feed":
        "stock_to_leave": float, "direction": str, "milling": str, "macro": bool, "precision": int,
        "pattern": str, "rest": bool, "rest_above": float, "max_engagement": float}
 _REQUIRED_OP = ("kind", "tool")
+MAX_OPERATIONS = 32
+"""Operations in one job file: a real job has a handful, and each is planned in turn up to the point limit."""
 
 
 @dataclass(frozen=True)
@@ -229,6 +232,9 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path("."), *, leng
     numbers = [t.number for t in tools.values()]
     if len(set(numbers)) != len(numbers):
         raise InputError(f"{source}: two tools share a number ({sorted(numbers)})")
+    if len(data["operations"]) > MAX_OPERATIONS:
+        raise InputError(f"{source}: {len(data['operations']):,} operations, more than the {MAX_OPERATIONS} a job "
+                         f"plans (each in turn, each up to the point limit): split the job into several files")
     ops = tuple(_operation(i, op, tools, source) for i, op in enumerate(data["operations"]))
     if not ops:
         raise InputError(f"{source}: operations is empty")

@@ -227,6 +227,7 @@ class Segment:
         axes = [(k, last[a]) for k, a in enumerate("XYZ") if a in last]
         if axes:
             self.emit("if m.motion not in ('G0', 'G1'): ARC(m)")
+            self.emit("if m.motion == 'G1' and not m.feed > 0: NOFEED(m)")
             self.emit("if m.absolute: " + "; ".join(f"POS[{k}] = {t}" for k, t in axes))
             self.emit("else: " + "; ".join(f"POS[{k}] = POS[{k}] + {t}" for k, t in axes))
             self.emit(f"A_LINE({b.line}); A_RAPID(m.motion == 'G0'); A_X(float(POS[0])); A_Y(float(POS[1])); "

@@ -136,6 +136,12 @@ def _send(m, b) -> None:
         raise alarm_at(e, b) from None
 
 
+def _no_feed(m) -> None:
+    """A feed move with no feed: F0, or no F since the start (a Fanuc's alarm PS0011, LinuxCNC's too)."""
+    raise BlockAlarm("11", f"a G01 move at feed {m.feed:g}: no F word since the start, or F0 (the control stops with "
+                           "'feed zero')")
+
+
 def _arc(m) -> None:
     """Refuse a move in a motion mode the simulator does not run: an arc, or a probing mode carried on."""
     if m.motion in ("G2", "G3"):
@@ -160,7 +166,7 @@ def _environment(m, labels) -> dict:
     return {"m": m, "V": m.vars, "NM": m.names, "POS": m.pos, "Z": Decimal(0), "ONE": Decimal(1),
             "ZERO": Decimal(0), "P": ctx.plus, "POW": ctx.power, "DIV": m.divide, "MOD": mod, "FUNC": m.func,
             "ATAN2": m.atan2, "GET": m.get, "GETN": m.named, "CHECK": m.check, "CONST": m.const, "JUMP": jump,
-            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc,
+            "RHU": ROUND_HALF_UP, "GMODAL": _modal_g, "MCHECK": _m_check, "ARC": _arc, "NOFEED": _no_feed,
             "RUNWORDS": _run_words, "SEND": _send, "WORDS": _constant_words, "STOPS": STOPS,
             "A_LINE": line, "A_RAPID": rapid, "A_X": x, "A_Y": y, "A_Z": z, "A_F": feed}
 

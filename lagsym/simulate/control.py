@@ -132,6 +132,9 @@ class ControlState:
                 v = words[letter]
                 self.pos[axis] = v if self.absolute else self.ctx.add(self.pos[axis], v)
         if any(k in words for k in "XYZ"):
+            if self.motion == "G1" and not self.feed > 0:
+                raise BlockAlarm("11", f"a G01 move at feed {self.feed:g}: no F word since the start, or F0 (the "
+                                       "control stops with 'feed zero')")
             self.moves.append(line, self.motion == "G0", float(self.pos[0]), float(self.pos[1]),
                               float(self.pos[2]), float(self.feed))
 

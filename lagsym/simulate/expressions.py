@@ -281,6 +281,7 @@ _AXIS_DECIMAL = set("XYZABCIJKRUVW")
 # or a call's parameters) would be skipped, and the path the simulator reports would not be the machine's.
 _RUN_LETTERS = frozenset("GMXYZFSTHDPNOIJKR")
 _PLAIN_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)")
+_SIGNS = re.compile(r"[-+]\s*[-+]")  # X--1. or X+-1.: a control's number has one sign at most
 
 
 def _word_value(letter: str, text: str, increments: bool):
@@ -296,6 +297,8 @@ def _word_value(letter: str, text: str, increments: bool):
                                     "the simulator does not run")
     if not t:
         raise BlockAlarm("114", f"address {letter} without a value")
+    if _SIGNS.match(t):
+        raise BlockAlarm("114", f"{letter}{t}: two signs in a row, which a control reads as no number")
     if _PLAIN_NUMBER.fullmatch(t):
         if letter in _AXIS_DECIMAL and "." not in t and increments:
             raise BlockAlarm("decimal-point",

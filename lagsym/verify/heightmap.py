@@ -32,6 +32,7 @@ _MOVES_PER_PASS = 200_000  # moves split and swept at a time
 _PIECE_CELLS = 8.0  # longest segment swept, sideways, in cells
 _CHUNK = 16384  # segments swept together
 _FEW = 1024  # fewer segments than this are swept over their whole footprint at once (see _sweep_few)
+_FEW_CELLS = 1 << 20  # footprint cells _sweep_few takes at once: its arrays stay within tens of MB
 MAX_CELLS = 16_000_000  # height-map cells by default: 4000 x 4000, about 0.5 GB with the arrays compared
 MAX_CONTACTS = 20_000_000_000  # segments (all, before those far from the box are dropped) times cells under the tool
 
@@ -221,26 +222,32 @@ def _sweep_few(chunk, geometry, lowest):
 
     The offset loop costs the same Python work for two segments as for
     thousands; here each NumPy operation covers every cell of the square
-    footprint of up to 64 segments, and ``np.fmin.at`` lowers the map.
+    footprint of up to 64 segments, and ``np.fmin.at`` lowers the map.  A
+    large footprint (a large tool over small cells) is taken in bands of its
+    rows, so no array holds more than :data:`_FEW_CELLS` cells.
     """
     (az, azr, length, m, k), base, bx, by, (ux, uy), _, move = chunk
     hx, hy, _, kx, ky, stride, flat, wflat = geometry
-    di, dj = np.arange(-kx, kx + 1), np.arange(-ky, ky + 1)
-    offsets = (di * stride)[:, None] + dj[None, :]
-    for s in range(0, len(base), 64):
-        g = slice(s, s + 64)
-        wx, wy = bx[g, None] + di * hx, by[g, None] + dj * hy
-        ca = (wx * ux[g, None])[:, :, None] + (wy * uy[g, None])[:, None, :]
-        ce = (-wx * uy[g, None])[:, :, None] + (wy * ux[g, None])[:, None, :]
-        every = base[g, None, None] + offsets
-        v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)), flat[every])
-        under = ~np.isnan(v)
-        cells = every[under]
-        np.fmin.at(flat, cells, v[under])
-        if wflat is not None:
-            # Any move whose value is the cell's new lowest reaches it there.
-            won = flat[cells] == v[under]
-            wflat[cells[won]] = np.broadcast_to(move[g, None, None], v.shape)[under][won]
+    dj = np.arange(-ky, ky + 1)
+    band = max(1, _FEW_CELLS // len(dj))  # footprint rows at a time
+    for r0 in range(-kx, kx + 1, band):
+        di = np.arange(r0, min(r0 + band, kx + 1))
+        offsets = (di * stride)[:, None] + dj[None, :]
+        group = max(1, min(64, _FEW_CELLS // offsets.size))  # segments at a time
+        for s in range(0, len(base), group):
+            g = slice(s, s + group)
+            wx, wy = bx[g, None] + di * hx, by[g, None] + dj * hy
+            ca = (wx * ux[g, None])[:, :, None] + (wy * uy[g, None])[:, None, :]
+            ce = (-wx * uy[g, None])[:, :, None] + (wy * ux[g, None])[:, None, :]
+            every = base[g, None, None] + offsets
+            v = lowest(ca, ce, tuple(p[g, None, None] for p in (az, azr, length, m, k)), flat[every])
+            under = ~np.isnan(v)
+            cells = every[under]
+            np.fmin.at(flat, cells, v[under])
+            if wflat is not None:
+                # Any move whose value is the cell's new lowest reaches it there.
+                won = flat[cells] == v[under]
+                wflat[cells[won]] = np.broadcast_to(move[g, None, None], v.shape)[under][won]
 
 
 def height_map_axes(box_mm, cell_mm: float | None, max_cells: int | None) -> tuple[np.ndarray, np.ndarray]:
