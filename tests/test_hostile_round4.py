@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -15,7 +14,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from lagsym import ConditioningError, FormulaError, InputError
+from lagsym import ConditioningError, FormulaError
 from lagsym.evaluate import surface_evaluator
 from lagsym.formula import parse_formula
 from lagsym.grid import grid_from_table
@@ -181,3 +180,21 @@ def test_the_basis_of_a_thousand_nodes_is_foreseen_and_refused_within_the_time_l
     assert "more than the limit of 15 s" in err
     assert time.perf_counter() - t < 30 and peak < 2 << 30, (time.perf_counter() - t, peak)
     assert math.isfinite(peak)
+
+
+def test_a_nul_in_a_jobs_points_path_names_the_job_file(tmp_path, run_cli):
+    """The message named the points path alone, not the job file and key it came from."""
+    job = tmp_path / "nul.toml"
+    job.write_text((EXAMPLES / "example-4-job.toml").read_text().replace(
+        'points = "paper-example-4.json"', 'points = "paper-example-4\\u0000.json"'))
+    status, out, err = run_cli("job", job, "-o", tmp_path / "x.ngc")
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"{job}: points = 'paper-example-4\\x00.json': a file name cannot hold a NUL character" in err, err
+
+
+def test_a_simulated_alarm_names_the_program_file(tmp_path, run_cli):
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1000\nG01 X--1. F100.\nM30\n%\n")
+    status, out, err = run_cli("simulate", program)
+    assert status == 2 and err == f"lagsym: error: {program}: alarm 114: X--1.: two signs in a row, which a control " \
+                                  f"reads as no number at line 3: 'G01 X--1. F100.'\n"

@@ -305,7 +305,7 @@ def test_a_runaway_program_stops_within_seconds_in_one_line(run_cli, tmp_path, n
     start = time.monotonic()
     status, out, err = run_cli("simulate", path, "-o", tmp_path / "moves.csv")
     took = time.monotonic() - start
-    assert status == 2 and err.count("\n") == 1 and err.startswith("lagsym: error: alarm runaway:"), err
+    assert status == 2 and err.count("\n") == 1 and err.startswith(f"lagsym: error: {path}: alarm runaway:"), err
     assert needle in err and "Traceback" not in err
     assert took < 30, f"{name}: {took:.1f} s"  # about 1 s here; the old guard took 42 to 257 s
     assert not (tmp_path / "moves.csv").exists()

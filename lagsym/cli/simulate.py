@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from ..controls import CONTROLS, control
+from ..errors import ProgramError
 from ..io import read_program
-from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, detect_dialect,
-                        moves_csv, simulate)
+from ..simulate import (BYTES_PER_MOVE, MAX_BLOCKS, MAX_IDLE_BLOCKS, MAX_PROGRAM_LINES, SIM_DIALECTS, ControlAlarm,
+                        detect_dialect, moves_csv, simulate)
 from ..simulate.runaway import check_lines
 from ._common import add_file_points_limit, add_exact_limit, count, emit, exact
 from ._lines import say
@@ -80,9 +81,13 @@ def run(args, out, err) -> int:
     dialect = args.dialect or detect_dialect(text)
     precision = args.precision or control(dialect).macro.default_precision
     target = _target(args.surface, args.tip_radius, args.max_exact_mb) if args.surface else None
-    with progress_bar(err) as progress:
-        sim = simulate(text, dialect, precision, max_blocks=args.max_blocks, max_idle_blocks=args.max_idle_blocks,
-                       progress=progress, target=target, max_lines=args.max_lines)
+    try:
+        with progress_bar(err) as progress:
+            sim = simulate(text, dialect, precision, max_blocks=args.max_blocks,
+                           max_idle_blocks=args.max_idle_blocks, progress=progress, target=target,
+                           max_lines=args.max_lines)
+    except ControlAlarm as e:  # the library names the block; the command names the file
+        raise ProgramError(f"{args.program}: {e}") from None
     if args.print_output:
         emit("\n".join(sim.output), args.print_output, out)
     emit(moves_csv(sim), args.output, out)

@@ -222,6 +222,8 @@ def parse_job(data: dict, source: str = "<job>", base: Path = Path("."), *, leng
     for key in ("tools", "operations", "stock"):
         if key not in data:
             raise InputError(f"{source}: missing key {key!r}")
+    if "\x00" in data.get("points", ""):
+        raise InputError(f"{source}: points = {data['points']!r}: a file name cannot hold a NUL character")
     if ("points" in data) == ("probe" in data):
         raise InputError(f"{source}: give points (a points file) or a [probe] table (the surface measured on the "
                          f"machine), {'not both' if 'points' in data else 'one of them'}")
