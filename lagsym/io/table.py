@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import re
+from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -266,10 +267,13 @@ def read_table(name: str, text: str, arity: int | None, columns=None) -> tuple[l
         rows = rows[1:]
     if not rows:
         raise InputError(f"{name}: no points in the file, only the header")
-    width = len(rows[0][1])
+    # The width most lines have: one odd line (a trailing separator) is the one named, even if it comes first.
+    counts = Counter(len(cells) for _, cells in rows)
+    width = max(counts, key=lambda w: (counts[w], w == len(rows[0][1])))
+    like = next(lineno for lineno, cells in rows if len(cells) == width)
     for lineno, cells in rows:
         if len(cells) != width:
-            raise InputError(f"{name}: line {lineno} has {len(cells)} columns, expected {width} like line {rows[0][0]}")
+            raise InputError(f"{name}: line {lineno} has {len(cells)} columns, expected {width} like line {like}")
     if header:
         _check_header(name, sep, header, header_line, rows)
         names, units = _header_names(name, header)
