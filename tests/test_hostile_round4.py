@@ -200,7 +200,8 @@ def test_a_simulated_alarm_names_the_program_file(tmp_path, run_cli):
                                   f"reads as no number at line 3: 'G01 X--1. F100.'\n"
 
 
-@pytest.mark.parametrize("lines, odd, like", [(["1,2,3,", "4,5,6", "7,8,9"], 2, 3), (["1,2,3", "4,5,6,", "7,8,9"], 3, 2)])
+@pytest.mark.parametrize("lines, odd, like", [(["1,2,3,", "4,5,6", "7,8,9"], 2, 3),
+                                              (["1,2,3", "4,5,6,", "7,8,9"], 3, 2)])
 def test_the_odd_line_of_a_table_is_the_one_named(tmp_path, run_cli, lines, odd, like):
     """A trailing comma on the first data line blamed the next line (its width was taken as the rule)."""
     path = tmp_path / "t.csv"
