@@ -67,7 +67,9 @@ def test_verify_with_a_large_tool_over_small_cells_stays_within_memory(tmp_path)
     status, peak, err = _peak_rss(LAGSYM + ["verify", str(EXAMPLES / "paper-example-1.json"), str(program),
                                             "--tool-diameter", "24"])
     assert status in (0, 1), err
-    assert peak < 1 << 30, f"{peak / 2 ** 30:.2f} GiB"
+    # The contract's 2 GB: a fresh install compiles its kernels in this process too (about 1 GB more than the
+    # 0.3 GB the sweep takes with them compiled).
+    assert peak < 2 << 30, f"{peak / 2 ** 30:.2f} GiB"
 
 
 def test_a_footprint_swept_in_bands_cuts_what_it_cuts_at_once(monkeypatch):
