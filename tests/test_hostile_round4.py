@@ -210,3 +210,37 @@ def test_the_odd_line_of_a_table_is_the_one_named(tmp_path, run_cli, lines, odd,
     path.write_text("x,y,z\n" + "\n".join(lines) + "\n")
     status, _, err = run_cli("fit", path)
     assert status == 2 and f"{path}: line {odd} has 4 columns, expected 3 like line {like}" in err, err
+
+
+SMALL_JOB = f"""points = "{(EXAMPLES / 'paper-example-1.json').as_posix()}"
+dialect = "fanuc"
+safe_z = 60
+title = "TITLE"
+
+[stock]
+top_above = 1
+
+[tools.ball]
+number = 1
+shape = "ball"
+diameter = 6
+
+[[operations]]
+kind = "finish"
+tool = "ball"
+stepover = 2
+step = 1
+"""
+
+
+def test_an_accented_title_keeps_its_letters_and_one_with_none_is_refused(tmp_path, run_cli):
+    """A title of accented letters only was dropped silently (the header read ``O1000 ()``)."""
+    job = tmp_path / "t.toml"
+    job.write_text(SMALL_JOB.replace("TITLE", "Pièce façonnée"))
+    status, _, err = run_cli("job", job, "-o", tmp_path / "t.nc")
+    assert status == 0, err
+    assert "O1000 (PIECE FACONNEE)" in (tmp_path / "t.nc").read_text()
+    job.write_text(SMALL_JOB.replace("TITLE", "日本"))
+    status, _, err = run_cli("job", job, "-o", tmp_path / "u.nc")
+    assert status == 2 and f"{job}: title = '日本' has no character a control prints" in err, err
+    assert not (tmp_path / "u.nc").exists()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import unicodedata
 
 from ..machine import MachineSettings
 
@@ -22,8 +23,12 @@ def iso_comment(text: str) -> str:
     --------
     >>> iso_comment("Paper example 4 (5x5), scale 1:20 – Ø6 ball")
     'PAPER EXAMPLE 4 5X5 SCALE 1 20 - 6 BALL'
+    >>> iso_comment("pièce façonnée")  # an accent is dropped, its letter kept
+    'PIECE FACONNEE'
     """
-    t = text.upper().replace("\u2013", "-").replace("\u2014", "-")
+    t = unicodedata.normalize("NFKD", text)
+    t = "".join(c for c in t if not unicodedata.combining(c))
+    t = t.upper().replace("\u2013", "-").replace("\u2014", "-")
     t = _NOT_ISO.sub(" ", t)
     return re.sub(r"\s+", " ", t).strip()
 

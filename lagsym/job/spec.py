@@ -322,6 +322,9 @@ def _check_title(title: str, c, program_number: int, source: str) -> None:
     from ..gcode.text import iso_comment
 
     text = iso_comment(title)
+    if title.strip() and not text:
+        raise InputError(f"{source}: title = {title!r} has no character a control prints in a comment (letters "
+                         "A-Z, digits, space and . + - /): write it in those, or leave title out")
     f = c.framing
     block = f.program_word.format(program_number) + f" ({text})" if f.program_word else f.comment(text)
     if len(block) > c.max_block:
