@@ -76,11 +76,16 @@ def exact_number(text: str) -> Fraction:
         raise NotANumber(f"{_quoted(text.strip())} is not a number")
     exponent = re.search(r"[eE]([+-]?\d+)", text)
     if exponent and len(exponent.group(1).lstrip("+-0")) > 6:
-        raise NotANumber(f"{_quoted(text.strip())} is out of range (overflow)")
+        raise NotANumber(f"{_quoted(text.strip())} is out of range ({_flow(exponent.group(1).startswith('-'))})")
     d = Decimal(text.strip())
     if len(d.as_tuple().digits) > MAX_EXPONENT or abs(d.adjusted()) > MAX_EXPONENT:
-        raise NotANumber(f"{_quoted(text.strip())} is out of range (overflow)")
+        tiny = d.adjusted() < -MAX_EXPONENT and len(d.as_tuple().digits) <= MAX_EXPONENT
+        raise NotANumber(f"{_quoted(text.strip())} is out of range ({_flow(tiny)})")
     return Fraction(d)
+
+
+def _flow(tiny: bool) -> str:
+    return f"too small: below 1e-{MAX_EXPONENT}, give 0 if it is nothing" if tiny else "overflow"
 
 
 def as_exact(value, where: str) -> Fraction:

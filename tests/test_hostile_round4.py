@@ -244,3 +244,12 @@ def test_an_accented_title_keeps_its_letters_and_one_with_none_is_refused(tmp_pa
     status, _, err = run_cli("job", job, "-o", tmp_path / "u.nc")
     assert status == 2 and f"{job}: title = '日本' has no character a control prints" in err, err
     assert not (tmp_path / "u.nc").exists()
+
+
+@pytest.mark.parametrize("text, words", [("1e-400", "too small: below 1e-300"), ("1e400", "overflow"),
+                                         ("1e-9999999", "too small"), ("1e9999999", "overflow")])
+def test_a_number_too_small_is_not_called_an_overflow(text, words):
+    from lagsym.values import NotANumber, exact_number
+
+    with pytest.raises(NotANumber, match=words):
+        exact_number(text)
