@@ -409,5 +409,18 @@ def snap_points(points: Sequence[Sequence[Fraction]], tolerance, axes: int = 2,
             moved += 1
             largest = max(largest, *shifts)
         out.append(q)
+    _check_not_joined(points, out, axes, tol, source)
     nodes = tuple(len(set(m.values())) for m in maps)
     return out, SnapReport(tolerance=tol, moved=moved, largest=largest, nodes=nodes)
+
+
+def _check_not_joined(points, snapped, axes: int, tol: Fraction, source: str) -> None:
+    """Refuse a snap that takes two points at different places to one place: two heights for one grid point."""
+    first: dict[tuple, int] = {}
+    for i, q in enumerate(snapped):
+        j = first.setdefault(q[:axes], i)
+        if j != i and any(Fraction(points[j][a]) != Fraction(points[i][a]) for a in range(axes)):
+            where = lambda p: ", ".join(_fmt(Fraction(v)) for v in p[:axes])  # noqa: E731
+            raise GridError(f"{source}: --snap {float(tol):g} takes points {j + 1} ({where(points[j])}) and {i + 1} "
+                            f"({where(points[i])}) to one place ({where(q)}): a tolerance wider than the nodes' "
+                            f"spacing (give a smaller one), or one place measured twice (average the two first)")

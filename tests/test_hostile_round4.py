@@ -253,3 +253,15 @@ def test_a_number_too_small_is_not_called_an_overflow(text, words):
 
     with pytest.raises(NotANumber, match=words):
         exact_number(text)
+
+
+def test_a_snap_that_joins_nodes_says_so(tmp_path, run_cli):
+    """``--snap 1e300`` said "duplicated grid point (2, 2) at points 1 and 2", with no word of the snap."""
+    path = tmp_path / "g.csv"
+    path.write_text("x,y,z\n1,1,1\n1,2,2\n2,1,3\n2,2,4\n")
+    status, _, err = run_cli("equation", path, "--snap", "1e300")
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"{path}: --snap 1e+300 takes points 1 (1, 1) and 2 (1, 2) to one place" in err, err
+    assert "a tolerance wider than the nodes' spacing (give a smaller one)" in err
+    status, out, err = run_cli("equation", path, "--snap", "0.5")
+    assert status == 0 and "z = 2*x + y - 2" in out
