@@ -265,3 +265,12 @@ def test_a_snap_that_joins_nodes_says_so(tmp_path, run_cli):
     assert "a tolerance wider than the nodes' spacing (give a smaller one)" in err
     status, out, err = run_cli("equation", path, "--snap", "0.5")
     assert status == 0 and "z = 2*x + y - 2" in out
+
+
+def test_a_point_with_both_x_and_capital_x_is_named(tmp_path, run_cli):
+    """``{"x": 1, "X": 2, ...}`` kept the later value and ended in "no point at (x, y) = ...", far from the cause."""
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps([{"x": 1, "X": 2, "y": 1, "z": 0}, {"x": 2, "y": 1, "z": 0},
+                                {"x": 1, "y": 2, "z": 0}, {"x": 2, "y": 2, "z": 0}]))
+    status, _, err = run_cli("equation", path)
+    assert status == 2 and "point 1 " in err and "should have keys x, y, z once each" in err, err

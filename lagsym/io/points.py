@@ -184,9 +184,9 @@ def _load_json(name: str, text: str) -> Any:
 def _point(name: str, idx: int, p: Any, arity: int) -> tuple[Fraction, ...]:
     want = "[x, y, z]" if arity == 3 else "[x, y]"
     if isinstance(p, dict):
-        keys = {str(k).lower(): v for k, v in p.items()}
-        if not all(c in keys for c in "xyz"[:arity]):
-            raise InputError(f"{name}: point {idx + 1} {_short(p)} should have keys {', '.join('xyz'[:arity])}")
+        keys, names = {str(k).lower(): v for k, v in p.items()}, ", ".join("xyz"[:arity])
+        if len(keys) < len(p) or not all(c in keys for c in "xyz"[:arity]):  # "x" and "X" are one key: twice
+            raise InputError(f"{name}: point {idx + 1} {_short(p)} should have keys {names} once each")
         return tuple(_value(keys[c], f"{name}: point {idx + 1} {c}") for c in "xyz"[:arity])
     if not isinstance(p, list):
         raise InputError(f"{name}: point {idx + 1} is {_short(p)}, not a list {want}")
