@@ -89,28 +89,27 @@ def _fmpq(v: Fraction) -> flint.fmpq:
     return flint.fmpq(v.numerator, v.denominator)
 
 
-def _basis_polys(nodes: tuple[Fraction, ...], source=None) -> list[flint.fmpq_poly]:
-    # One division and one normalisation a node, each about as long as the others: the clock foresees the whole
-    # basis from the first ones and refuses it past the time limit, as it does the products that follow.
-    clock = ExactClock(f"Lagrange basis on {len(nodes)} nodes", source)
-    started = time.perf_counter()
+def _basis_polys(nodes: tuple[Fraction, ...], clock: ExactClock) -> list[flint.fmpq_poly]:
     w = flint.fmpq_poly([1])
     for xj in nodes:
         w *= flint.fmpq_poly([-_fmpq(xj), 1])
-    out = []
+    out, started = [], time.perf_counter()
     for k, xi in enumerate(nodes):
         q = w // flint.fmpq_poly([-_fmpq(xi), 1])
         out.append(q / q(_fmpq(xi)))
-        clock.foresee(k + 1, len(nodes), time.perf_counter() - started, 0)
+        clock.foresee(k + 1, len(nodes), time.perf_counter() - started, 1)  # the rows' numbers follow
     return out
 
 
 def _basis_matrix(nodes: tuple[Fraction, ...], source=None) -> flint.fmpq_mat:
+    # A division and a normalisation a node, then a row's coefficients made into numbers (most of the time),
+    # each about as long as the others: one clock foresees the basis from its first rows and refuses it past the
+    # time limit, as it does the products that follow.
     n = len(nodes)
-    rows = []
-    polys = _basis_polys(nodes, source)
-    clock, started = ExactClock(f"Lagrange basis on {n} nodes", source), time.perf_counter()
-    for k, p in enumerate(polys):  # a row's coefficients made into numbers: most of the basis's time
+    clock = ExactClock(f"Lagrange basis on {n} nodes", source)
+    rows, polys = [], _basis_polys(nodes, clock)
+    started = time.perf_counter()
+    for k, p in enumerate(polys):
         c = p.coeffs()
         rows.extend(c + [flint.fmpq(0)] * (n - len(c)))
         clock.foresee(k + 1, n, time.perf_counter() - started, 0)
