@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..errors import ProgramError
 
-__all__ = ["ControlAlarm", "BlockAlarm", "alarm_at"]
+__all__ = ["ControlAlarm", "BlockAlarm", "alarm_at", "feed_zero"]
 
 
 class ControlAlarm(ProgramError):
@@ -33,3 +33,10 @@ def alarm_at(error: Exception, block) -> ControlAlarm:
     if isinstance(error, BlockAlarm):
         return ControlAlarm(error.alarm, error.message, block.line, block.text)
     return ControlAlarm("111", f"calculated data out of range ({type(error).__name__})", block.line, block.text)
+
+
+def feed_zero(feed) -> BlockAlarm:
+    """The alarm of a feed move with no feed: ``F0``, or no ``F`` since the start (a Fanuc's PS0011; LinuxCNC
+    refuses it too)."""
+    return BlockAlarm("11", f"a G01 move at feed {feed:g}: no F word since the start, or F0 (the control stops with "
+                            "'feed zero')")

@@ -29,7 +29,7 @@ import re
 from decimal import ROUND_HALF_UP, Decimal
 
 from ..gcode.program import unrun_code
-from .alarms import BlockAlarm, alarm_at
+from .alarms import BlockAlarm, alarm_at, feed_zero
 from .blocks import (Assign, AssignNamed, End, Goto, IfGoto, IfGotoLabel, IfThen, OElse, OElseIf, OEndWhile,
                      OIf, OWhile, Output, Stop, While, Words, probe_code)
 from .codegen import STOPS, Segment
@@ -137,9 +137,7 @@ def _send(m, b) -> None:
 
 
 def _no_feed(m) -> None:
-    """A feed move with no feed: F0, or no F since the start (a Fanuc's alarm PS0011, LinuxCNC's too)."""
-    raise BlockAlarm("11", f"a G01 move at feed {m.feed:g}: no F word since the start, or F0 (the control stops with "
-                           "'feed zero')")
+    raise feed_zero(m.feed)
 
 
 def _arc(m) -> None:

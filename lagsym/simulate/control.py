@@ -11,7 +11,7 @@ import math
 from decimal import ROUND_CEILING, ROUND_DOWN, ROUND_FLOOR, ROUND_HALF_UP, ROUND_UP, Context, Decimal
 
 from ..controls import Control, control
-from .alarms import BlockAlarm
+from .alarms import BlockAlarm, feed_zero
 from .probing import ProbeCrash
 from .result import SimMoves
 
@@ -133,8 +133,7 @@ class ControlState:
                 self.pos[axis] = v if self.absolute else self.ctx.add(self.pos[axis], v)
         if any(k in words for k in "XYZ"):
             if self.motion == "G1" and not self.feed > 0:
-                raise BlockAlarm("11", f"a G01 move at feed {self.feed:g}: no F word since the start, or F0 (the "
-                                       "control stops with 'feed zero')")
+                raise feed_zero(self.feed)
             self.moves.append(line, self.motion == "G0", float(self.pos[0]), float(self.pos[1]),
                               float(self.pos[2]), float(self.feed))
 
