@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import errno
 import importlib
 import os
 import signal
@@ -202,8 +201,9 @@ class _StandardOutput:
     def _fail(self, e: OSError | None) -> OutputError:
         if e is None:
             return OutputError("standard output is closed: nothing could be written; give -o FILE or open it")
-        reason = "no space left on the device" if e.errno == errno.ENOSPC else (e.strerror or str(e)).lower()
-        return OutputError(f"standard output: cannot write ({reason}); give -o FILE to write a file instead")
+        from ..io.write import error_reason
+
+        return OutputError(f"standard output: cannot write ({error_reason(e)}); give -o FILE to write a file instead")
 
     def write(self, text: str) -> int:
         if self._stream is None:

@@ -11,7 +11,7 @@ from ..errors import InputError
 from ..io import write_text
 from ._lines import say
 from ..controls import CONTROLS, work_offset
-from ..machine import FEED_UNITS, LENGTH_UNITS, split_unit
+from ..machine import FEED_UNITS, LENGTH_UNITS, MM_PER, split_unit
 from ..values import as_exact, finite, in_range, whole
 
 
@@ -217,7 +217,6 @@ def number(low: float, high: float, unit: str = "", *, above: bool = False):
 # Lengths and feeds are read in the program's units (``--units``: a machinist with an inch control thinks
 # in inches and inches a minute) unless the number carries its own: ``5mm``, ``0.2in``, ``600mm/min``,
 # ``24in/min``.  The range is checked once the number is in millimetres.
-MM_PER_INCH = 25.4
 
 
 @dataclass(frozen=True)
@@ -233,7 +232,7 @@ class Given:
     unit: str
 
     def mm(self, option: str, program_units: str) -> float:
-        factor = self.factor if self.factor is not None else (MM_PER_INCH if program_units == "inch" else 1.0)
+        factor = self.factor if self.factor is not None else float(MM_PER[program_units])
         value = self.value if factor == 1.0 else self.value * factor
         try:
             return in_range(value, "", self.low, self.high, above=self.above, unit=self.unit)

@@ -27,7 +27,7 @@ from ..errors import InputError, OutputError
 from .files import path_problem
 
 __all__ = ["atomic_path", "atomic_write", "write_text", "check_output", "check_not_input", "check_apart",
-           "OutputNotice", "temporary_name"]
+           "OutputNotice", "temporary_name", "error_reason"]
 
 SUFFIX_KEPT = 16  # characters of the target's extension the temporary keeps (meshio and VTK choose a format by it)
 
@@ -36,7 +36,8 @@ class OutputNotice(UserWarning):
     """Something about a finished write the user should know (the command line prints it as one line)."""
 
 
-def _reason(e: OSError) -> str:
+def error_reason(e: OSError) -> str:
+    """Why a write or a path failed, in the words a message gives: ``no space left on the device``, ..."""
     return "no space left on the device" if e.errno == errno.ENOSPC else (e.strerror or str(e)).lower()
 
 
@@ -44,11 +45,11 @@ def _write_error(path, e: OSError, stream: bool = False) -> OutputError:
     if isinstance(e, OutputError):  # already one line that names the path: never wrapped twice
         return e
     tail = "" if stream else "; any earlier file there is untouched"
-    return OutputError(f"{path}: cannot write ({_reason(e)}){tail}")
+    return OutputError(f"{path}: cannot write ({error_reason(e)}){tail}")
 
 
 def _path_error(path, e: OSError) -> InputError:
-    return InputError(f"{path}: {path_problem(e) or f'cannot use this path ({_reason(e)})'}")
+    return InputError(f"{path}: {path_problem(e) or f'cannot use this path ({error_reason(e)})'}")
 
 
 def _target(path) -> tuple[Path, os.stat_result | None]:

@@ -19,7 +19,7 @@ from ..export.piecewisejson import read_piecewise_file
 from ..exactsize import MAX_EXACT_MB
 from ..io import read_points
 from ..lagrange import lagrange_surface
-from ..machine import MachineSettings, RasterSpec
+from ..machine import MM_PER, MachineSettings, RasterSpec
 from ..macro import DEFAULT_PRECISION
 from ..macro.roughing import piecewise_macro_refusal, rough_macro
 from ..progress import Progress, Tally, prefixed
@@ -126,7 +126,8 @@ def plan_job(spec: JobSpec, max_points: int | None = MAX_PLAN_POINTS,
     ev = evaluator_of(surface)
     stock = job_stock(spec, surface, ev)
     if spec.safe_z_mm <= stock.top_mm:
-        both = (lambda mm: f"{mm / 25.4:.4f} in ({mm:g} mm)") if spec.units == "inch" else (lambda mm: f"{mm:g} mm")
+        inch = float(MM_PER["inch"])
+        both = (lambda mm: f"{mm / inch:.4f} in ({mm:g} mm)") if spec.units == "inch" else (lambda mm: f"{mm:g} mm")
         raise InputError(f"{spec.source}: safe_z = {both(spec.safe_z_mm)} is not above the stock top "
                          f"{both(stock.top_mm)}")
     ops = []
